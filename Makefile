@@ -1,0 +1,150 @@
+# kmorph - build, test, run. `make run` and `make test` do all set-up on a
+# fresh Debian 12 machine (system packages are installed with apt-get when
+# missing).
+
+CC      ?= gcc
+BUILD   ?= build
+SAN     ?=
+OPT     ?= -O2
+CSTD    := -std=c11
+WARN    := -Wall -Wextra -Werror -Wshadow -Wpointer-arith -Wstrict-prototypes
+CFLAGS_BASE := $(CSTD) $(OPT) -g $(WARN) -D_POSIX_C_SOURCE=200809L -fno-common
+ifeq ($(SAN),address)
+  SANFLAGS := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
+endif
+ifeq ($(SAN),thread)
+  SANFLAGS := -fsanitize=thread -fno-omit-frame-pointer
+endif
+CFLAGS  := $(CFLAGS_BASE) $(SANFLAGS) $(EXTRA_CFLAGS)
+LDFLAGS := $(SANFLAGS) $(EXTRA_LDFLAGS)
+
+# System packages the build and the tests need (Debian 12 names).
+PACKAGES := gcc make pkg-config libcmocka-dev libcjson-dev libmicrohttpd-dev \
+            clang libclang-rt-14-dev curl jq valgrind libxml2-utils \
+            librsvg2-bin nodejs npm wrk python3
+
+CJSON_CFLAGS := -I/usr/include/cjson
+CJSON_LIBS   := -lcjson
+MHD_LIBS     := -lmicrohttpd
+
+# Layers: each is a static library; a wrong-way include does not compile
+# because the include path of a layer names only the layers below it.
+CORE_INC := -Icore/include
+API_INC  := -Iapi/include $(CORE_INC) $(CJSON_CFLAGS)
+SRV_INC  := -Iapi/include
+
+CORE_SRC := $(wildcard core/src/*.c)
+API_SRC  := $(wildcard api/src/*.c)
+SRV_SRC  := $(wildcard server/src/*.c)
+CORE_OBJ := $(CORE_SRC:%.c=$(BUILD)/%.o)
+API_OBJ  := $(API_SRC:%.c=$(BUILD)/%.o)
+SRV_OBJ  := $(SRV_SRC:%.c=$(BUILD)/%.o)
+
+LIBCORE := $(BUILD)/libkmorph.a
+LIBAPI  := $(BUILD)/libkmapi.a
+CLI     := $(BUILD)/kmorph
+DAEMON  := $(BUILD)/kmorphd
+
+UNIT_SRC  := $(wildcard tests/unit/test_*.c)
+APIT_SRC  := $(wildcard tests/api/test_*.c)
+UNIT_BIN  := $(UNIT_SRC:%.c=$(BUILD)/%)
+APIT_BIN  := $(APIT_SRC:%.c=$(BUILD)/%)
+SUPPORT_SRC := $(wildcard tests/support/*.c)
+
+.PHONY: all deps build run test test-unit test-asan test-server check-layers \
+        bench fuzz clean format examples
+
+all: build
+
+deps:
+	@missing=""; for p in $(PACKAGES); do \
+	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "ok installed" || missing="$$missing $$p"; \
+	done; \
+	if [ -n "$$missing" ]; then \
+	  echo "installing:$$missing"; \
+	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
+	  $$SUDO apt-get update -qq && \
+	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $$missing >/dev/null; \
+	fi
+
+build: $(LIBCORE) $(LIBAPI) $(CLI) $(if $(SRV_SRC),$(DAEMON))
+
+$(BUILD)/core/%.o: core/%.c
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) $(CORE_INC) -MMD -MP -c $< -o $@
+
+$(BUILD)/api/%.o: api/%.c
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) $(API_INC) -MMD -MP -c $< -o $@
+
+$(BUILD)/server/%.o: server/%.c
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) $(SRV_INC) -MMD -MP -c $< -o $@
+
+$(LIBCORE): $(CORE_OBJ)
+	@mkdir -p $(@D)
+	rm -f $@ && ar rcs $@ $^
+
+$(LIBAPI): $(API_OBJ)
+	@mkdir -p $(@D)
+	rm -f $@ && ar rcs $@ $^
+
+$(CLI): cli/kmorph.c $(LIBAPI) $(LIBCORE)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) $(SRV_INC) $< -o $@ $(LIBAPI) $(LIBCORE) $(CJSON_LIBS) -lm $(LDFLAGS)
+
+$(DAEMON): $(SRV_OBJ) $(LIBAPI) $(LIBCORE)
+	@mkdir -p $(@D)
+	$(CC) $(SRV_OBJ) -o $@ $(LIBAPI) $(LIBCORE) $(MHD_LIBS) $(CJSON_LIBS) -lm -lpthread $(LDFLAGS)
+
+$(BUILD)/tests/unit/%: tests/unit/%.c $(SUPPORT_SRC) $(LIBCORE)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) $(CORE_INC) -Itests/support $(CJSON_CFLAGS) $< $(SUPPORT_SRC) -o $@ $(LIBCORE) -lcmocka $(CJSON_LIBS) -lm $(LDFLAGS)
+
+$(BUILD)/tests/api/%: tests/api/%.c $(SUPPORT_SRC) $(LIBAPI) $(LIBCORE)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) $(API_INC) -Itests/support $< $(SUPPORT_SRC) -o $@ $(LIBAPI) $(LIBCORE) -lcmocka $(CJSON_LIBS) -lm $(LDFLAGS)
+
+-include $(CORE_OBJ:.o=.d) $(API_OBJ:.o=.d) $(SRV_OBJ:.o=.d)
+
+# core/ must build with libm alone and must not include anything above it.
+check-layers:
+	@if grep -rnE '#include *[<"](kmapi|cJSON|microhttpd|stdio|pthread)' core/; then \
+	  echo "core/ includes something above it or does I/O"; exit 1; fi
+	@if grep -rnE '#include *[<"](km/|microhttpd)' api/ | grep -v '^api/src'; then \
+	  echo "api headers leak core or transport"; exit 1; fi
+	@if grep -rnE '#include *[<"](km/|cJSON)' server/; then \
+	  echo "server/ reaches past the api layer"; exit 1; fi
+	@echo "layers: ok"
+
+test-unit: $(UNIT_BIN) $(APIT_BIN) $(CLI)
+	@KMORPH_CLI=$(CLI) tests/run-tests.sh $(UNIT_BIN) $(APIT_BIN)
+
+test: deps
+	@rm -f build/test-results.txt
+	@$(MAKE) --no-print-directory build check-layers
+	@$(MAKE) --no-print-directory CC=clang BUILD=build/clang build >/dev/null
+	@echo "== unit and contract-layer tests (gcc -O2)"
+	@$(MAKE) --no-print-directory test-unit
+	@echo "== the same under AddressSanitizer + UndefinedBehaviorSanitizer"
+	@$(MAKE) --no-print-directory BUILD=build/asan SAN=address OPT=-O1 test-unit
+	@tests/summarise.sh
+
+run: deps build
+	@if [ -x $(DAEMON) ]; then exec $(DAEMON) --bind 127.0.0.1 --port 8080; \
+	else echo "kmorphd not built yet: CLI demo"; \
+	  $(CLI) signature < docs/examples/circle-signature.json; fi
+
+bench: deps
+	@$(MAKE) --no-print-directory build/bench/bench_core
+	build/bench/bench_core
+
+build/bench/%: bench/%.c $(LIBCORE)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) $(CORE_INC) $< -o $@ $(LIBCORE) -lm $(LDFLAGS)
+
+format:
+	clang-format -i core/src/*.c core/include/km/*.h api/src/*.c api/include/kmapi/*.h cli/*.c $(wildcard server/src/*.[ch])
+
+clean:
+	rm -rf build

@@ -1,0 +1,35 @@
+/* limits.h - every hard bound of libkmorph in one place, each with why.
+ *
+ * The contract layer enforces its own, configurable limits (control points
+ * per curve, frames per request) before calling the core; these are the
+ * bounds the core itself will not go past whatever it is asked.
+ */
+#ifndef KM_LIMITS_H
+#define KM_LIMITS_H
+
+/* Degrees 1..9: the range; above 9 Bernstein bases lose digits. */
+#define KM_MIN_DEGREE 1
+#define KM_MAX_DEGREE 9
+
+/* Coordinates and lengths beyond 1e15 leave fewer than one digit of
+ * sub-unit precision in a double; refuse rather than compute noise. */
+#define KM_MAX_COORDINATE 1e15
+
+/* Smallest relative tolerance honoured: below ~1e-13 of the length the
+ * answer is rounding noise, so tighter requests are clamped to it. */
+#define KM_MIN_RELATIVE_TOLERANCE 1e-13
+
+/* Output pieces one signature or reconstruction may create. Bounds memory
+ * and time for adversarial input (~100 bytes a piece). */
+#define KM_MAX_PIECES 2000000
+
+/* Bisection depth when refining toward a singular point (a degenerate
+ * control leg makes curvature grow like 1/sqrt(s)); 2^-60 of a span is
+ * below double resolution. */
+#define KM_MAX_REFINE_DEPTH 60
+
+/* Newton iterations for arc-length inversion before falling back to
+ * bisection. */
+#define KM_MAX_NEWTON_ITERATIONS 50
+
+#endif

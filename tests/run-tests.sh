@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# run-tests.sh - run cmocka test binaries, show their output, and append
+# "name passed failed" per binary to the results file that summarise.sh
+# totals. A binary that crashes or exits non-zero without reporting a
+# failure counts as one failed test.
+set -u
+results=${KM_RESULTS:-build/test-results.txt}
+mkdir -p "$(dirname "$results")"
+status=0
+for bin in "$@"; do
+  out=$(CMOCKA_MESSAGE_OUTPUT=stdout timeout "${KM_TEST_TIMEOUT:-900}" "$bin" 2>&1)
+  rc=$?
+  printf '%s\n' "$out"
+  passed=$(printf '%s\n' "$out" | sed -n 's/^\[  PASSED  \] \([0-9]*\) test(s)\./\1/p' | tail -n 1)
+  failed=$(printf '%s\n' "$out" | sed -n 's/^\[  FAILED  \] \([0-9]*\) test(s).*/\1/p' | tail -n 1)
+  passed=${passed:-0}
+  failed=${failed:-0}
+  if [ "$rc" -ne 0 ] && [ "$failed" -eq 0 ]; then
+    echo "!! $bin exited with status $rc"
+    failed=1
+  fi
+  [ "$failed" -ne 0 ] && status=1
+  echo "$bin $passed $failed" >>"$results"
+done
+exit $status
