@@ -4,6 +4,7 @@
 #include "km/curve.h"
 #include "km/fn.h"
 #include "km/limits.h"
+#include "km/morph.h"
 #include "km/reconstruct.h"
 #include "km/signature.h"
 #include "km/status.h"

@@ -1,0 +1,63 @@
+/* svg.h - SVG path data in and out, and SVG documents for morph results
+ * (internal to the api layer).
+ *
+ * Ownership: returned strings are malloc'd and freed by the caller.
+ */
+#ifndef KMAPI_SVG_H
+#define KMAPI_SVG_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "km/curve.h"
+#include "km/signature.h"
+
+/* Parse one SVG 1.1 path `d` (one subpath; every command, absolute and
+ * relative) into a curve: lines, quadratics and cubics exactly, arcs as
+ * rational pieces exactly, all raised to one common degree; `Z` makes it
+ * closed; zero-length pieces are dropped. tol (> 0) is the distance
+ * tolerance used where a repair needs one. On failure returns a status,
+ * *err_offset = character offset of the problem and msg (NUL-terminated,
+ * at most msgcap bytes) says what was expected. */
+km_status api_svg_parse_path(const char *d, size_t len, double tol,
+                             km_curve *out, size_t *err_offset, char *msg,
+                             size_t msgcap);
+
+/* The curve as an SVG path of cubic Beziers ("M x y C ..." and "Z" if
+ * closed), within tol of the curve (degree > 3 and rational curves are
+ * approximated; *err_bound, if not NULL, receives the bound). NULL on
+ * out-of-memory. */
+char *api_svg_path_d(const km_curve *c, double tol, double *err_bound);
+
+/* Same, with a fixed number of cubic pieces (n_pieces >= 1), so that paths
+ * of every frame share one command structure (for SMIL / CSS animation). */
+char *api_svg_path_d_fixed(const km_curve *c, size_t n_pieces);
+
+typedef enum api_svg_layout {
+  API_SVG_FILMSTRIP,
+  API_SVG_OVERLAY,
+  API_SVG_ANIMATE,
+  API_SVG_CURVATURE_PLOT
+} api_svg_layout;
+
+typedef struct api_svg_options {
+  api_svg_layout layout;
+  double width, height;   /* document size in px; <= 0: automatic */
+  double stroke_width;    /* <= 0: automatic */
+  const char *stroke;     /* colour of single-colour layouts, or NULL */
+  const char *from_color; /* colour ramp start (overlay, plot), or NULL */
+  const char *to_color;   /* colour ramp end, or NULL */
+  double duration;        /* seconds, animate layout; <= 0: 2 s */
+} api_svg_options;
+
+typedef struct api_svg_frame {
+  double t;
+  const km_curve *curve;
+  const km_signature *sig; /* for curvature plots; may be NULL */
+} api_svg_frame;
+
+/* A complete, well-formed SVG document of a morph. NULL on out-of-memory. */
+char *api_svg_morph_document(const api_svg_frame *frames, size_t n,
+                             const api_svg_options *opt);
+
+#endif
