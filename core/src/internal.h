@@ -1,0 +1,82 @@
+/* internal.h - helpers shared inside libkmorph; not part of the API.
+ *
+ * Non-static internal symbols are prefixed km__ (public ones km_).
+ */
+#ifndef KM_INTERNAL_H
+#define KM_INTERNAL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "km/curve.h"
+#include "km/fn.h"
+#include "km/status.h"
+
+#define KM_PI 3.14159265358979323846
+
+/* Record an error: code, field, element index, parameter and a message
+ * formatted by km__format (a small printf subset: %s %d %ld %zu %g; no
+ * locale, no stdio). Returns code so callers can `return km__fail(...)`. */
+km_status km__fail(km_error *err, km_status code, km_field field, long index,
+                   double param, const char *fmt, ...);
+
+/* printf-like formatting into buf (always NUL-terminated): %s %d %ld %zu
+ * and %g (six significant digits). */
+void km__format(char *buf, size_t cap, const char *fmt, ...);
+
+/* Allocate an empty curve of the given shape in one block (knots, points,
+ * weights if rational). Contents uninitialised. */
+km_status km__curve_alloc(km_curve *c, int degree, size_t n, bool rational);
+km_status km__fn_alloc(km_fn *f, int degree, size_t n);
+
+/* Gauss-Legendre rules on [-1, 1]. */
+extern const double km__gl8_x[8], km__gl8_w[8];
+extern const double km__gl16_x[16], km__gl16_w[16];
+
+/* Speed |C'(t)| and the integral of the speed over [a, b], to about
+ * rel_tol relative (adaptive Gauss-Legendre, 8 vs 16 points). */
+double km__speed(const km_curve *c, double t);
+double km__length_adaptive(const km_curve *c, double a, double b,
+                           double abs_tol);
+
+/* Span index i with knots[i] <= t < knots[i+1] (last non-empty span at the
+ * domain end); side < 0 picks knots[i] < t <= knots[i+1]. */
+size_t km__find_span(const km_curve *c, double t, int side);
+
+/* Wrap an angle to (-pi, pi]. */
+double km__wrap_angle(double a);
+
+/* ---- piecewise polynomials in Bernstein form ----------------------------
+ * The numerics work on pieces: breaks x[0] < ... < x[m], and per piece the
+ * d+1 Bernstein coefficients over [x[i], x[i+1]]. */
+typedef struct km_pp {
+  int degree;
+  size_t m;    /* number of pieces */
+  double *x;   /* m + 1 breaks */
+  double *c;   /* m * (degree + 1) coefficients */
+} km_pp;
+
+void km__pp_init(km_pp *p);
+void km__pp_free(km_pp *p);
+km_status km__pp_alloc(km_pp *p, int degree, size_t m);
+/* B-spline function -> pieces (exact, by knot insertion). */
+km_status km__pp_from_fn(km_pp *out, const km_fn *f);
+/* Pieces -> B-spline function (breaks of multiplicity degree+1). */
+km_status km__pp_to_fn(km_fn *out, const km_pp *p);
+/* Value of a Bernstein polynomial of degree d at u in [0,1]. */
+double km__bern_eval(const double *c, int d, double u);
+/* Coefficients over the sub-interval [u0, u1] of [0, 1]. */
+void km__bern_restrict(const double *c, int d, double u0, double u1,
+                       double *out);
+/* Degree elevation from d to e >= d. */
+void km__bern_elevate(const double *c, int d, int e, double *out);
+/* Derivative with respect to the piece variable scaled by 1/h (degree d-1
+ * coefficients). */
+void km__bern_derivative(const double *c, int d, double h, double *out);
+/* Max |coefficient|: a bound on max |p| over the piece. */
+double km__bern_abs_bound(const double *c, int d);
+/* Index of the piece containing x (right-continuous, last piece at end). */
+size_t km__pp_find(const km_pp *p, double x);
+double km__pp_eval(const km_pp *p, double x);
+
+#endif
