@@ -78,5 +78,10 @@ double km__bern_abs_bound(const double *c, int d);
 /* Index of the piece containing x (right-continuous, last piece at end). */
 size_t km__pp_find(const km_pp *p, double x);
 double km__pp_eval(const km_pp *p, double x);
+double km__pp_max_abs(const km_pp *p);
+double km__pp_integral_sq(const km_pp *p);
+/* out(u0 + r (u1-u0)) = wa a(r over a's domain) + wb b(r over b's), exact. */
+km_status km__pp_blend(km_pp *out, const km_pp *a, double wa, const km_pp *b,
+                       double wb, double u0, double u1);
 
 #endif

@@ -1,0 +1,386 @@
+/* fn.c - scalar B-spline functions: construction, evaluation, exact
+ * antiderivative, bounds, and the exact linear blend of two functions on
+ * different knots over a normalised domain.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+#include "km/limits.h"
+
+#define FN_MAX_DEGREE (KM_MAX_DEGREE + 1)
+
+void km_fn_init(km_fn *f) {
+  if (f) memset(f, 0, sizeof *f);
+}
+
+void km_fn_free(km_fn *f) {
+  if (!f) return;
+  free(f->knots);
+  memset(f, 0, sizeof *f);
+}
+
+km_status km__fn_alloc(km_fn *f, int degree, size_t n) {
+  size_t nk = n + (size_t)degree + 1;
+  if (n == 0) return KM_ENOMEM;
+  double *block = malloc((nk + n) * sizeof(double));
+  if (!block) return KM_ENOMEM;
+  f->degree = degree;
+  f->n = n;
+  f->knots = block;
+  f->coef = block + nk;
+  return KM_OK;
+}
+
+km_status km_fn_create(km_fn *out, int degree, size_t n, const double *knots,
+                       const double *coef, km_error *err) {
+  if (degree < 0 || degree > FN_MAX_DEGREE)
+    return km__fail(err, KM_EDEGREE, KM_FIELD_KAPPA_DEGREE, -1, NAN,
+                    "degree %d is outside 0..%d", degree, FN_MAX_DEGREE);
+  if (!knots || !coef || n < (size_t)degree + 1)
+    return km__fail(err, KM_ECOUNT, KM_FIELD_KAPPA_COEFFICIENTS, -1, NAN,
+                    "a function of degree %d needs at least %d coefficients",
+                    degree, degree + 1);
+  size_t nk = n + (size_t)degree + 1;
+  for (size_t i = 0; i < n; i++) {
+    if (!isfinite(coef[i]))
+      return km__fail(err, KM_ENONFINITE, KM_FIELD_KAPPA_COEFFICIENTS,
+                      (long)i, NAN, "coefficient %zu is not finite", i);
+    if (fabs(coef[i]) > KM_MAX_COORDINATE)
+      return km__fail(err, KM_ERANGE, KM_FIELD_KAPPA_COEFFICIENTS, (long)i,
+                      NAN, "coefficient %zu exceeds %g in magnitude", i,
+                      KM_MAX_COORDINATE);
+  }
+  for (size_t i = 0; i < nk; i++) {
+    if (!isfinite(knots[i]))
+      return km__fail(err, KM_ENONFINITE, KM_FIELD_KAPPA_KNOTS, (long)i, NAN,
+                      "knot %zu is not finite", i);
+    if (fabs(knots[i]) > KM_MAX_COORDINATE)
+      return km__fail(err, KM_ERANGE, KM_FIELD_KAPPA_KNOTS, (long)i, NAN,
+                      "knot %zu exceeds %g in magnitude", i,
+                      KM_MAX_COORDINATE);
+    if (i > 0 && knots[i] < knots[i - 1])
+      return km__fail(err, KM_EKNOTS, KM_FIELD_KAPPA_KNOTS, (long)i, NAN,
+                      "knot vector decreases at index %zu", i);
+  }
+  for (int i = 1; i <= degree; i++) {
+    if (knots[i] != knots[0])
+      return km__fail(err, KM_EKNOTS, KM_FIELD_KAPPA_KNOTS, (long)i, NAN,
+                      "knot vector is not clamped: the first %d knots must "
+                      "be equal",
+                      degree + 1);
+    if (knots[nk - 1 - (size_t)i] != knots[nk - 1])
+      return km__fail(err, KM_EKNOTS, KM_FIELD_KAPPA_KNOTS,
+                      (long)(nk - 1 - (size_t)i), NAN,
+                      "knot vector is not clamped: the last %d knots must be "
+                      "equal",
+                      degree + 1);
+  }
+  if (!(knots[n] > knots[degree]))
+    return km__fail(err, KM_EKNOTS, KM_FIELD_KAPPA_KNOTS, (long)n, NAN,
+                    "knot vector has an empty domain");
+  size_t run = 1;
+  for (size_t i = (size_t)degree + 1; i < n; i++) {
+    run = knots[i] == knots[i - 1] ? run + 1 : 1;
+    if (run > (size_t)degree + 1)
+      return km__fail(err, KM_EKNOTS, KM_FIELD_KAPPA_KNOTS, (long)i, NAN,
+                      "interior knot at index %zu has multiplicity above "
+                      "degree + 1",
+                      i);
+  }
+  km_fn f;
+  if (km__fn_alloc(&f, degree, n))
+    return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  memcpy(f.knots, knots, nk * sizeof(double));
+  memcpy(f.coef, coef, n * sizeof(double));
+  *out = f;
+  return KM_OK;
+}
+
+km_status km_fn_copy(km_fn *out, const km_fn *f, km_error *err) {
+  return km_fn_create(out, f->degree, f->n, f->knots, f->coef, err);
+}
+
+km_status km_fn_constant(km_fn *out, double a, double b, double c,
+                         km_error *err) {
+  double knots[2] = {a, b};
+  return km_fn_create(out, 0, 1, knots, &c, err);
+}
+
+void km_fn_domain(const km_fn *f, double *a, double *b) {
+  *a = f->knots[f->degree];
+  *b = f->knots[f->n];
+}
+
+static size_t fn_span(const km_fn *f, double x) {
+  size_t p = (size_t)f->degree, n = f->n;
+  const double *U = f->knots;
+  if (x >= U[n]) {
+    size_t i = n - 1;
+    while (i > p && !(U[i + 1] > U[i])) i--;
+    return i;
+  }
+  if (x <= U[p]) {
+    size_t i = p;
+    while (i < n - 1 && !(U[i + 1] > U[i])) i++;
+    return i;
+  }
+  size_t lo = p, hi = n;
+  while (hi - lo > 1) {
+    size_t mid = (lo + hi) / 2;
+    if (x < U[mid])
+      hi = mid;
+    else
+      lo = mid;
+  }
+  return lo;
+}
+
+/* k-th derivative at x on span i: difference the local coefficients k
+ * times, then de Boor on the lowered degree. */
+static double eval_local(const km_fn *f, size_t i, double x, int k) {
+  int p = f->degree;
+  if (k > p) return 0.0;
+  const double *U = f->knots;
+  double e[FN_MAX_DEGREE + 2];
+  /* e[j] holds the coefficient with global index i - p + j */
+  for (int j = 0; j <= p; j++) e[j] = f->coef[i - (size_t)p + (size_t)j];
+  int q = p;
+  for (int r = 1; r <= k; r++) {
+    /* new coefficients for global j = i-q+1 .. i (local jj = p-q+1..p) */
+    for (int jj = p; jj >= p - q + 1; jj--) {
+      size_t g = i - (size_t)p + (size_t)jj;
+      double den = U[g + (size_t)q] - U[g];
+      e[jj] = den > 0 ? q * (e[jj] - e[jj - 1]) / den : 0.0;
+    }
+    q--;
+  }
+  /* de Boor for degree q with coefficients e[p-q .. p] */
+  double d[FN_MAX_DEGREE + 2];
+  for (int j = 0; j <= q; j++) d[j] = e[p - q + j];
+  for (int r = 1; r <= q; r++) {
+    for (int j = q; j >= r; j--) {
+      size_t lo = i - (size_t)q + (size_t)j;
+      size_t hi = i + 1 + (size_t)j - (size_t)r;
+      double den = U[hi] - U[lo];
+      double al = den > 0 ? (x - U[lo]) / den : 0.0;
+      d[j] = (1.0 - al) * d[j - 1] + al * d[j];
+    }
+  }
+  return d[q];
+}
+
+void km_fn_eval(const km_fn *f, double x, int nder, double *out) {
+  double a, b;
+  km_fn_domain(f, &a, &b);
+  if (x < a) x = a;
+  if (x > b) x = b;
+  size_t i = fn_span(f, x);
+  for (int k = 0; k <= nder; k++) out[k] = eval_local(f, i, x, k);
+}
+
+double km_fn_value(const km_fn *f, double x) {
+  double v;
+  km_fn_eval(f, x, 0, &v);
+  return v;
+}
+
+km_status km_fn_antiderivative(km_fn *out, const km_fn *f, double c0,
+                               km_error *err) {
+  int p = f->degree;
+  if (p + 1 > FN_MAX_DEGREE)
+    return km__fail(err, KM_EDEGREE, KM_FIELD_KAPPA_DEGREE, -1, NAN,
+                    "antiderivative would exceed degree %d", FN_MAX_DEGREE);
+  km_fn r;
+  if (km__fn_alloc(&r, p + 1, f->n + 1))
+    return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  size_t nk = f->n + (size_t)p + 1;
+  r.knots[0] = f->knots[0];
+  memcpy(r.knots + 1, f->knots, nk * sizeof(double));
+  r.knots[nk + 1] = f->knots[nk - 1];
+  r.coef[0] = c0;
+  for (size_t j = 1; j <= f->n; j++)
+    r.coef[j] = r.coef[j - 1] + f->coef[j - 1] *
+                                    (f->knots[j + (size_t)p] - f->knots[j - 1]) /
+                                    (p + 1);
+  *out = r;
+  return KM_OK;
+}
+
+double km_fn_integral(const km_fn *f) {
+  int p = f->degree;
+  double s = 0.0;
+  for (size_t i = 0; i < f->n; i++)
+    s += f->coef[i] * (f->knots[i + (size_t)p + 1] - f->knots[i]);
+  return s / (p + 1);
+}
+
+double km_fn_abs_bound(const km_fn *f, double x0, double x1) {
+  km_pp pp;
+  if (km__pp_from_fn(&pp, f)) {
+    double m = 0; /* fall back to the global coefficient hull */
+    for (size_t i = 0; i < f->n; i++) m = fmax(m, fabs(f->coef[i]));
+    return m;
+  }
+  int d = pp.degree;
+  double m = 0.0, c[FN_MAX_DEGREE + 2];
+  for (size_t i = 0; i < pp.m; i++) {
+    double a = pp.x[i], b = pp.x[i + 1];
+    double lo = fmax(a, x0), hi = fmin(b, x1);
+    if (hi < lo || (hi == lo && !(x0 == x1))) continue;
+    double h = b - a;
+    km__bern_restrict(pp.c + i * (size_t)(d + 1), d, (lo - a) / h,
+                      (hi - a) / h, c);
+    m = fmax(m, km__bern_abs_bound(c, d));
+  }
+  km__pp_free(&pp);
+  return m;
+}
+
+/* max |p| over [0,1] by subdivision: the coefficient hull bounds from
+ * above, end values from below. */
+static double bern_max_abs(const double *c, int d, double lower, int depth) {
+  double ends = fmax(fabs(c[0]), fabs(c[d]));
+  if (ends > lower) lower = ends;
+  double upper = km__bern_abs_bound(c, d);
+  if (upper <= lower * (1.0 + 1e-13) || depth > 60) return fmax(lower, ends);
+  double L[FN_MAX_DEGREE + 2], R[FN_MAX_DEGREE + 2];
+  km__bern_restrict(c, d, 0.0, 0.5, L);
+  km__bern_restrict(c, d, 0.5, 1.0, R);
+  double ml = bern_max_abs(L, d, lower, depth + 1);
+  if (ml > lower) lower = ml;
+  double mr = bern_max_abs(R, d, lower, depth + 1);
+  return fmax(lower, mr);
+}
+
+double km__pp_max_abs(const km_pp *p) {
+  double m = 0.0;
+  int d = p->degree;
+  for (size_t i = 0; i < p->m; i++)
+    m = fmax(m, bern_max_abs(p->c + i * (size_t)(d + 1), d, m, 0));
+  return m;
+}
+
+double km_fn_max_abs(const km_fn *f) {
+  km_pp pp;
+  if (km__pp_from_fn(&pp, f)) return km_fn_abs_bound(f, -INFINITY, INFINITY);
+  double m = km__pp_max_abs(&pp);
+  km__pp_free(&pp);
+  return m;
+}
+
+static double binom(int n, int k) {
+  double r = 1.0;
+  for (int i = 1; i <= k; i++) r = r * (n - k + i) / i;
+  return r;
+}
+
+double km__pp_integral_sq(const km_pp *p) {
+  int d = p->degree;
+  double total = 0.0;
+  for (size_t i = 0; i < p->m; i++) {
+    const double *c = p->c + i * (size_t)(d + 1);
+    double h = p->x[i + 1] - p->x[i], s = 0.0;
+    /* product coefficients of degree 2d, their mean times h */
+    for (int k = 0; k <= 2 * d; k++) {
+      double v = 0.0;
+      for (int a = k - d < 0 ? 0 : k - d; a <= d && a <= k; a++)
+        v += binom(d, a) * binom(d, k - a) * c[a] * c[k - a];
+      s += v / binom(2 * d, k);
+    }
+    total += h * s / (2 * d + 1);
+  }
+  return total;
+}
+
+double km_fn_integral_sq(const km_fn *f) {
+  km_pp pp;
+  if (km__pp_from_fn(&pp, f)) return NAN;
+  double v = km__pp_integral_sq(&pp);
+  km__pp_free(&pp);
+  return v;
+}
+
+static int cmp_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+/* Coefficients of the piece of p covering [r0, r1] (normalised r over p's
+ * domain), elevated to degree e. */
+static void piece_on(const km_pp *p, double r0, double r1, int e,
+                     double *out) {
+  double a = p->x[0], b = p->x[p->m], L = b - a;
+  double x0 = a + r0 * L, x1 = a + r1 * L;
+  size_t i = km__pp_find(p, 0.5 * (x0 + x1));
+  double pa = p->x[i], h = p->x[i + 1] - pa;
+  double u0 = (x0 - pa) / h, u1 = (x1 - pa) / h;
+  if (u0 < 0) u0 = 0;
+  if (u1 > 1) u1 = 1;
+  double tmp[FN_MAX_DEGREE + 2];
+  km__bern_restrict(p->c + i * (size_t)(p->degree + 1), p->degree, u0, u1,
+                    tmp);
+  km__bern_elevate(tmp, p->degree, e, out);
+}
+
+km_status km__pp_blend(km_pp *out, const km_pp *a, double wa, const km_pp *b,
+                       double wb, double u0, double u1) {
+  size_t nr = a->m + b->m + 2;
+  double *r = malloc(nr * sizeof(double));
+  if (!r) return KM_ENOMEM;
+  size_t k = 0;
+  double La = a->x[a->m] - a->x[0], Lb = b->x[b->m] - b->x[0];
+  for (size_t i = 0; i <= a->m; i++) r[k++] = (a->x[i] - a->x[0]) / La;
+  for (size_t i = 0; i <= b->m; i++) r[k++] = (b->x[i] - b->x[0]) / Lb;
+  qsort(r, k, sizeof(double), cmp_double);
+  size_t m = 0;
+  for (size_t i = 0; i < k; i++) {
+    double v = r[i] < 0 ? 0 : (r[i] > 1 ? 1 : r[i]);
+    if (m == 0 || v - r[m - 1] > 1e-13) r[m++] = v;
+  }
+  r[0] = 0.0;
+  if (r[m - 1] < 1.0 - 1e-13)
+    r[m++] = 1.0;
+  else
+    r[m - 1] = 1.0;
+  int e = a->degree > b->degree ? a->degree : b->degree;
+  km_pp o;
+  if (km__pp_alloc(&o, e, m - 1)) {
+    free(r);
+    return KM_ENOMEM;
+  }
+  double ca[FN_MAX_DEGREE + 2], cb[FN_MAX_DEGREE + 2];
+  for (size_t i = 0; i + 1 < m; i++) {
+    piece_on(a, r[i], r[i + 1], e, ca);
+    piece_on(b, r[i], r[i + 1], e, cb);
+    double *c = o.c + i * (size_t)(e + 1);
+    for (int j = 0; j <= e; j++) c[j] = wa * ca[j] + wb * cb[j];
+    o.x[i] = u0 + r[i] * (u1 - u0);
+  }
+  o.x[0] = u0;
+  o.x[m - 1] = u1;
+  free(r);
+  *out = o;
+  return KM_OK;
+}
+
+km_status km_fn_blend(km_fn *out, const km_fn *a, double wa, const km_fn *b,
+                      double wb, double u0, double u1, km_error *err) {
+  if (!(u1 > u0) || !isfinite(u0) || !isfinite(u1))
+    return km__fail(err, KM_EINVAL, KM_FIELD_NONE, -1, NAN,
+                    "blend domain must be a non-empty finite interval");
+  km_pp pa, pb, po;
+  km__pp_init(&pa);
+  km__pp_init(&pb);
+  km__pp_init(&po);
+  km_status st = km__pp_from_fn(&pa, a);
+  if (!st) st = km__pp_from_fn(&pb, b);
+  if (!st) st = km__pp_blend(&po, &pa, wa, &pb, wb, u0, u1);
+  if (!st) st = km__pp_to_fn(out, &po);
+  km__pp_free(&pa);
+  km__pp_free(&pb);
+  km__pp_free(&po);
+  if (st) return km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
+  return KM_OK;
+}
