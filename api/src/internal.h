@@ -1,0 +1,186 @@
+/* internal.h - shared machinery of the contract layer: the per-request
+ * context that carries the first error found (as a JSON pointer and a
+ * message), typed JSON readers that validate while they read, JSON writers
+ * that refuse non-finite numbers, and the mapping of core statuses to
+ * problem types. Nothing here is visible above api/.
+ *
+ * DESIGN: every reader takes the JSON pointer of the value it reads, so an
+ * error names the exact field ("/from/knots/4") without any parsing of
+ * messages afterwards. The first error wins: later failures in the same
+ * request do not overwrite it, which keeps the report about the root cause.
+ */
+#ifndef KMAPI_INTERNAL_H
+#define KMAPI_INTERNAL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include <cJSON.h>
+
+#include "kmapi/api.h"
+#include "km/kmorph.h"
+
+#define API_POINTER_MAX 256
+#define API_TEXT_MAX 512
+
+#define API_CT_JSON "application/json"
+#define API_CT_PROBLEM "application/problem+json"
+#define API_CT_SVG "image/svg+xml"
+
+/* Problem types (RFC 9457 "type" members, relative URIs). */
+#define API_P_MALFORMED "/problems/malformed-json"
+#define API_P_INVALID_REQUEST "/problems/invalid-request"
+#define API_P_INVALID_CURVE "/problems/invalid-curve"
+#define API_P_INVALID_SIGNATURE "/problems/invalid-signature"
+#define API_P_NOT_MORPHABLE "/problems/not-morphable"
+#define API_P_LIMIT "/problems/limit-exceeded"
+#define API_P_NO_CONVERGE "/problems/no-convergence"
+#define API_P_NO_MEMORY "/problems/out-of-memory"
+#define API_P_TOO_LARGE "/problems/body-too-large"
+#define API_P_NOT_FOUND "/problems/not-found"
+#define API_P_INTERNAL "/problems/internal"
+
+/* The request being handled and the first error found in it. */
+typedef struct api_ctx {
+  const api_config *cfg;
+  int status; /* 0 while no error */
+  const char *type;
+  const char *title;
+  char detail[API_POINTER_MAX + API_TEXT_MAX + 4];
+  bool has_pointer;
+  char pointer[API_POINTER_MAX];
+  char message[API_TEXT_MAX];
+} api_ctx;
+
+void api__ctx_init(api_ctx *ctx, const api_config *cfg);
+
+/* Record an error unless one is recorded already. pointer may be NULL (no
+ * errors[] entry); the message is also used as the detail when detail_fmt
+ * is NULL. Returns false so callers can `return api__fail(...)`. */
+bool api__fail(api_ctx *ctx, int status, const char *type, const char *title,
+               const char *pointer, const char *message);
+/* Same with a formatted message (printf-style). */
+bool api__failf(api_ctx *ctx, int status, const char *type,
+                const char *title, const char *pointer, const char *fmt, ...)
+    __attribute__((format(printf, 6, 7)));
+
+/* 422 invalid-request at pointer with a formatted message. */
+bool api__invalid(api_ctx *ctx, const char *pointer, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/* Map a core failure to the context. base is the JSON pointer of the
+ * object the core was working on (a bspline/points curve object, or a
+ * signature object); fields are appended to it. kind says which names the
+ * fields have there. */
+typedef enum api_kind {
+  API_KIND_CURVE,     /* degree, knots, control_points, weights, closed */
+  API_KIND_POINTS,    /* points, closed */
+  API_KIND_SIGNATURE, /* length, start, kappa, corners */
+  API_KIND_SVG,       /* d */
+  API_KIND_REQUEST    /* the request itself (tolerance, matches, times) */
+} api_kind;
+bool api__core_fail(api_ctx *ctx, km_status st, const km_error *err,
+                    const char *base, api_kind kind);
+
+/* Out-of-memory in the api layer itself (503). */
+bool api__oom(api_ctx *ctx);
+
+/* Write "<base>/<key>" or "<base>/<index>" into buf (API_POINTER_MAX). */
+void api__ptr_key(char *buf, const char *base, const char *key);
+void api__ptr_idx(char *buf, const char *base, size_t index);
+
+/* Fill *out from the context's error (a problem+json response). */
+void api__ctx_problem(const api_ctx *ctx, api_response *out,
+                      const char *request_id);
+
+/* Parse a request body: size limit (413), depth limit and syntax (400),
+ * top level must be an object (422). NULL with the error in ctx. */
+cJSON *api__parse_body(api_ctx *ctx, const char *body, size_t length);
+
+/* ---- typed readers. Each returns true on success; on failure the error
+ * is recorded in ctx (with `ptr` naming the value) and false returned.
+ * `present`, where given, is set to whether the member exists; absent
+ * optional members leave *out untouched. ---- */
+
+/* A finite number. */
+bool api__num(api_ctx *ctx, const cJSON *v, const char *ptr, double *out);
+/* Member `key` of obj as a finite number; required or optional. */
+bool api__member_num(api_ctx *ctx, const cJSON *obj, const char *base,
+                     const char *key, bool required, double *out,
+                     bool *present);
+/* An integral number in [lo, hi]. */
+bool api__member_int(api_ctx *ctx, const cJSON *obj, const char *base,
+                     const char *key, bool required, long lo, long hi,
+                     long *out, bool *present);
+bool api__member_bool(api_ctx *ctx, const cJSON *obj, const char *base,
+                      const char *key, bool required, bool *out,
+                      bool *present);
+/* A string member that must be one of names[0..n); *out = its index. */
+bool api__member_enum(api_ctx *ctx, const cJSON *obj, const char *base,
+                      const char *key, const char *const *names, size_t n,
+                      int *out, bool *present);
+/* An array of finite numbers (length 1..max); *out malloc'd, caller frees. */
+bool api__num_array(api_ctx *ctx, const cJSON *v, const char *ptr,
+                    size_t max, double **out, size_t *n);
+/* An array of [x, y] pairs (length 1..max) into 2n doubles; malloc'd. */
+bool api__point_array(api_ctx *ctx, const cJSON *v, const char *ptr,
+                      size_t max, double **out, size_t *n);
+/* A single [x, y]. */
+bool api__point(api_ctx *ctx, const cJSON *v, const char *ptr,
+                double out[2]);
+/* Member must exist (422 "is required" otherwise). */
+const cJSON *api__require(api_ctx *ctx, const cJSON *obj, const char *base,
+                          const char *key);
+
+/* ---- curves and signatures from JSON ---- */
+
+/* An input curve as given: a curve, or a signature (type "signature"). */
+typedef struct api_input {
+  bool is_signature;
+  api_kind kind; /* how it was given, for mapping core errors */
+  km_curve curve;
+  km_signature sig;
+  double length; /* arc length of the input */
+} api_input;
+
+void api__input_init(api_input *in);
+void api__input_free(api_input *in);
+
+/* Parse a Curve object at ptr. tol > 0 is the request tolerance, or <= 0
+ * when none was given (the SVG parser then uses a small absolute one). */
+bool api__parse_curve(api_ctx *ctx, const cJSON *v, const char *ptr,
+                      double tol, api_input *out);
+/* Parse a Signature object at ptr. */
+bool api__parse_signature(api_ctx *ctx, const cJSON *v, const char *ptr,
+                          km_signature *out);
+/* The optional "tolerance" member: positive finite; *tol = 0 if absent. */
+bool api__parse_tolerance(api_ctx *ctx, const cJSON *root, double *tol);
+/* The optional "include" member: array of known names. */
+typedef struct api_include {
+  bool svg_d;
+  bool animate_d;
+} api_include;
+bool api__parse_include(api_ctx *ctx, const cJSON *root, bool allow_animate,
+                        api_include *inc);
+
+/* ---- writers. A writer that meets a non-finite number records a 422
+ * no-convergence error (the core produced something it cannot stand
+ * behind) and returns false; allocation failures record 503. ---- */
+bool api__add_num(api_ctx *ctx, cJSON *obj, const char *key, double v);
+cJSON *api__num_array_json(api_ctx *ctx, const double *v, size_t n,
+                           size_t stride);
+cJSON *api__curve_json(api_ctx *ctx, const km_curve *c, bool svg_d,
+                       double tol);
+cJSON *api__signature_json(api_ctx *ctx, const km_signature *sig);
+
+/* Render root into a 2xx JSON response; takes ownership of root. */
+int api__respond_json(api_ctx *ctx, cJSON *root, int status,
+                      api_response *out, const char *request_id);
+
+/* Routes. */
+int api__route_signature(api_ctx *ctx, const api_request *req,
+                         api_response *out);
+int api__route_reconstruct(api_ctx *ctx, const api_request *req,
+                           api_response *out);
+
+#endif

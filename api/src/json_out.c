@@ -1,0 +1,182 @@
+/* json_out.c - core types to JSON: curves and signatures as the contract
+ * spells them, refusing to print a non-finite number.
+ *
+ * cJSON prints NaN and infinities as null, which would silently break the
+ * contract ("numbers are JSON numbers"), so every number goes through
+ * api__add_num / api__num_array_json, which check it first. Doubles print
+ * with up to 17 significant digits (cJSON tries %1.15g and falls back to
+ * %1.17g when that does not read back exactly), so values round-trip.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+#include "svg.h"
+
+static bool nonfinite(api_ctx *ctx, const char *what) {
+  return api__failf(ctx, 422, API_P_NO_CONVERGE,
+                    "Computation did not converge", NULL,
+                    "the computation produced a non-finite %s; try another "
+                    "tolerance or simpler input",
+                    what);
+}
+
+bool api__add_num(api_ctx *ctx, cJSON *obj, const char *key, double v) {
+  if (!isfinite(v))
+    return nonfinite(ctx, key);
+  if (cJSON_AddNumberToObject(obj, key, v) == NULL)
+    return api__oom(ctx);
+  return true;
+}
+
+/* n values (stride 1) or n points (stride 2) as a JSON array. */
+cJSON *api__num_array_json(api_ctx *ctx, const double *v, size_t n,
+                           size_t stride) {
+  cJSON *a = cJSON_CreateArray();
+  if (a == NULL) {
+    api__oom(ctx);
+    return NULL;
+  }
+  for (size_t i = 0; i < n; i++) {
+    cJSON *e;
+    if (stride == 1) {
+      if (!isfinite(v[i]))
+        goto nonfinite_value;
+      e = cJSON_CreateNumber(v[i]);
+    } else {
+      if (!isfinite(v[2 * i]) || !isfinite(v[2 * i + 1]))
+        goto nonfinite_value;
+      e = cJSON_CreateDoubleArray(&v[2 * i], 2);
+    }
+    if (e == NULL) {
+      cJSON_Delete(a);
+      api__oom(ctx);
+      return NULL;
+    }
+    cJSON_AddItemToArray(a, e);
+  }
+  return a;
+nonfinite_value:
+  cJSON_Delete(a);
+  nonfinite(ctx, "coordinate");
+  return NULL;
+}
+
+static bool add_array(api_ctx *ctx, cJSON *obj, const char *key,
+                      const double *v, size_t n, size_t stride) {
+  cJSON *a = api__num_array_json(ctx, v, n, stride);
+  if (a == NULL)
+    return false;
+  cJSON_AddItemToObject(obj, key, a);
+  return true;
+}
+
+cJSON *api__curve_json(api_ctx *ctx, const km_curve *c, bool svg_d,
+                       double tol) {
+  cJSON *o = cJSON_CreateObject();
+  double length;
+  if (o == NULL) {
+    api__oom(ctx);
+    return NULL;
+  }
+  if (!api__add_num(ctx, o, "degree", c->degree) ||
+      !add_array(ctx, o, "knots", c->knots, c->n + (size_t)c->degree + 1, 1) ||
+      !add_array(ctx, o, "control_points", c->cp, c->n, 2))
+    goto fail;
+  if (c->w != NULL && !add_array(ctx, o, "weights", c->w, c->n, 1))
+    goto fail;
+  if (cJSON_AddBoolToObject(o, "closed", c->closed) == NULL) {
+    api__oom(ctx);
+    goto fail;
+  }
+  length = km_curve_length(c);
+  if (!api__add_num(ctx, o, "length", length))
+    goto fail;
+  if (svg_d) {
+    /* Default tolerance as everywhere: 1e-5 of the curve's length. */
+    char *d = api_svg_path_d(c, tol > 0 ? tol : 1e-5 * length, NULL);
+    if (d == NULL) {
+      api__oom(ctx);
+      goto fail;
+    }
+    cJSON *s = cJSON_CreateString(d);
+    free(d);
+    if (s == NULL) {
+      api__oom(ctx);
+      goto fail;
+    }
+    cJSON_AddItemToObject(o, "svg_d", s);
+  }
+  return o;
+fail:
+  cJSON_Delete(o);
+  return NULL;
+}
+
+cJSON *api__signature_json(api_ctx *ctx, const km_signature *sig) {
+  cJSON *o = cJSON_CreateObject();
+  cJSON *start, *kappa, *corners;
+  if (o == NULL) {
+    api__oom(ctx);
+    return NULL;
+  }
+  if (!api__add_num(ctx, o, "length", sig->length))
+    goto fail;
+  start = cJSON_AddObjectToObject(o, "start");
+  if (start == NULL) {
+    api__oom(ctx);
+    goto fail;
+  }
+  if (!isfinite(sig->start[0]) || !isfinite(sig->start[1])) {
+    nonfinite(ctx, "start point");
+    goto fail;
+  }
+  {
+    cJSON *pt = cJSON_CreateDoubleArray(sig->start, 2);
+    if (pt == NULL) {
+      api__oom(ctx);
+      goto fail;
+    }
+    cJSON_AddItemToObject(start, "point", pt);
+  }
+  if (!api__add_num(ctx, start, "angle", sig->angle))
+    goto fail;
+  kappa = cJSON_AddObjectToObject(o, "kappa");
+  if (kappa == NULL) {
+    api__oom(ctx);
+    goto fail;
+  }
+  if (!api__add_num(ctx, kappa, "degree", sig->kappa.degree) ||
+      !add_array(ctx, kappa, "knots", sig->kappa.knots,
+                 sig->kappa.n + (size_t)sig->kappa.degree + 1, 1) ||
+      !add_array(ctx, kappa, "coefficients", sig->kappa.coef, sig->kappa.n,
+                 1))
+    goto fail;
+  corners = cJSON_AddArrayToObject(o, "corners");
+  if (corners == NULL) {
+    api__oom(ctx);
+    goto fail;
+  }
+  for (size_t i = 0; i < sig->ncorners; i++) {
+    cJSON *c = cJSON_CreateObject();
+    if (c == NULL) {
+      api__oom(ctx);
+      goto fail;
+    }
+    cJSON_AddItemToArray(corners, c);
+    if (!api__add_num(ctx, c, "s", sig->corners[i].s) ||
+        !api__add_num(ctx, c, "turn", sig->corners[i].turn))
+      goto fail;
+  }
+  if (!api__add_num(ctx, o, "turning", sig->turning))
+    goto fail;
+  if (cJSON_AddBoolToObject(o, "closed", sig->closed) == NULL) {
+    api__oom(ctx);
+    goto fail;
+  }
+  return o;
+fail:
+  cJSON_Delete(o);
+  return NULL;
+}
