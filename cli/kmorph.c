@@ -1,0 +1,199 @@
+/* kmorph.c - the command-line face of the v1 contract: one request read
+ * from standard input, the response body written to standard output.
+ *
+ * Usage: kmorph signature|reconstruct|morph [--pretty] [--svg] < request.json
+ * Exit status: 0 for a 2xx answer, 1 for a problem (the problem+json is on
+ * stdout), 2 for a usage error (usage on stderr). The request goes through
+ * api_handle exactly as the daemon's would, so the CLI is also a way to
+ * reproduce any server answer without a network.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "kmapi/api.h"
+
+static void usage(FILE *to) {
+  fputs("usage: kmorph signature|reconstruct|morph [--pretty] [--svg] "
+        "< request.json\n"
+        "\n"
+        "Reads one request body (JSON, as for POST /v1/<command>) from\n"
+        "standard input and writes the response body to standard output.\n"
+        "\n"
+        "  --pretty   indent JSON output\n"
+        "  --svg      ask for SVG (as the header Accept: image/svg+xml)\n"
+        "  --help     this text\n"
+        "\n"
+        "Exit status: 0 on success, 1 when the answer is a problem\n"
+        "(application/problem+json on stdout), 2 on a usage error.\n",
+        to);
+}
+
+/* Read all of stdin, at most max bytes; *too_big when there was more. */
+static char *read_all(FILE *in, size_t max, size_t *len, bool *too_big) {
+  size_t cap = 65536, n = 0;
+  char *buf = malloc(cap);
+  *too_big = false;
+  if (buf == NULL)
+    return NULL;
+  for (;;) {
+    size_t got;
+    if (n == cap) {
+      char *nb;
+      if (cap > max) {
+        *too_big = true;
+        break;
+      }
+      cap *= 2;
+      nb = realloc(buf, cap);
+      if (nb == NULL) {
+        free(buf);
+        return NULL;
+      }
+      buf = nb;
+    }
+    got = fread(buf + n, 1, cap - n, in);
+    n += got;
+    if (got == 0)
+      break;
+    if (n > max) {
+      *too_big = true;
+      break;
+    }
+  }
+  *len = n;
+  return buf;
+}
+
+static void indent(FILE *out, int depth) {
+  fputc('\n', out);
+  for (int i = 0; i < depth; i++)
+    fputs("  ", out);
+}
+
+/* Re-indent compact JSON (the api layer prints it without whitespace).
+ * Only structure outside strings is touched. */
+static void print_pretty(FILE *out, const char *s, size_t n) {
+  int depth = 0;
+  bool in_str = false;
+  for (size_t i = 0; i < n; i++) {
+    char c = s[i];
+    if (in_str) {
+      fputc(c, out);
+      if (c == '\\' && i + 1 < n)
+        fputc(s[++i], out);
+      else if (c == '"')
+        in_str = false;
+      continue;
+    }
+    switch (c) {
+    case '"':
+      in_str = true;
+      fputc(c, out);
+      break;
+    case '{':
+    case '[':
+      fputc(c, out);
+      if (i + 1 < n && (s[i + 1] == '}' || s[i + 1] == ']')) {
+        fputc(s[++i], out);
+        break;
+      }
+      indent(out, ++depth);
+      break;
+    case '}':
+    case ']':
+      indent(out, --depth);
+      fputc(c, out);
+      break;
+    case ',':
+      fputc(c, out);
+      indent(out, depth);
+      break;
+    case ':':
+      fputs(": ", out);
+      break;
+    default:
+      fputc(c, out);
+    }
+  }
+}
+
+int main(int argc, char **argv) {
+  api_config cfg;
+  api_request req;
+  api_response res;
+  const char *cmd = NULL;
+  bool pretty = false, svg = false, too_big = false;
+  size_t len = 0;
+  char *body;
+  int status;
+
+  for (int i = 1; i < argc; i++) {
+    if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+      usage(stdout);
+      return 0;
+    } else if (strcmp(argv[i], "--pretty") == 0) {
+      pretty = true;
+    } else if (strcmp(argv[i], "--svg") == 0) {
+      svg = true;
+    } else if (argv[i][0] != '-' && cmd == NULL) {
+      cmd = argv[i];
+    } else {
+      fprintf(stderr, "kmorph: unexpected argument '%s'\n", argv[i]);
+      usage(stderr);
+      return 2;
+    }
+  }
+  memset(&req, 0, sizeof req);
+  if (cmd == NULL) {
+    usage(stderr);
+    return 2;
+  } else if (strcmp(cmd, "signature") == 0) {
+    req.route = API_ROUTE_SIGNATURE;
+  } else if (strcmp(cmd, "reconstruct") == 0) {
+    req.route = API_ROUTE_RECONSTRUCT;
+  } else if (strcmp(cmd, "morph") == 0) {
+    req.route = API_ROUTE_MORPH;
+  } else {
+    fprintf(stderr, "kmorph: unknown command '%s'\n", cmd);
+    usage(stderr);
+    return 2;
+  }
+
+  api_config_default(&cfg);
+  api_response_init(&res);
+  body = read_all(stdin, cfg.max_body_bytes, &len, &too_big);
+  if (body == NULL) {
+    fputs("kmorph: out of memory reading the request\n", stderr);
+    return 1;
+  }
+  if (too_big) {
+    char detail[128];
+    snprintf(detail, sizeof detail, "the request is larger than %zu bytes",
+             cfg.max_body_bytes);
+    api_problem(&res, 413, NULL, NULL, detail, NULL, NULL, NULL);
+  } else {
+    req.body = body;
+    req.length = len;
+    req.accept = svg ? "image/svg+xml" : "application/json";
+    api_handle(&cfg, &req, &res);
+  }
+  free(body);
+  status = res.status;
+  if (res.body != NULL) {
+    bool json = res.content_type != NULL &&
+                strstr(res.content_type, "json") != NULL;
+    if (pretty && json)
+      print_pretty(stdout, res.body, res.length);
+    else
+      fwrite(res.body, 1, res.length, stdout);
+    if (res.length == 0 || res.body[res.length - 1] != '\n')
+      fputc('\n', stdout);
+  }
+  api_response_free(&res);
+  if (fflush(stdout) != 0) {
+    perror("kmorph: writing the response");
+    return 1;
+  }
+  return status >= 200 && status < 300 ? 0 : 1;
+}
