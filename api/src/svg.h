@@ -60,4 +60,34 @@ typedef struct api_svg_frame {
 char *api_svg_morph_document(const api_svg_frame *frames, size_t n,
                              const api_svg_options *opt);
 
+/* As api_svg_path_d_fixed, with the closing "Z" written when with_z is true
+ * whatever c->closed says: frames of one animation must agree on it. */
+char *api_svg_path_d_fixed_z(const km_curve *c, size_t n_pieces,
+                             bool with_z);
+
+/* ---- internal helpers shared by the SVG writers ---- */
+
+/* A growing NUL-terminated string; after an allocation failure every
+ * append is a no-op and api__svg_buf_take returns NULL. */
+typedef struct api_svg_buf {
+  char *s;
+  size_t len, cap;
+  bool failed;
+} api_svg_buf;
+
+void api__svg_buf_init(api_svg_buf *b);
+void api__svg_buf_free(api_svg_buf *b);
+void api__svg_buf_put(api_svg_buf *b, const char *str);
+void api__svg_buf_printf(api_svg_buf *b, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+/* Text with the XML special characters escaped (&<>"'); bytes below 0x20
+ * other than tab/newline become spaces so the document stays well-formed. */
+void api__svg_buf_escaped(api_svg_buf *b, const char *text);
+/* The shortest decimal form of x that reads back within budget (>= 0; 0
+ * means exact round-trip); *err (may be NULL) is raised to the error
+ * actually committed. Non-finite x is written as 0. C locale assumed. */
+void api__svg_buf_num(api_svg_buf *b, double x, double budget, double *err);
+/* The string (caller frees), or NULL after a failure; b is emptied. */
+char *api__svg_buf_take(api_svg_buf *b);
+
 #endif
