@@ -1,0 +1,198 @@
+/* metrics.c - counters and histograms behind GET /metrics.
+ *
+ * DESIGN: fixed arrays indexed by route and by a small status table, under
+ * one mutex held for a few increments; rendering copies nothing big. The
+ * status table names every status the daemon can answer; anything else
+ * is counted as "other" so the label set stays finite.
+ */
+#include "metrics.h"
+
+#include <pthread.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *const ROUTE_NAMES[SRV_R_COUNT] = {
+    "index",  "healthz", "readyz",      "metrics", "openapi",
+    "signature", "reconstruct", "morph", "jobs",   "job",
+    "job_result", "static", "other"};
+
+static const int STATUSES[] = {200, 202, 204, 400, 404, 405, 406, 409,
+                               413, 415, 422, 429, 500, 503, 0};
+#define NSTATUS (sizeof STATUSES / sizeof STATUSES[0])
+
+static const double BUCKETS[] = {0.0005, 0.001, 0.0025, 0.005, 0.01, 0.025,
+                                 0.05,   0.1,   0.25,   0.5,   1,    2.5,
+                                 5,      10,    30};
+#define NBUCKET (sizeof BUCKETS / sizeof BUCKETS[0])
+
+struct srv_metrics {
+  pthread_mutex_t mu;
+  unsigned long long count[SRV_R_COUNT][NSTATUS];
+  unsigned long long bucket[SRV_R_COUNT][NBUCKET];
+  unsigned long long observed[SRV_R_COUNT];
+  double sum[SRV_R_COUNT];
+  unsigned long long rejected_queue, rejected_jobs;
+};
+
+const char *srv_route_name(srv_route r)
+{
+  return (unsigned)r < SRV_R_COUNT ? ROUTE_NAMES[r] : "other";
+}
+
+srv_metrics *srv_metrics_create(void)
+{
+  srv_metrics *m = calloc(1, sizeof *m);
+  if (m)
+    pthread_mutex_init(&m->mu, NULL);
+  return m;
+}
+
+void srv_metrics_destroy(srv_metrics *m)
+{
+  if (m == NULL)
+    return;
+  pthread_mutex_destroy(&m->mu);
+  free(m);
+}
+
+void srv_metrics_observe(srv_metrics *m, srv_route route, int status,
+                         double seconds)
+{
+  if ((unsigned)route >= SRV_R_COUNT)
+    route = SRV_R_OTHER;
+  size_t s = NSTATUS - 1;
+  for (size_t i = 0; i + 1 < NSTATUS; i++)
+    if (STATUSES[i] == status)
+      s = i;
+  pthread_mutex_lock(&m->mu);
+  m->count[route][s]++;
+  for (size_t b = 0; b < NBUCKET; b++)
+    if (seconds <= BUCKETS[b])
+      m->bucket[route][b]++;
+  m->observed[route]++;
+  m->sum[route] += seconds;
+  pthread_mutex_unlock(&m->mu);
+}
+
+void srv_metrics_reject(srv_metrics *m, const char *reason)
+{
+  pthread_mutex_lock(&m->mu);
+  if (strcmp(reason, "jobs_full") == 0)
+    m->rejected_jobs++;
+  else
+    m->rejected_queue++;
+  pthread_mutex_unlock(&m->mu);
+}
+
+typedef struct buf {
+  char *p;
+  size_t len, cap;
+  int oom;
+} buf;
+
+static void put(buf *b, const char *fmt, ...)
+{
+  if (b->oom)
+    return;
+  for (;;) {
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(b->p + b->len, b->cap - b->len, fmt, ap);
+    va_end(ap);
+    if (n < 0) {
+      b->oom = 1;
+      return;
+    }
+    if ((size_t)n < b->cap - b->len) {
+      b->len += (size_t)n;
+      return;
+    }
+    size_t ncap = b->cap * 2 + (size_t)n;
+    char *np = realloc(b->p, ncap);
+    if (np == NULL) {
+      b->oom = 1;
+      return;
+    }
+    b->p = np;
+    b->cap = ncap;
+  }
+}
+
+char *srv_metrics_render(srv_metrics *m, const srv_gauges *g, size_t *len)
+{
+  buf b = {malloc(16384), 0, 16384, 0};
+  if (b.p == NULL)
+    return NULL;
+  b.p[0] = '\0';
+  pthread_mutex_lock(&m->mu);
+  put(&b, "# HELP kmorph_http_requests_total HTTP requests answered, by "
+          "route and status.\n"
+          "# TYPE kmorph_http_requests_total counter\n");
+  for (int r = 0; r < SRV_R_COUNT; r++)
+    for (size_t s = 0; s < NSTATUS; s++)
+      if (m->count[r][s] > 0) {
+        if (STATUSES[s] == 0)
+          put(&b, "kmorph_http_requests_total{route=\"%s\",status=\"other\"} %llu\n",
+              ROUTE_NAMES[r], m->count[r][s]);
+        else
+          put(&b, "kmorph_http_requests_total{route=\"%s\",status=\"%d\"} %llu\n",
+              ROUTE_NAMES[r], STATUSES[s], m->count[r][s]);
+      }
+  put(&b, "# HELP kmorph_http_request_duration_seconds Time from request "
+          "headers to response, by route.\n"
+          "# TYPE kmorph_http_request_duration_seconds histogram\n");
+  for (int r = 0; r < SRV_R_COUNT; r++) {
+    if (m->observed[r] == 0)
+      continue;
+    for (size_t k = 0; k < NBUCKET; k++)
+      put(&b,
+          "kmorph_http_request_duration_seconds_bucket{route=\"%s\",le=\"%g\"} %llu\n",
+          ROUTE_NAMES[r], BUCKETS[k], m->bucket[r][k]);
+    put(&b,
+        "kmorph_http_request_duration_seconds_bucket{route=\"%s\",le=\"+Inf\"} %llu\n"
+        "kmorph_http_request_duration_seconds_sum{route=\"%s\"} %.9g\n"
+        "kmorph_http_request_duration_seconds_count{route=\"%s\"} %llu\n",
+        ROUTE_NAMES[r], m->observed[r], ROUTE_NAMES[r], m->sum[r],
+        ROUTE_NAMES[r], m->observed[r]);
+  }
+  put(&b,
+      "# HELP kmorph_rejected_total Requests refused at once because the "
+      "daemon was full.\n"
+      "# TYPE kmorph_rejected_total counter\n"
+      "kmorph_rejected_total{reason=\"queue_full\"} %llu\n"
+      "kmorph_rejected_total{reason=\"jobs_full\"} %llu\n",
+      m->rejected_queue, m->rejected_jobs);
+  pthread_mutex_unlock(&m->mu);
+  put(&b,
+      "# HELP kmorph_queue_depth Compute requests waiting for a worker.\n"
+      "# TYPE kmorph_queue_depth gauge\n"
+      "kmorph_queue_depth %zu\n"
+      "# HELP kmorph_queue_capacity Compute requests that may wait.\n"
+      "# TYPE kmorph_queue_capacity gauge\n"
+      "kmorph_queue_capacity %zu\n"
+      "# HELP kmorph_workers_busy Compute workers running a request or a "
+      "job frame.\n"
+      "# TYPE kmorph_workers_busy gauge\n"
+      "kmorph_workers_busy %zu\n"
+      "# HELP kmorph_workers Compute workers.\n"
+      "# TYPE kmorph_workers gauge\n"
+      "kmorph_workers %zu\n"
+      "# HELP kmorph_connections Open HTTP connections.\n"
+      "# TYPE kmorph_connections gauge\n"
+      "kmorph_connections %zu\n"
+      "# HELP kmorph_jobs Jobs known to the job store, by state.\n"
+      "# TYPE kmorph_jobs gauge\n",
+      g->queue_depth, g->queue_capacity, g->workers_busy, g->workers,
+      g->connections);
+  for (int s = 0; s < 5; s++)
+    put(&b, "kmorph_jobs{state=\"%s\"} %zu\n", g->job_state_names[s],
+        g->jobs[s]);
+  if (b.oom) {
+    free(b.p);
+    return NULL;
+  }
+  *len = b.len;
+  return b.p;
+}

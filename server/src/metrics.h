@@ -1,0 +1,59 @@
+/* metrics.h - request counters and latency histograms for GET /metrics
+ * (Prometheus text exposition format 0.0.4).
+ *
+ * Thread-safety: srv_metrics_observe and srv_metrics_render may run on
+ * any threads at once.
+ */
+#ifndef SRV_METRICS_H
+#define SRV_METRICS_H
+
+#include <stddef.h>
+
+/* Routes as metric labels; a fixed set keeps label cardinality bounded
+ * whatever paths clients send. */
+typedef enum srv_route {
+  SRV_R_INDEX,
+  SRV_R_HEALTHZ,
+  SRV_R_READYZ,
+  SRV_R_METRICS,
+  SRV_R_OPENAPI,
+  SRV_R_SIGNATURE,
+  SRV_R_RECONSTRUCT,
+  SRV_R_MORPH,
+  SRV_R_JOBS,
+  SRV_R_JOB,
+  SRV_R_JOB_RESULT,
+  SRV_R_STATIC,
+  SRV_R_OTHER,
+  SRV_R_COUNT
+} srv_route;
+
+const char *srv_route_name(srv_route r);
+
+typedef struct srv_metrics srv_metrics;
+
+srv_metrics *srv_metrics_create(void);
+void srv_metrics_destroy(srv_metrics *m);
+
+/* Count one answered request. */
+void srv_metrics_observe(srv_metrics *m, srv_route route, int status,
+                         double seconds);
+
+/* Count a request refused by admission control (reason: "queue_full",
+ * "jobs_full"). */
+void srv_metrics_reject(srv_metrics *m, const char *reason);
+
+/* Gauges supplied by the caller at render time. */
+typedef struct srv_gauges {
+  size_t queue_depth, queue_capacity;
+  size_t workers_busy, workers;
+  size_t connections;
+  size_t jobs[5]; /* by srv_job_state */
+  const char *const *job_state_names;
+} srv_gauges;
+
+/* Render everything as text; malloc'd, NUL-terminated, caller frees.
+ * *len receives the length. NULL if out of memory. */
+char *srv_metrics_render(srv_metrics *m, const srv_gauges *g, size_t *len);
+
+#endif

@@ -1,0 +1,39 @@
+/* server.h - the kmorphd HTTP server: routing, admission control, compute
+ * hand-off, jobs, CORS, request ids, access log and graceful shutdown.
+ *
+ * All state lives in one srv_server; nothing is global.
+ */
+#ifndef SRV_SERVER_H
+#define SRV_SERVER_H
+
+#include <stdio.h>
+
+#include "config.h"
+
+typedef struct srv_server srv_server;
+
+/* Create the server (pools, job store, metrics) from cfg (copied; workers
+ * must be > 0 already). log receives the access log and notices. NULL if
+ * memory or threads are short (a message is printed to log). */
+srv_server *srv_server_create(const srv_config *cfg, FILE *log);
+
+/* Bind and start serving. Returns 0, or -1 with a message in the log
+ * (address in use, bad bind address). */
+int srv_server_start(srv_server *s);
+
+/* The port actually bound (useful with --port 0). */
+unsigned srv_server_port(const srv_server *s);
+
+/* Graceful stop: stop accepting, answer queued compute with 503, cancel
+ * jobs, let running requests finish, resume every suspended connection,
+ * then stop the HTTP daemon - all within cfg.shutdown_grace seconds.
+ * Returns 0 when everything stopped cleanly; -1 when the deadline passed
+ * with work still running (the HTTP daemon is then left running and the
+ * caller should exit the process at once). */
+int srv_server_shutdown(srv_server *s);
+
+/* Free everything (after srv_server_shutdown returned 0, or if never
+ * started). Accepts NULL. */
+void srv_server_destroy(srv_server *s);
+
+#endif
