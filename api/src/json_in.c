@@ -325,7 +325,9 @@ bool api__core_fail(api_ctx *ctx, km_status st, const km_error *err,
     snprintf(p, sizeof p, "%s", base);
   }
 
-  if (err != NULL && isfinite(err->param) &&
+  /* The core's own message usually says where already; add the place
+   * only to a bare default message. */
+  if (err != NULL && err->message[0] == '\0' && isfinite(err->param) &&
       (st == KM_ECUSP || st == KM_EDEGENERATE || st == KM_ENOCONVERGE))
     snprintf(msg, sizeof msg, "%s (at %s %.17g)", text,
              kind == API_KIND_SIGNATURE ? "arc length" : "parameter",
