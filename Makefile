@@ -52,7 +52,7 @@ APIT_BIN  := $(APIT_SRC:%.c=$(BUILD)/%)
 SUPPORT_SRC := $(wildcard tests/support/*.c)
 
 .PHONY: all deps build run test test-unit test-asan test-server check-layers \
-        bench fuzz clean format examples
+        bench bench-http fuzz clean format examples
 
 all: build
 
@@ -129,7 +129,18 @@ test: deps
 	@$(MAKE) --no-print-directory test-unit
 	@echo "== the same under AddressSanitizer + UndefinedBehaviorSanitizer"
 	@$(MAKE) --no-print-directory BUILD=build/asan SAN=address OPT=-O1 test-unit
+	@echo "== kmorphd over HTTP: contract, jobs, load, shutdown"
+	@$(MAKE) --no-print-directory test-server || true
 	@tests/summarise.sh
+
+# The daemon over real HTTP (loopback, ephemeral ports); appends its counts
+# to build/test-results.txt like the other suites.
+test-server: build
+	@tests/server/run.sh
+
+# Throughput and latency of kmorphd with wrk (see bench/http/run.sh).
+bench-http: deps build
+	@bench/http/run.sh
 
 run: deps build
 	@if [ -x $(DAEMON) ]; then exec $(DAEMON) --bind 127.0.0.1 --port 8080; \

@@ -1,0 +1,153 @@
+"""test_jobs.py - the asynchronous job life cycle: queued -> running ->
+done, result 409 before done, cancel, 429 at the job limit, 404 after
+expiry."""
+import time
+import unittest
+
+from kmtest import (ContractCase, Daemon, close_to, heavy_morph_body, metric,
+                    morph_body, wait_for)
+
+import math
+
+
+class JobLifeCycle(ContractCase):
+    """One worker, so that jobs run one after another (the oldest live job
+    gets the frames) and the states can be seen."""
+
+    TTL = 2.0
+
+    @classmethod
+    def setUpClass(cls):
+        cls.d = Daemon("--threads", "1", "--max-jobs", "2",
+                       "--job-ttl", str(cls.TTL), "--job-keep", "10")
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.d.stop()
+
+    def create(self, body):
+        r = self.d.request("POST", "/v1/jobs", body=body)
+        doc = self.assertDocumented(r, "/v1/jobs", "post")
+        self.assertEqual(r.status, 202, r.body[:300])
+        self.assertEqual(r.header("Location"), "/v1/jobs/" + doc["id"])
+        self.assertEqual(doc["state"], "queued")
+        return doc
+
+    def status(self, jid):
+        r = self.d.request("GET", "/v1/jobs/" + jid)
+        return self.assertDocumented(r, "/v1/jobs/{id}", "get")
+
+    def test_life_cycle_cancel_and_expiry(self):
+        # Given a long job A and a short job B behind it,
+        a = self.create(heavy_morph_body(10000))
+        b = self.create(morph_body(5))
+        self.assertEqual(a["frames_total"], 10000)
+        running = wait_for(lambda: self.status(a["id"])["state"] == "running"
+                           and self.status(a["id"]), 10)
+        self.assertTrue(running, "job A starts running")
+        # then B waits while A runs, and B's result is a 409 problem;
+        sb = self.status(b["id"])
+        self.assertEqual(sb["state"], "queued")
+        self.assertEqual(sb["progress"], 0)
+        r = self.d.request("GET", "/v1/jobs/%s/result" % b["id"])
+        self.assertProblem(r, 409, "/v1/jobs/{id}/result", "get")
+        # a third job is refused while two are live;
+        r = self.d.request("POST", "/v1/jobs", body=morph_body(3))
+        self.assertProblem(r, 429, "/v1/jobs", "post")
+        # progress of A grows and stays frames_done / frames_total;
+        p1 = self.status(a["id"])
+        time.sleep(0.2)
+        p2 = self.status(a["id"])
+        for p in (p1, p2):
+            self.assertAlmostEqual(p["progress"],
+                                   p["frames_done"] / p["frames_total"], 5)
+        self.assertGreaterEqual(p2["frames_done"], p1["frames_done"])
+        # when A is cancelled it stops short of its frames at once,
+        r = self.d.request("DELETE", "/v1/jobs/" + a["id"])
+        self.assertDocumented(r, "/v1/jobs/{id}", "delete")
+        self.assertEqual(r.status, 204)
+        sa = self.status(a["id"])
+        self.assertEqual(sa["state"], "cancelled")
+        self.assertLess(sa["frames_done"], sa["frames_total"])
+        r = self.d.request("GET", "/v1/jobs/%s/result" % a["id"])
+        self.assertProblem(r, 409, "/v1/jobs/{id}/result", "get")
+        # and B, which could only run once A gave up the worker, is done;
+        done = wait_for(lambda: self.status(b["id"])["state"] == "done", 20)
+        self.assertTrue(done, "job B finishes after A is cancelled")
+        sb = self.status(b["id"])
+        self.assertEqual((sb["frames_done"], sb["progress"]), (5, 1))
+        r = self.d.request("GET", "/v1/jobs/%s/result" % b["id"])
+        doc = self.assertDocumented(r, "/v1/jobs/{id}/result", "get")
+        self.assertEqual(r.status, 200)
+        self.assertEqual([f["t"] for f in doc["frames"]],
+                         [0, 0.25, 0.5, 0.75, 1])
+        self.assertTrue(close_to(doc["frames"][2]["metrics"]["length"],
+                                 3 * math.pi, 1e-4))
+        m = self.d.request("GET", "/metrics").body.decode()
+        self.assertGreaterEqual(metric(m, "kmorph_jobs", {"state": "done"}), 1)
+        self.assertEqual(metric(m, "kmorph_workers_busy"), 0,
+                         "no worker still renders the cancelled job")
+        # Finally, after the time to live both are forgotten.
+        time.sleep(self.TTL + 0.3)
+        for jid in (a["id"], b["id"]):
+            r = self.d.request("GET", "/v1/jobs/" + jid)
+            self.assertProblem(r, 404, "/v1/jobs/{id}", "get")
+            r = self.d.request("GET", "/v1/jobs/%s/result" % jid)
+            self.assertProblem(r, 404, "/v1/jobs/{id}/result", "get")
+
+    def test_unknown_job_is_404_for_every_method(self):
+        for method, path in (("GET", "/v1/jobs/%s"),
+                             ("DELETE", "/v1/jobs/%s"),
+                             ("GET", "/v1/jobs/%s/result")):
+            p = path % ("0" * 32)
+            r = self.d.request(method, p)
+            tmpl = path.replace("%s", "{id}")
+            self.assertProblem(r, 404, tmpl, method.lower())
+
+    def test_deleting_a_finished_job_forgets_it(self):
+        j = self.create(morph_body(2))
+        self.assertTrue(wait_for(
+            lambda: self.status(j["id"])["state"] == "done", 20))
+        r = self.d.request("DELETE", "/v1/jobs/" + j["id"])
+        self.assertEqual(r.status, 204)
+        r = self.d.request("GET", "/v1/jobs/" + j["id"])
+        self.assertProblem(r, 404, "/v1/jobs/{id}", "get")
+
+    def test_invalid_job_request_is_refused_before_a_job_exists(self):
+        r = self.d.request("POST", "/v1/jobs",
+                           body={"from": {"type": "svg", "d": "M 0 0 Q"},
+                                 "to": {"type": "svg", "d": "M 0 0 L 1 1"}})
+        doc = self.assertProblem(r, 422, "/v1/jobs", "post")
+        self.assertTrue(doc["errors"][0]["pointer"].startswith("/from"))
+
+
+class JobWallTime(ContractCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.d = Daemon("--threads", "2", "--job-time", "0.3")
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.d.stop()
+
+    def test_job_over_its_wall_time_fails_with_a_clear_error(self):
+        r = self.d.request("POST", "/v1/jobs", body=heavy_morph_body(10000))
+        self.assertEqual(r.status, 202, r.body[:300])
+        jid = r.json()["id"]
+
+        def final():
+            s = self.d.request("GET", "/v1/jobs/" + jid).json()
+            return s if s["state"] in ("done", "failed") else None
+        s = wait_for(final, 15)
+        self.assertTrue(s, "the job ends")
+        self.assertEqual(s["state"], "failed")
+        self.assertIn("KMORPH_JOB_TIME", s["error"]["detail"])
+        self.assertEqual(self.assertDocumented(
+            self.d.request("GET", "/v1/jobs/" + jid), "/v1/jobs/{id}", "get")
+            ["state"], "failed")
+        r = self.d.request("GET", "/v1/jobs/%s/result" % jid)
+        self.assertProblem(r, 409, "/v1/jobs/{id}/result", "get")
+
+
+if __name__ == "__main__":
+    unittest.main()
