@@ -1,0 +1,391 @@
+/* intersect.c - counting the proper self-crossings of a planar B-spline /
+ * NURBS curve.
+ *
+ * DESIGN. The curve is cut into its Bezier pieces (homogeneous, so rational
+ * curves are exact) and each piece into sub-curves whose control polygons
+ * are monotone in x and in y. Such a sub-curve is itself monotone in both
+ * coordinates (for positive weights the derivative of a rational Bezier
+ * coordinate is a positive combination of control differences), so it
+ * cannot cross itself: only pairs of sub-curves need testing. Pairs are
+ * pruned by a sweep over their bounding boxes, then subdivided while their
+ * boxes overlap until both are flat; the chords' intersection seeds Newton
+ * on the exact pieces. A root counts when |C(s) - C(t)| <= tol, the two
+ * parameters are different points of the curve (not the shared end of
+ * adjacent pieces, not the seam of a closed curve, not an end of an open
+ * one), and the tangents are transversal. Roots found twice (a crossing on
+ * a piece boundary, or on the seam) are merged by parameter.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bezier_util.h"
+#include "internal.h"
+#include "km/curve.h"
+#include "km/limits.h"
+#include "km/morph.h"
+
+#define MAXC (KM_MAX_DEGREE + 1)
+
+/* Smallest sine of the crossing angle that still counts as a crossing. At
+ * a tangential touch Newton converges only to about sqrt(eps) in the
+ * parameter, which leaves a sine of about sqrt(eps * curvature * size)
+ * (1e-7 for curvature ~ 1/size, 1e-6 for features 1e-4 of the size);
+ * crossings at smaller angles than this are reported as touches. */
+#define MIN_CROSSING_SINE 1e-5
+
+/* Sub-curves per monotone split and pair subdivision depth: 2^-24 of a
+ * piece is far below any loop that matters; 2^-60 is below resolution. */
+#define MONO_DEPTH 24
+#define PAIR_DEPTH 60
+
+typedef struct seg {
+  size_t piece;
+  double u0, u1;      /* local parameter range within the piece */
+  double h[MAXC][3];  /* homogeneous Bezier points of the sub-curve */
+  double xmin, xmax, ymin, ymax;
+} seg;
+
+typedef struct ctx {
+  int p;
+  const km__hcurve *bz; /* Bezier form, dim 3 */
+  double t0, t1;        /* curve domain */
+  double tol, flat, size, eps_t;
+  bool closed;
+  seg *segs;
+  size_t nseg, capseg;
+  double *hits; /* (ta, tb) pairs, ta < tb */
+  size_t nhit, caphit;
+  bool oom;
+} ctx;
+
+static void cart(const double h[3], double out[2]) {
+  out[0] = h[0] / h[2];
+  out[1] = h[1] / h[2];
+}
+
+static void seg_bbox(seg *s, int p) {
+  double q[2];
+  cart(s->h[0], q);
+  s->xmin = s->xmax = q[0];
+  s->ymin = s->ymax = q[1];
+  for (int i = 1; i <= p; i++) {
+    cart(s->h[i], q);
+    s->xmin = fmin(s->xmin, q[0]);
+    s->xmax = fmax(s->xmax, q[0]);
+    s->ymin = fmin(s->ymin, q[1]);
+    s->ymax = fmax(s->ymax, q[1]);
+  }
+}
+
+/* de Casteljau at 1/2: both halves. */
+static void split_half(const seg *s, int p, seg *l, seg *r) {
+  double tmp[MAXC][3];
+  memcpy(tmp, s->h, sizeof tmp);
+  l->piece = r->piece = s->piece;
+  double um = 0.5 * (s->u0 + s->u1);
+  l->u0 = s->u0;
+  l->u1 = um;
+  r->u0 = um;
+  r->u1 = s->u1;
+  for (int c = 0; c < 3; c++) {
+    l->h[0][c] = tmp[0][c];
+    r->h[p][c] = tmp[p][c];
+  }
+  for (int k = 1; k <= p; k++) {
+    for (int i = 0; i <= p - k; i++)
+      for (int c = 0; c < 3; c++)
+        tmp[i][c] = 0.5 * (tmp[i][c] + tmp[i + 1][c]);
+    for (int c = 0; c < 3; c++) {
+      l->h[k][c] = tmp[0][c];
+      r->h[p - k][c] = tmp[p - k][c];
+    }
+  }
+  seg_bbox(l, p);
+  seg_bbox(r, p);
+}
+
+static bool monotone(const seg *s, int p, double eps) {
+  int sx = 0, sy = 0;
+  double a[2], b[2];
+  cart(s->h[0], a);
+  for (int i = 1; i <= p; i++) {
+    cart(s->h[i], b);
+    double dx = b[0] - a[0], dy = b[1] - a[1];
+    int cx = dx > eps ? 1 : (dx < -eps ? -1 : 0);
+    int cy = dy > eps ? 1 : (dy < -eps ? -1 : 0);
+    if (cx && sx && cx != sx) return false;
+    if (cy && sy && cy != sy) return false;
+    if (cx) sx = cx;
+    if (cy) sy = cy;
+    a[0] = b[0];
+    a[1] = b[1];
+  }
+  return true;
+}
+
+static void push_seg(ctx *x, const seg *s) {
+  if (x->nseg == x->capseg) {
+    size_t cap = x->capseg ? 2 * x->capseg : 64;
+    seg *n = realloc(x->segs, cap * sizeof *n);
+    if (!n) {
+      x->oom = true;
+      return;
+    }
+    x->segs = n;
+    x->capseg = cap;
+  }
+  x->segs[x->nseg++] = *s;
+}
+
+static void collect(ctx *x, const seg *s, int depth) {
+  if (x->oom) return;
+  if (depth >= MONO_DEPTH || monotone(s, x->p, 1e-15 * x->size)) {
+    push_seg(x, s);
+    return;
+  }
+  seg l, r;
+  split_half(s, x->p, &l, &r);
+  collect(x, &l, depth + 1);
+  collect(x, &r, depth + 1);
+}
+
+/* Largest distance of the control points from the chord. */
+static double flatness(const seg *s, int p) {
+  double a[2], b[2], q[2];
+  cart(s->h[0], a);
+  cart(s->h[p], b);
+  double dx = b[0] - a[0], dy = b[1] - a[1], len = hypot(dx, dy), d = 0;
+  for (int i = 1; i < p; i++) {
+    cart(s->h[i], q);
+    double e = len > 0 ? fabs((q[0] - a[0]) * dy - (q[1] - a[1]) * dx) / len
+                       : hypot(q[0] - a[0], q[1] - a[1]);
+    d = fmax(d, e);
+  }
+  return d;
+}
+
+/* Point and derivative (with respect to the local parameter) of piece k at
+ * u in [0, 1]. */
+static void eval_piece(const ctx *x, size_t k, double u, double P[2],
+                       double D[2]) {
+  int p = x->p;
+  double tmp[MAXC][3];
+  memcpy(tmp, x->bz->pw + k * (size_t)p * 3, (size_t)(p + 1) * 3 * sizeof(double));
+  double d[3] = {0, 0, 0};
+  for (int lvl = 1; lvl <= p; lvl++) {
+    if (lvl == p)
+      for (int c = 0; c < 3; c++) d[c] = p * (tmp[1][c] - tmp[0][c]);
+    for (int i = 0; i <= p - lvl; i++)
+      for (int c = 0; c < 3; c++)
+        tmp[i][c] = (1 - u) * tmp[i][c] + u * tmp[i + 1][c];
+  }
+  double w = tmp[0][2];
+  P[0] = tmp[0][0] / w;
+  P[1] = tmp[0][1] / w;
+  D[0] = (d[0] - P[0] * d[2]) / w;
+  D[1] = (d[1] - P[1] * d[2]) / w;
+}
+
+static double piece_t(const ctx *x, size_t k, double u) {
+  const double *U = x->bz->knots;
+  double a = U[(size_t)x->p * (k + 1)], b = U[(size_t)x->p * (k + 2)];
+  return a + u * (b - a);
+}
+
+static void add_hit(ctx *x, double ta, double tb) {
+  if (ta > tb) {
+    double t = ta;
+    ta = tb;
+    tb = t;
+  }
+  for (size_t i = 0; i < x->nhit; i++)
+    if (fabs(x->hits[2 * i] - ta) <= x->eps_t &&
+        fabs(x->hits[2 * i + 1] - tb) <= x->eps_t)
+      return;
+  if (x->nhit == x->caphit) {
+    size_t cap = x->caphit ? 2 * x->caphit : 16;
+    double *n = realloc(x->hits, 2 * cap * sizeof(double));
+    if (!n) {
+      x->oom = true;
+      return;
+    }
+    x->hits = n;
+    x->caphit = cap;
+  }
+  x->hits[2 * x->nhit] = ta;
+  x->hits[2 * x->nhit + 1] = tb;
+  x->nhit++;
+}
+
+/* Newton on C_a(ua) = C_b(ub) from a chord estimate; record proper
+ * crossings. */
+static void refine(ctx *x, size_t ka, double ua, size_t kb, double ub) {
+  double Pa[2], Da[2], Pb[2], Db[2];
+  /* Newton, keeping the best iterate: at a tangential touch the iteration
+   * ends up wandering in rounding noise, and the best point there is the
+   * one whose tangents are closest to parallel */
+  double best = INFINITY, bua = ua, bub = ub;
+  for (int it = 0; it < 100; it++) {
+    eval_piece(x, ka, ua, Pa, Da);
+    eval_piece(x, kb, ub, Pb, Db);
+    double fx = Pa[0] - Pb[0], fy = Pa[1] - Pb[1], f = hypot(fx, fy);
+    if (f < best) {
+      best = f;
+      bua = ua;
+      bub = ub;
+    }
+    double det = Db[0] * Da[1] - Da[0] * Db[1];
+    double na = hypot(Da[0], Da[1]), nb = hypot(Db[0], Db[1]);
+    if (f == 0 || !(fabs(det) > 0) || !isfinite(det)) break;
+    /* converged on a well-conditioned (transversal) root */
+    if (f <= 1e-15 * x->size && fabs(det) >= 1e-3 * na * nb) break;
+    double dua = (fx * Db[1] - Db[0] * fy) / det;
+    double dub = (Da[1] * fx - Da[0] * fy) / det;
+    if (!isfinite(dua) || !isfinite(dub)) break;
+    double nua = fmin(1.0, fmax(0.0, ua + dua));
+    double nub = fmin(1.0, fmax(0.0, ub + dub));
+    if (nua == ua && nub == ub) break;
+    ua = nua;
+    ub = nub;
+  }
+  ua = bua;
+  ub = bub;
+  eval_piece(x, ka, ua, Pa, Da);
+  eval_piece(x, kb, ub, Pb, Db);
+  if (!(hypot(Pa[0] - Pb[0], Pa[1] - Pb[1]) <= x->tol)) return;
+  double ta = piece_t(x, ka, ua), tb = piece_t(x, kb, ub);
+  if (x->closed) {
+    /* the seam is one point of a closed curve */
+    if (ta >= x->t1 - x->eps_t) ta = x->t0;
+    if (tb >= x->t1 - x->eps_t) tb = x->t0;
+  } else if (fmin(ta, tb) <= x->t0 + x->eps_t ||
+             fmax(ta, tb) >= x->t1 - x->eps_t) {
+    /* an end of an open curve touching it is not a crossing */
+    return;
+  }
+  if (fabs(ta - tb) <= x->eps_t) return; /* the same point of the curve */
+  double na = hypot(Da[0], Da[1]), nb = hypot(Db[0], Db[1]);
+  if (!(na > 0 && nb > 0)) return;
+  double sine = fabs(Da[0] * Db[1] - Da[1] * Db[0]) / (na * nb);
+  if (!(sine >= MIN_CROSSING_SINE)) return;
+  add_hit(x, ta, tb);
+}
+
+static bool boxes_overlap(const seg *a, const seg *b, double m) {
+  return a->xmin <= b->xmax + m && b->xmin <= a->xmax + m &&
+         a->ymin <= b->ymax + m && b->ymin <= a->ymax + m;
+}
+
+/* Chord intersection of two flat sub-curves seeds Newton. The parameter
+ * window is a little wider than [0, 1] because a flat chord is only
+ * tol-close to its curve; duplicates from neighbours are merged later. */
+static void chord_seed(ctx *x, const seg *A, const seg *B) {
+  int p = x->p;
+  double a0[2], a1[2], b0[2], b1[2];
+  cart(A->h[0], a0);
+  cart(A->h[p], a1);
+  cart(B->h[0], b0);
+  cart(B->h[p], b1);
+  double ax = a1[0] - a0[0], ay = a1[1] - a0[1];
+  double bx = b1[0] - b0[0], by = b1[1] - b0[1];
+  double det = bx * ay - ax * by;
+  double la = hypot(ax, ay), lb = hypot(bx, by);
+  if (!(la > 0 && lb > 0) || !(fabs(det) > 1e-12 * la * lb)) return;
+  double rx = b0[0] - a0[0], ry = b0[1] - a0[1];
+  double s = (bx * ry - by * rx) / det; /* on A */
+  double t = (ax * ry - ay * rx) / det; /* on B */
+  const double w = 0.05;
+  if (s < -w || s > 1 + w || t < -w || t > 1 + w) return;
+  s = fmin(1, fmax(0, s));
+  t = fmin(1, fmax(0, t));
+  refine(x, A->piece, A->u0 + s * (A->u1 - A->u0), B->piece,
+         B->u0 + t * (B->u1 - B->u0));
+}
+
+static void pair(ctx *x, const seg *A, const seg *B, int depth) {
+  if (x->oom || !boxes_overlap(A, B, x->tol)) return;
+  int p = x->p;
+  bool fa = flatness(A, p) <= x->flat, fb = flatness(B, p) <= x->flat;
+  if ((fa && fb) || depth >= PAIR_DEPTH) {
+    chord_seed(x, A, B);
+    return;
+  }
+  /* split the one that is not flat, else the larger */
+  double sa = (A->xmax - A->xmin) + (A->ymax - A->ymin);
+  double sb = (B->xmax - B->xmin) + (B->ymax - B->ymin);
+  seg l, r;
+  if (!fa && (fb || sa >= sb)) {
+    split_half(A, p, &l, &r);
+    pair(x, &l, B, depth + 1);
+    pair(x, &r, B, depth + 1);
+  } else {
+    split_half(B, p, &l, &r);
+    pair(x, A, &l, depth + 1);
+    pair(x, A, &r, depth + 1);
+  }
+}
+
+static int by_xmin(const void *a, const void *b) {
+  double u = ((const seg *)a)->xmin, v = ((const seg *)b)->xmin;
+  return (u > v) - (u < v);
+}
+
+long km_curve_self_intersections(const km_curve *c, double tol) {
+  if (!c || !c->knots || !c->cp || c->degree < KM_MIN_DEGREE ||
+      c->degree > KM_MAX_DEGREE || c->n < (size_t)c->degree + 1)
+    return -1;
+  km__hcurve h, bz;
+  km__h_init(&h);
+  km__h_init(&bz);
+  ctx x;
+  memset(&x, 0, sizeof x);
+  long result = -1;
+  if (km__h_from_curve(&h, c, 3) || km__h_to_bezier(&bz, &h)) goto cleanup;
+  int p = c->degree;
+  x.p = p;
+  x.bz = &bz;
+  x.closed = c->closed;
+  km_curve_domain(c, &x.t0, &x.t1);
+  double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
+  for (size_t i = 0; i < c->n; i++) {
+    xmin = fmin(xmin, c->cp[2 * i]);
+    xmax = fmax(xmax, c->cp[2 * i]);
+    ymin = fmin(ymin, c->cp[2 * i + 1]);
+    ymax = fmax(ymax, c->cp[2 * i + 1]);
+  }
+  x.size = hypot(xmax - xmin, ymax - ymin);
+  if (!(x.size > 0) || !isfinite(x.size)) {
+    result = 0;
+    goto cleanup;
+  }
+  double floor_tol = KM_MIN_RELATIVE_TOLERANCE * x.size;
+  x.tol = (tol > 0 && isfinite(tol)) ? fmax(tol, floor_tol) : 1e-9 * x.size;
+  x.flat = fmax(x.tol, 1e-7 * x.size);
+  x.eps_t = 1e-8 * (x.t1 - x.t0);
+  size_t pieces = (bz.n - 1) / (size_t)p;
+  for (size_t k = 0; k < pieces && !x.oom; k++) {
+    seg s;
+    s.piece = k;
+    s.u0 = 0;
+    s.u1 = 1;
+    memcpy(s.h, bz.pw + k * (size_t)p * 3, (size_t)(p + 1) * 3 * sizeof(double));
+    seg_bbox(&s, p);
+    collect(&x, &s, 0);
+  }
+  if (x.oom) goto cleanup;
+  qsort(x.segs, x.nseg, sizeof *x.segs, by_xmin);
+  for (size_t i = 0; i < x.nseg && !x.oom; i++)
+    for (size_t j = i + 1; j < x.nseg && !x.oom; j++) {
+      if (x.segs[j].xmin > x.segs[i].xmax + x.tol) break;
+      pair(&x, &x.segs[i], &x.segs[j], 0);
+    }
+  if (x.oom) goto cleanup;
+  result = (long)x.nhit;
+cleanup:
+  free(x.segs);
+  free(x.hits);
+  km__h_free(&h);
+  km__h_free(&bz);
+  return result;
+}

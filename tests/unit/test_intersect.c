@@ -1,0 +1,235 @@
+/* test_intersect.c - counting proper self-crossings: loops, figure-eights,
+ * circles, tangential touches, crossings on piece boundaries and on the
+ * seam of a closed curve.
+ *
+ * Every expected count is read off the geometry: the loop of a cubic
+ * Bezier is located in closed form, polygons are counted by hand, the
+ * parabola y = x^2 touches y = 0 once and y = x^2 - 0.01 crosses it at
+ * x = +-0.1.
+ */
+#include "testutil.h"
+
+#include <string.h>
+
+#include "km/curve.h"
+#include "km/morph.h"
+
+static km_curve make(int degree, size_t n, const double *knots,
+                     const double *cp, const double *w, bool closed) {
+  km_curve c;
+  km_error e;
+  assert_status(km_curve_create(&c, degree, n, knots, cp, w, closed, &e),
+                KM_OK);
+  return c;
+}
+
+/* Degree-1 curve through the points with knots 0, 1, 2, ... */
+static km_curve polyline(const double *pts, size_t n, bool closed) {
+  double knots[64];
+  knots[0] = 0;
+  for (size_t i = 0; i < n; i++) knots[i + 1] = (double)i;
+  knots[n + 1] = (double)(n - 1);
+  return make(1, n, knots, pts, NULL, closed);
+}
+
+static void loop_cubic_bezier_crosses_once(void **state) {
+  (void)state;
+  /* y(t) = 9 t (1 - t) is symmetric, so the loop closes where
+   * x(1/2 + a) = x(1/2 - a): a^2 = 3/28, inside (0, 1/2) */
+  double knots[] = {0, 0, 0, 0, 1, 1, 1, 1};
+  double cp[] = {0, 0, 3, 3, -1, 3, 2, 0};
+  km_curve c = make(3, 4, knots, cp, NULL, false);
+  assert_int_equal(km_curve_self_intersections(&c, 1e-10), 1);
+  km_curve_free(&c);
+  /* the same shape without the loop: (0,0),(1,3),(2,3),(3,0) */
+  double cp2[] = {0, 0, 1, 3, 2, 3, 3, 0};
+  c = make(3, 4, knots, cp2, NULL, false);
+  assert_int_equal(km_curve_self_intersections(&c, 1e-10), 0);
+  km_curve_free(&c);
+}
+
+static void loop_is_found_after_exact_operations(void **state) {
+  (void)state;
+  /* the loop split over many pieces and raised in degree, made rational
+   * by a compatible partner: still one crossing */
+  double knots[] = {0, 0, 0, 0, 1, 1, 1, 1};
+  double cp[] = {0, 0, 3, 3, -1, 3, 2, 0};
+  km_curve c = make(3, 4, knots, cp, NULL, false), k1, k2, e;
+  assert_status(km_curve_insert_knot(&k1, &c, 0.1727, 1, NULL), KM_OK);
+  assert_status(km_curve_insert_knot(&k2, &k1, 0.5, 2, NULL), KM_OK);
+  assert_status(km_curve_elevate(&e, &k2, 2, NULL), KM_OK);
+  assert_int_equal(km_curve_self_intersections(&k1, 1e-10), 1);
+  assert_int_equal(km_curve_self_intersections(&k2, 1e-10), 1);
+  assert_int_equal(km_curve_self_intersections(&e, 1e-10), 1);
+  km_curve_free(&c);
+  km_curve_free(&k1);
+  km_curve_free(&k2);
+  km_curve_free(&e);
+}
+
+static void figure_eight_crosses_once(void **state) {
+  (void)state;
+  /* samples of the lemniscate of Gerono x = cos t, y = sin t cos t: one
+   * double point at the origin */
+  double pts[64];
+  for (int i = 0; i < 24; i++) {
+    double t = 2 * M_PI * (i + 0.25) / 24;
+    pts[2 * i] = 2 * cos(t);
+    pts[2 * i + 1] = sin(t) * cos(t);
+  }
+  km_curve c;
+  assert_status(km_curve_interpolate(&c, pts, 24, true, NULL), KM_OK);
+  assert_int_equal(km_curve_self_intersections(&c, 1e-10), 1);
+  km_curve_free(&c);
+  /* a clamped cubic figure-eight written by hand */
+  double knots[] = {0, 0, 0, 0, 1, 2, 3, 4, 5, 6, 7, 7, 7, 7};
+  double cp[] = {0, 0, 2, 2, 4, 2, 4, -2, 2, -2, -2, 2, -4, 2, -4, -2, -2, -2,
+                 0, 0};
+  c = make(3, 10, knots, cp, NULL, true);
+  assert_int_equal(km_curve_self_intersections(&c, 1e-10), 1);
+  km_curve_free(&c);
+}
+
+static void circles_do_not_cross_themselves(void **state) {
+  (void)state;
+  const double s = sqrt(0.5);
+  double knots[] = {0, 0, 0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1, 1, 1};
+  double cp[] = {3, 0, 3, 3, 0, 3, -3, 3, -3, 0, -3, -3, 0, -3, 3, -3, 3, 0};
+  double w[] = {1, s, 1, s, 1, s, 1, s, 1};
+  km_curve c = make(2, 9, knots, cp, w, true);
+  assert_int_equal(km_curve_self_intersections(&c, 1e-10), 0);
+  km_curve e;
+  assert_status(km_curve_elevate(&e, &c, 1, NULL), KM_OK);
+  assert_int_equal(km_curve_self_intersections(&e, 1e-10), 0);
+  km_curve_free(&e);
+  km_curve_free(&c);
+  double pts[40];
+  for (int i = 0; i < 20; i++) {
+    pts[2 * i] = cos(2 * M_PI * i / 20);
+    pts[2 * i + 1] = sin(2 * M_PI * i / 20);
+  }
+  assert_status(km_curve_interpolate(&c, pts, 20, true, NULL), KM_OK);
+  assert_int_equal(km_curve_self_intersections(&c, 1e-10), 0);
+  km_curve_free(&c);
+}
+
+/* A segment along y = 0 from x = -2 to 2, up the side x = 2, then the
+ * parabola y = x^2 - shift from x = 2 back to x = -2, as quadratic Bezier
+ * pieces. */
+static km_curve parabola_over_line(double shift) {
+  double knots[] = {0, 0, 0, 1, 1, 2, 2, 3, 3, 3};
+  double cp[] = {-2, 0, 0, 0, 2, 0, 2, 2 - shift / 2, 2, 4 - shift,
+                 0, -4 - shift, -2, 4 - shift};
+  return make(2, 7, knots, cp, NULL, false);
+}
+
+static void tangential_touch_is_not_a_crossing(void **state) {
+  (void)state;
+  km_curve c = parabola_over_line(0.0);
+  assert_int_equal(km_curve_self_intersections(&c, 1e-10), 0);
+  km_curve_free(&c);
+}
+
+static void curve_crossing_itself_twice(void **state) {
+  (void)state;
+  km_curve c = parabola_over_line(0.01);
+  assert_int_equal(km_curve_self_intersections(&c, 1e-10), 2);
+  km_curve_free(&c);
+  /* a shallow crossing: slopes +-2e-3 */
+  c = parabola_over_line(1e-6);
+  assert_int_equal(km_curve_self_intersections(&c, 1e-12), 2);
+  km_curve_free(&c);
+  /* lifted clear of the line: no contact */
+  c = parabola_over_line(-0.01);
+  assert_int_equal(km_curve_self_intersections(&c, 1e-10), 0);
+  km_curve_free(&c);
+}
+
+static void polygons_count_like_by_hand(void **state) {
+  (void)state;
+  double bowtie[] = {0, 0, 2, 2, 2, 0, 0, 2, 0, 0};
+  km_curve c = polyline(bowtie, 5, true);
+  assert_int_equal(km_curve_self_intersections(&c, 1e-10), 1);
+  km_curve_free(&c);
+  double square[] = {0, 0, 2, 0, 2, 2, 0, 2, 0, 0};
+  c = polyline(square, 5, true);
+  assert_int_equal(km_curve_self_intersections(&c, 1e-10), 0);
+  km_curve_free(&c);
+  /* pentagram {5/2}: five crossings */
+  double star[12];
+  for (int i = 0; i <= 5; i++) {
+    double a = M_PI / 2 + 2 * (2 * M_PI / 5) * (i % 5);
+    star[2 * i] = cos(a);
+    star[2 * i + 1] = sin(a);
+  }
+  star[10] = star[0];
+  star[11] = star[1];
+  c = polyline(star, 6, true);
+  assert_int_equal(km_curve_self_intersections(&c, 1e-10), 5);
+  km_curve_free(&c);
+}
+
+static void crossing_at_a_piece_boundary_counts_once(void **state) {
+  (void)state;
+  /* the vertical leg passes through the joint (0, 0) of the first two
+   * segments */
+  double pts[] = {-1, 0, 0, 0, 1, 0, 1, 1, 0, 1, 0, -1};
+  km_curve c = polyline(pts, 6, false);
+  assert_int_equal(km_curve_self_intersections(&c, 1e-10), 1);
+  km_curve_free(&c);
+}
+
+static void crossing_at_the_seam_counts_once(void **state) {
+  (void)state;
+  /* closed polygon starting at (1, 1), which the diagonal from (2, 0) to
+   * (0, 2) passes through */
+  double pts[] = {1, 1, 2, 2, 2, 0, 0, 2, 0, 0, 1, 1};
+  km_curve c = polyline(pts, 6, true);
+  assert_int_equal(km_curve_self_intersections(&c, 1e-10), 1);
+  km_curve_free(&c);
+  /* the seam alone is no crossing, nor an open end touching the curve */
+  double hook[] = {0, 0, 2, 0, 2, 2, 1, 2, 1, 0};
+  c = polyline(hook, 5, false);
+  assert_int_equal(km_curve_self_intersections(&c, 1e-10), 0);
+  km_curve_free(&c);
+}
+
+static void count_is_invariant_under_rigid_motion(void **state) {
+  (void)state;
+  double knots[] = {0, 0, 0, 0, 1, 2, 3, 4, 5, 6, 7, 7, 7, 7};
+  double cp[] = {0, 0, 2, 2, 4, 2, 4, -2, 2, -2, -2, 2, -4, 2, -4, -2, -2, -2,
+                 0, 0};
+  km_curve c = make(3, 10, knots, cp, NULL, true), t;
+  for (int k = 0; k < 8; k++) {
+    assert_status(km_curve_transform(&t, &c, 0.37 * k, 1e3 * k, -7.0 * k, NULL),
+                  KM_OK);
+    assert_int_equal(km_curve_self_intersections(&t, 0), 1);
+    km_curve_free(&t);
+  }
+  km_curve_free(&c);
+}
+
+static void invalid_curve_gives_minus_one(void **state) {
+  (void)state;
+  assert_int_equal(km_curve_self_intersections(NULL, 1e-9), -1);
+  km_curve empty;
+  km_curve_init(&empty);
+  assert_int_equal(km_curve_self_intersections(&empty, 1e-9), -1);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(loop_cubic_bezier_crosses_once),
+      cmocka_unit_test(loop_is_found_after_exact_operations),
+      cmocka_unit_test(figure_eight_crosses_once),
+      cmocka_unit_test(circles_do_not_cross_themselves),
+      cmocka_unit_test(tangential_touch_is_not_a_crossing),
+      cmocka_unit_test(curve_crossing_itself_twice),
+      cmocka_unit_test(polygons_count_like_by_hand),
+      cmocka_unit_test(crossing_at_a_piece_boundary_counts_once),
+      cmocka_unit_test(crossing_at_the_seam_counts_once),
+      cmocka_unit_test(count_is_invariant_under_rigid_motion),
+      cmocka_unit_test(invalid_curve_gives_minus_one),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
