@@ -178,7 +178,8 @@ km_status km_path_arc_to(km_path *p, double rx, double ry, double x_rot_deg,
   /* F.6.6.2: scale radii up until the ellipse reaches the end point. */
   double lx = x1p / rx, ly = y1p / ry;
   double lambda = lx * lx + ly * ly;
-  if (lambda > 1.0) {
+  bool scaled = lambda > 1.0;
+  if (scaled) {
     double sl = sqrt(lambda);
     rx *= sl;
     ry *= sl;
@@ -186,12 +187,13 @@ km_status km_path_arc_to(km_path *p, double rx, double ry, double x_rot_deg,
   if (!isfinite(rx) || !isfinite(ry) || !isfinite(lambda))
     return km__fail(err, KM_ERANGE, KM_FIELD_CONTROL_POINTS, 0, NAN,
                     "arc radii out of range");
-  /* F.6.5.2: centre in the rotated frame; the radicand is >= 0 up to
-   * rounding after the scaling above. */
+  /* F.6.5.2: centre in the rotated frame. Scaled radii put the centre at
+   * the chord's midpoint exactly: the radicand is then 0, and computing it
+   * would leave rounding noise whose square root (~1e-8) moves the centre. */
   double rx2 = rx * rx, ry2 = ry * ry;
   double num = rx2 * ry2 - rx2 * y1p * y1p - ry2 * x1p * x1p;
   double den = rx2 * y1p * y1p + ry2 * x1p * x1p;
-  double coef = (num > 0.0 && den > 0.0) ? sqrt(num / den) : 0.0;
+  double coef = (!scaled && num > 0.0 && den > 0.0) ? sqrt(num / den) : 0.0;
   if (large_arc == sweep) coef = -coef;
   double cxp = coef * rx * y1p / ry;
   double cyp = -coef * ry * x1p / rx;
