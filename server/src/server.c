@@ -527,8 +527,14 @@ static enum MHD_Result serve_metrics(srv_req *r)
   g.queue_capacity = srv_pool_capacity(s->pool);
   g.workers_busy = srv_pool_busy(s->pool);
   g.workers = srv_pool_workers(s->pool);
+  /* The daemon pointer comes from the connection: s->daemon is written by
+   * the main thread after the I/O threads have started. */
+  const union MHD_ConnectionInfo *ci =
+      MHD_get_connection_info(r->conn, MHD_CONNECTION_INFO_DAEMON);
   const union MHD_DaemonInfo *info =
-      MHD_get_daemon_info(s->daemon, MHD_DAEMON_INFO_CURRENT_CONNECTIONS);
+      ci ? MHD_get_daemon_info(ci->daemon,
+                               MHD_DAEMON_INFO_CURRENT_CONNECTIONS)
+         : NULL;
   g.connections = info ? info->num_connections : 0;
   s->store->ops->counts(s->store, srv_now(), g.jobs);
   g.job_state_names = names;
