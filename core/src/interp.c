@@ -284,10 +284,13 @@ km_status km_curve_interpolate(km_curve *out, const double *pts, size_t n,
     st = km__fail(err, KM_EDEGENERATE, KM_FIELD_POINTS, -1, NAN, NULL);
     goto cleanup;
   }
+  /* breaks as cumulative chord / total: each is rounded once, not
+   * accumulated */
+  double cum = 0.0;
   u[0] = 0.0;
   for (size_t k = 0; k < nspan; k++) {
-    h[k] /= total;
-    u[k + 1] = u[k] + h[k];
+    cum += h[k];
+    u[k + 1] = cum / total;
   }
   u[nspan] = 1.0;
   for (size_t k = 0; k < nspan; k++) {
