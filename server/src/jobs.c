@@ -26,6 +26,7 @@ struct srv_jobs {
   size_t live;
   size_t max_active;
   double job_time;
+  bool closed; /* shutting down: no new jobs */
   srv_jobstore *store;
 };
 
@@ -73,10 +74,11 @@ int srv_jobs_start(srv_jobs *j, api_morph_plan *plan,
   double now = srv_now();
   nj->deadline = now + j->job_time;
   pthread_mutex_lock(&j->mu);
-  if (count_active(j) >= j->max_active) {
+  if (j->closed || count_active(j) >= j->max_active) {
+    int rc = j->closed ? -3 : -1;
     pthread_mutex_unlock(&j->mu);
     free(nj);
-    return -1;
+    return rc;
   }
   if (j->store->ops->create(j->store, nj->id, nj->total, now) != 0) {
     pthread_mutex_unlock(&j->mu);
@@ -254,6 +256,7 @@ void srv_jobs_cancel_all(srv_jobs *j)
   job *done_list = NULL;
   double now = srv_now();
   pthread_mutex_lock(&j->mu);
+  j->closed = true;
   job *next;
   for (job *p = j->first; p; p = next) {
     next = p->next;

@@ -31,8 +31,8 @@ bool srv_jobs_full(srv_jobs *j);
 
 /* Admit a prepared plan: on success (0) the runner owns plan and id
  * (SRV_JOB_ID_LEN hex digits + NUL) names the new queued job. Returns -1
- * when max_active jobs are live, -2 when out of memory; then the caller
- * still owns plan. The caller kicks the pool afterwards. */
+ * when max_active jobs are live, -2 when out of memory, -3 after
+ * srv_jobs_cancel_all (shutting down); then the caller still owns plan. The caller kicks the pool afterwards. */
 int srv_jobs_start(srv_jobs *j, api_morph_plan *plan,
                    char id[SRV_JOB_ID_LEN + 1]);
 
@@ -45,7 +45,7 @@ bool srv_jobs_work(void *ctx);
  * already final). */
 int srv_jobs_cancel(srv_jobs *j, const char *id);
 
-/* Cancel every live job (shutdown). */
+/* Cancel every live job and admit no more (shutdown). */
 void srv_jobs_cancel_all(srv_jobs *j);
 
 /* Jobs whose plan is still held (live, or finishing in-flight frames). */

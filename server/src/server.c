@@ -368,6 +368,13 @@ static void create_job(srv_req *r, const api_request *req)
                 NULL, NULL, r->rid);
     return;
   }
+  if (st == -3) {
+    api_morph_plan_free(plan);
+    api_problem(&r->resp, 503, "/problems/shutting-down", "Shutting down",
+                "the service is stopping; retry on another instance", NULL,
+                NULL, r->rid);
+    return;
+  }
   if (st != 0 || job_created_body(&r->resp, r->job_id, total) != 0) {
     if (st != 0)
       api_morph_plan_free(plan);
