@@ -373,6 +373,12 @@ cleanup:
   return st;
 }
 
+/* Insert t (within the domain) `times` times, capped so that no interior
+ * multiplicity exceeds the degree; at a domain end nothing is inserted.
+ * out: a new curve owned by the caller (km_curve_free), same trace and
+ * parameterisation, closed flag kept. Returns KM_OK, KM_EINVAL (not a
+ * curve; times < 0, field KM_FIELD_TIMES), KM_ENONFINITE (t), KM_ERANGE (t
+ * outside the domain, err->param = t), KM_ENOMEM. Thread-safe. */
 km_status km_curve_insert_knot(km_curve *out, const km_curve *c, double t,
                                int times, km_error *err) {
   km_status st = check_curve(c, err);
@@ -399,6 +405,10 @@ km_status km_curve_insert_knot(km_curve *out, const km_curve *c, double t,
   return KM_OK;
 }
 
+/* Split at t strictly inside the domain into left on [t0, t] and right on
+ * [t, t1], both open, meeting in one bit-identical point; each is owned by
+ * the caller. Returns KM_OK, KM_EINVAL, KM_ERANGE / KM_ENONFINITE (t not
+ * inside), KM_ENOMEM; on failure neither output is written. */
 km_status km_curve_split(const km_curve *c, double t, km_curve *left,
                          km_curve *right, km_error *err) {
   km_status st = check_curve(c, err);
@@ -447,6 +457,8 @@ cleanup:
   return st;
 }
 
+/* Same trace backwards on the same domain: C_rev(a + b - t) = C(t).
+ * Returns KM_OK, KM_EINVAL, KM_ENOMEM; out owned by the caller. */
 km_status km_curve_reverse(km_curve *out, const km_curve *c, km_error *err) {
   km_status st = check_curve(c, err);
   if (st) return st;
@@ -471,6 +483,8 @@ km_status km_curve_reverse(km_curve *out, const km_curve *c, km_error *err) {
   return KM_OK;
 }
 
+/* Bezier extraction: every interior knot raised to multiplicity degree.
+ * Returns KM_OK, KM_EINVAL, KM_ENOMEM; out owned by the caller. */
 km_status km_curve_to_bezier(km_curve *out, const km_curve *c,
                              km_error *err) {
   km__hcurve h, q;
@@ -487,6 +501,11 @@ km_status km_curve_to_bezier(km_curve *out, const km_curve *c,
   return st;
 }
 
+/* Degree raised by times >= 0 (exact; homogeneous for NURBS); each
+ * distinct knot's multiplicity grows by times. Returns KM_OK, KM_EINVAL
+ * (times < 0, field KM_FIELD_TIMES), KM_EDEGREE (degree + times above
+ * KM_MAX_DEGREE, field KM_FIELD_TIMES), KM_ENOMEM; out owned by the
+ * caller. */
 km_status km_curve_elevate(km_curve *out, const km_curve *c, int times,
                            km_error *err) {
   km__hcurve h, q;
@@ -526,6 +545,9 @@ static void reparam_knots(double *U, size_t nk, int p, double t0, double t1) {
   }
 }
 
+/* Linear map of the domain onto [t0, t1]; the trace is unchanged. Returns
+ * KM_OK, KM_EINVAL, KM_ENONFINITE, KM_ERANGE (t0 >= t1 or beyond
+ * KM_MAX_COORDINATE), KM_ENOMEM; out owned by the caller. */
 km_status km_curve_reparam(km_curve *out, const km_curve *c, double t0,
                            double t1, km_error *err) {
   km_status st = check_curve(c, err);
@@ -545,6 +567,10 @@ km_status km_curve_reparam(km_curve *out, const km_curve *c, double t0,
   return KM_OK;
 }
 
+/* Rigid motion x' = R(rot) x + (tx, ty) of the control points (exact for
+ * NURBS too: rational curves are affinely invariant). Returns KM_OK,
+ * KM_EINVAL, KM_ENONFINITE, KM_ERANGE (a point beyond KM_MAX_COORDINATE,
+ * err->index names it), KM_ENOMEM; out owned by the caller. */
 km_status km_curve_transform(km_curve *out, const km_curve *c, double rot,
                              double tx, double ty, km_error *err) {
   km_status st = check_curve(c, err);
@@ -609,6 +635,12 @@ static void snap_knots(km__hcurve *b, const km__hcurve *a, double snap) {
   }
 }
 
+/* Both curves on [0, 1], of the larger degree, with one merged knot vector
+ * (multiplicity the larger of the two; knots closer than 1e-13 are taken
+ * as one) and both rational if either is (unit weights for a polynomial
+ * one). Traces unchanged, closed flags kept. Returns KM_OK, KM_EINVAL,
+ * KM_ENOMEM; on failure neither output is written; outputs owned by the
+ * caller. Thread-safe. */
 km_status km_curve_make_compatible(const km_curve *a, const km_curve *b,
                                    km_curve *out_a, km_curve *out_b,
                                    km_error *err) {

@@ -226,6 +226,15 @@ static km_status solve_closed(const double *Q, const double *h,
   return KM_OK;
 }
 
+/* Cubic through n points (x0, y0, x1, y1, ...) on [0, 1] with chord-length
+ * parameters. Open: not-a-knot, n = 2 gives the segment at uniform speed, 3
+ * the parabola. Closed: periodic C2, stored clamped with the first point
+ * repeated at the end. Consecutive duplicates (and, closed, repeats of the
+ * first point at the end) are dropped first. Returns KM_OK, KM_EINVAL (pts
+ * NULL), KM_ENONFINITE / KM_ERANGE (a point; err->index names it),
+ * KM_EDEGENERATE (fewer than 2 distinct points, 3 when closed; field
+ * KM_FIELD_POINTS), KM_ELIMIT (n absurdly large), KM_ENOMEM. out owned by
+ * the caller. Thread-safe. */
 km_status km_curve_interpolate(km_curve *out, const double *pts, size_t n,
                                bool closed, km_error *err) {
   double *Q = NULL, *u = NULL, *h = NULL;
@@ -235,6 +244,9 @@ km_status km_curve_interpolate(km_curve *out, const double *pts, size_t n,
   if (n > 0 && !pts)
     return km__fail(err, KM_EINVAL, KM_FIELD_POINTS, -1, NAN,
                     "points array is missing");
+  if (n > ((size_t)-1) / (16 * sizeof(double)))
+    return km__fail(err, KM_ELIMIT, KM_FIELD_POINTS, -1, NAN,
+                    "too many points");
   for (size_t i = 0; i < n; i++) {
     for (int k = 0; k < 2; k++) {
       double v = pts[2 * i + (size_t)k];

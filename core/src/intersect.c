@@ -331,6 +331,14 @@ static int by_xmin(const void *a, const void *b) {
   return (u > v) - (u < v);
 }
 
+/* Number of proper self-crossings of c: points where two different
+ * parameters meet within tol (absolute, clamped to at least 1e-13 of the
+ * control polygon's extent; tol <= 0 or NaN means 1e-9 of it) and the
+ * branches cross at a sine of at least MIN_CROSSING_SINE. The seam of a
+ * closed curve, the shared ends of adjacent pieces, the ends of an open
+ * curve and tangential touches are not crossings; overlapping (collinear
+ * or coincident) stretches are not counted. Returns -1 for an invalid
+ * curve or when memory runs out. Thread-safe; allocates only scratch. */
 long km_curve_self_intersections(const km_curve *c, double tol) {
   if (!c || !c->knots || !c->cp || c->degree < KM_MIN_DEGREE ||
       c->degree > KM_MAX_DEGREE || c->n < (size_t)c->degree + 1)

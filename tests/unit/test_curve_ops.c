@@ -34,7 +34,18 @@ static void make_circle(km_curve *c) {
   assert_status(km_curve_create(c, 2, 9, knots, cp, w, true, &e), KM_OK);
 }
 
+/* The result is a curve km_curve_create accepts as it stands. */
+static void assert_valid(const km_curve *c) {
+  km_curve v;
+  km_error e;
+  assert_status(km_curve_create(&v, c->degree, c->n, c->knots, c->cp, c->w,
+                                c->closed, &e),
+                KM_OK);
+  km_curve_free(&v);
+}
+
 static void assert_on_circle(const km_curve *c, int samples) {
+  assert_valid(c);
   double t0, t1;
   km_curve_domain(c, &t0, &t1);
   for (int i = 0; i <= samples; i++) {
@@ -60,6 +71,7 @@ static void make_poly_cubic(km_curve *c) {
 }
 
 static void assert_is_poly(const km_curve *c, double t0, double t1) {
+  assert_valid(c);
   double a, b;
   km_curve_domain(c, &a, &b);
   for (int i = 0; i <= 200; i++) {
@@ -101,6 +113,7 @@ static void make_random_nurbs(km_curve *c, int degree, uint64_t seed) {
 /* Same point at the same parameter (domains equal) within tol. */
 static void assert_same_trace(const km_curve *a, const km_curve *b,
                               double tol) {
+  assert_valid(b);
   double a0, a1, b0, b1;
   km_curve_domain(a, &a0, &a1);
   km_curve_domain(b, &b0, &b1);
