@@ -88,7 +88,7 @@ class Overload(ContractCase):
         barrier = threading.Barrier(n)
 
         def client(i):
-            frames = 200 + i  # the answer's frame count identifies it
+            frames = 800 + 10 * i  # the answer's frame count identifies it
             rid = "load-%d" % i
             barrier.wait(timeout=10)
             t0 = time.monotonic()
