@@ -30,7 +30,10 @@ km_status api_svg_parse_path(const char *d, size_t len, double tol,
 char *api_svg_path_d(const km_curve *c, double tol, double *err_bound);
 
 /* Same, with a fixed number of cubic pieces (n_pieces >= 1), so that paths
- * of every frame share one command structure (for SMIL / CSS animation). */
+ * of every frame share one command structure (for SMIL / CSS animation).
+ * Piece ends are uniform in arc length and lie on the curve; each piece is
+ * the cubic Hermite interpolant of its stretch (a shape approximation, no
+ * bound stated); coordinates are printed to 1e-6 of the curve's extent. */
 char *api_svg_path_d_fixed(const km_curve *c, size_t n_pieces);
 
 typedef enum api_svg_layout {

@@ -7,6 +7,7 @@
 #define KM_SVG_TESTUTIL_H
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include <cJSON.h>
@@ -65,31 +66,44 @@ static inline void st_same_at_params(const km_curve *a, const km_curve *b,
   }
 }
 
-/* Distance from p to the trace of c: the nearest of dense samples, then a
- * golden-section search between its neighbours. */
-static inline double st_dist(const km_curve *c, const double p[2]) {
+/* Dense samples of a curve's trace, for nearest-point searches. */
+typedef struct st_samples {
+  const km_curve *c;
   double t0, t1;
-  km_curve_domain(c, &t0, &t1);
-  int n = (int)ceil((t1 - t0) * 256) + 1;
-  if (n > 20000) n = 20000;
+  int n;
+  double *xy; /* 2 (n + 1) */
+} st_samples;
+
+static inline void st_sample(const km_curve *c, st_samples *s) {
+  s->c = c;
+  km_curve_domain(c, &s->t0, &s->t1);
+  s->n = (int)ceil((s->t1 - s->t0) * 256) + 1;
+  if (s->n > 20000) s->n = 20000;
+  s->xy = malloc(2 * ((size_t)s->n + 1) * sizeof *s->xy);
+  assert_non_null(s->xy);
+  for (int i = 0; i <= s->n; i++)
+    st_pos(c, s->t0 + (s->t1 - s->t0) * i / s->n, s->xy + 2 * i);
+}
+
+/* Distance from p to the trace: the nearest sample, then a golden-section
+ * search between its neighbours. */
+static inline double st_dist_s(const st_samples *s, const double p[2]) {
   double best = INFINITY;
   int bi = 0;
-  for (int i = 0; i <= n; i++) {
-    double q[2];
-    st_pos(c, t0 + (t1 - t0) * i / n, q);
-    double d = hypot(q[0] - p[0], q[1] - p[1]);
+  for (int i = 0; i <= s->n; i++) {
+    double d = hypot(s->xy[2 * i] - p[0], s->xy[2 * i + 1] - p[1]);
     if (d < best) {
       best = d;
       bi = i;
     }
   }
-  double lo = t0 + (t1 - t0) * (bi > 0 ? bi - 1 : 0) / n;
-  double hi = t0 + (t1 - t0) * (bi < n ? bi + 1 : n) / n;
+  double lo = s->t0 + (s->t1 - s->t0) * (bi > 0 ? bi - 1 : 0) / s->n;
+  double hi = s->t0 + (s->t1 - s->t0) * (bi < s->n ? bi + 1 : s->n) / s->n;
   const double g = 0.5 * (sqrt(5.0) - 1.0);
   for (int it = 0; it < 80; it++) {
     double m1 = hi - g * (hi - lo), m2 = lo + g * (hi - lo), q1[2], q2[2];
-    st_pos(c, m1, q1);
-    st_pos(c, m2, q2);
+    st_pos(s->c, m1, q1);
+    st_pos(s->c, m2, q2);
     double d1 = hypot(q1[0] - p[0], q1[1] - p[1]);
     double d2 = hypot(q2[0] - p[0], q2[1] - p[1]);
     if (d1 < best) best = d1;
@@ -106,6 +120,8 @@ static inline double st_trace_distance(const km_curve *a, const km_curve *b) {
   double worst = 0.0;
   for (int side = 0; side < 2; side++) {
     const km_curve *x = side ? b : a, *y = side ? a : b;
+    st_samples ys;
+    st_sample(y, &ys);
     double t0, t1;
     km_curve_domain(x, &t0, &t1);
     int n = (int)ceil((t1 - t0) * 24) + 1;
@@ -113,9 +129,10 @@ static inline double st_trace_distance(const km_curve *a, const km_curve *b) {
     for (int i = 0; i <= n; i++) {
       double p[2];
       st_pos(x, t0 + (t1 - t0) * i / n, p);
-      double d = st_dist(y, p);
+      double d = st_dist_s(&ys, p);
       if (d > worst) worst = d;
     }
+    free(ys.xy);
   }
   return worst;
 }
