@@ -398,6 +398,32 @@ static void make_compatible_of_two_random_nurbs(void **state) {
   km_curve_free(&ob);
 }
 
+static void make_compatible_merges_knots_equal_up_to_rounding(void **state) {
+  (void)state;
+  /* A's knot 0.55 on [0.1, 0.7] and B's knot 0.75 on [0, 1] are the same
+   * place once both live on [0, 1], although (0.55 - 0.1) / 0.6 rounds to
+   * 0.7500000000000001 */
+  double ka[] = {0.1, 0.1, 0.1, 0.1, 0.55, 0.7, 0.7, 0.7, 0.7};
+  double kb[] = {0, 0, 0, 0, 0.75, 1, 1, 1, 1};
+  double pa[] = {0, 0, 1, 2, 2, 3, 3, 1, 4, 0};
+  double pb[] = {0, 5, 1, 6, 2, 6, 3, 5, 4, 4};
+  km_curve a, b, oa, ob;
+  assert_status(km_curve_create(&a, 3, 5, ka, pa, NULL, false, NULL), KM_OK);
+  assert_status(km_curve_create(&b, 3, 5, kb, pb, NULL, false, NULL), KM_OK);
+  assert_status(km_curve_make_compatible(&a, &b, &oa, &ob, NULL), KM_OK);
+  /* one shared interior knot, not two a hair apart */
+  assert_int_equal(oa.n, 5);
+  assert_int_equal(ob.n, 5);
+  assert_null(oa.w);
+  assert_memory_equal(oa.knots, ob.knots, 9 * sizeof(double));
+  assert_same_trace(&a, &oa, 1e-13);
+  assert_same_trace(&b, &ob, 1e-13);
+  km_curve_free(&a);
+  km_curve_free(&b);
+  km_curve_free(&oa);
+  km_curve_free(&ob);
+}
+
 static void reparam_maps_domain_linearly(void **state) {
   (void)state;
   km_curve c, r;
@@ -450,6 +476,7 @@ int main(void) {
       cmocka_unit_test(elevate_refuses_degree_beyond_limit),
       cmocka_unit_test(make_compatible_gives_same_degree_and_knots),
       cmocka_unit_test(make_compatible_of_two_random_nurbs),
+      cmocka_unit_test(make_compatible_merges_knots_equal_up_to_rounding),
       cmocka_unit_test(reparam_maps_domain_linearly),
       cmocka_unit_test(transform_moves_circle_rigidly),
   };
