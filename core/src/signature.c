@@ -1,0 +1,611 @@
+/* signature.c - curvature signatures of B-spline / NURBS curves.
+ *
+ * DESIGN. kappa(s) is obtained as the derivative of a piecewise polynomial
+ * interpolant of the tangent angle theta(s), not by sampling kappa itself:
+ *   - theta(t) is smooth in the curve parameter even where a control leg is
+ *     degenerate (C' = 0 at a span end), while kappa(s) there grows like
+ *     1/sqrt(s); interpolating theta keeps the turning exact (the pieces
+ *     meet the true theta at their ends) and bounds the position error
+ *     directly: |C - C~| <= integral |theta - theta~| ds <= L max|dtheta|.
+ *   - Nodes are Chebyshev-Lobatto points in t on each piece; their images
+ *     in s (by Gauss-Legendre arc length) are the interpolation abscissae.
+ *     Points midway between nodes check the interpolant; a piece that
+ *     fails is bisected in t, which refines geometrically toward a
+ *     degenerate end by itself.
+ *   - Knots are always piece boundaries, so kappa's breakpoints include
+ *     their arc-length images and curvature jumps at C1 knots survive.
+ *   - Where the one-sided tangents at a knot differ, the turn is a corner;
+ *     a turn of (nearly) pi is a cusp and is refused.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+#include "km/limits.h"
+#include "km/signature.h"
+
+#define THETA_DEGREE 7               /* kappa pieces are of degree 6 */
+#define NPTS (2 * THETA_DEGREE + 1)  /* nodes and check points */
+#define CORNER_NOISE 1e-11           /* turns below this are rounding */
+#define CUSP_MARGIN 1e-7             /* |turn| > pi - this: a cusp */
+
+/* cos(m pi / 14), m = 0..27: Chebyshev-Lobatto abscissae and the cosine
+ * transform of NPTS = 15 points */
+static const double COS14[28] = {1, 0.97492791218182362, 0.90096886790241915, 0.7818314824680298, 0.62348980185873359, 0.43388373911755818, 0.22252093395631445, 6.123233995736766e-17, -0.22252093395631434, -0.43388373911755806, -0.62348980185873348, -0.78183148246802947, -0.90096886790241903, -0.97492791218182373, -1, -0.97492791218182373, -0.90096886790241915, -0.78183148246802958, -0.62348980185873371, -0.43388373911755829, -0.22252093395631459, -1.8369701987210297e-16, 0.22252093395631334, 0.43388373911755795, 0.62348980185873337, 0.78183148246802969, 0.90096886790241937, 0.97492791218182351};
+
+void km_signature_init(km_signature *sig) {
+  if (!sig) return;
+  memset(sig, 0, sizeof *sig);
+  km_fn_init(&sig->kappa);
+}
+
+void km_signature_free(km_signature *sig) {
+  if (!sig) return;
+  km_fn_free(&sig->kappa);
+  free(sig->corners);
+  km_signature_init(sig);
+}
+
+km_status km_signature_copy(km_signature *out, const km_signature *sig,
+                            km_error *err) {
+  return km_signature_create(out, sig->length, sig->start, sig->angle,
+                             &sig->kappa, sig->corners, sig->ncorners,
+                             sig->closed, err);
+}
+
+km_status km_signature_create(km_signature *out, double length,
+                              const double start[2], double angle,
+                              const km_fn *kappa, const km_corner *corners,
+                              size_t ncorners, bool closed, km_error *err) {
+  if (!isfinite(length))
+    return km__fail(err, KM_ENONFINITE, KM_FIELD_LENGTH, -1, NAN,
+                    "length is not finite");
+  if (!(length > 0) || length > KM_MAX_COORDINATE)
+    return km__fail(err, KM_ERANGE, KM_FIELD_LENGTH, -1, NAN,
+                    "length must be positive and at most %g",
+                    KM_MAX_COORDINATE);
+  for (int k = 0; k < 2; k++) {
+    if (!isfinite(start[k]))
+      return km__fail(err, KM_ENONFINITE, KM_FIELD_START, k, NAN,
+                      "start point is not finite");
+    if (fabs(start[k]) > KM_MAX_COORDINATE)
+      return km__fail(err, KM_ERANGE, KM_FIELD_START, k, NAN,
+                      "start point exceeds %g in magnitude",
+                      KM_MAX_COORDINATE);
+  }
+  if (!isfinite(angle) || fabs(angle) > 1e6)
+    return km__fail(err, KM_ERANGE, KM_FIELD_ANGLE, -1, NAN,
+                    "start angle must be finite and at most 1e6 radians");
+  double a, b;
+  km_fn_domain(kappa, &a, &b);
+  if (fabs(a) > 1e-9 * length || fabs(b - length) > 1e-9 * length)
+    return km__fail(err, KM_EKNOTS, KM_FIELD_KAPPA_KNOTS, -1, NAN,
+                    "kappa must be defined on [0, length] = [0, %g], not "
+                    "[%g, %g]",
+                    length, a, b);
+  for (size_t i = 0; i < ncorners; i++) {
+    if (!isfinite(corners[i].s) || !isfinite(corners[i].turn))
+      return km__fail(err, KM_ENONFINITE, KM_FIELD_CORNERS, (long)i, NAN,
+                      "corner %zu is not finite", i);
+    if (corners[i].s < 0 || corners[i].s > length * (1 + 1e-12))
+      return km__fail(err, KM_ERANGE, KM_FIELD_CORNERS, (long)i, NAN,
+                      "corner %zu lies outside [0, length]", i);
+    if (!(fabs(corners[i].turn) < KM_PI))
+      return km__fail(err, KM_ERANGE, KM_FIELD_CORNERS, (long)i, NAN,
+                      "corner %zu turns by %g, outside (-pi, pi)", i,
+                      corners[i].turn);
+    if (i > 0 && corners[i].s < corners[i - 1].s)
+      return km__fail(err, KM_EINVAL, KM_FIELD_CORNERS, (long)i, NAN,
+                      "corners must be sorted by s (corner %zu)", i);
+  }
+  km_signature r;
+  km_signature_init(&r);
+  km_status st = km_fn_copy(&r.kappa, kappa, err);
+  if (st) return st;
+  /* snap the domain to [0, length] exactly */
+  size_t nk = r.kappa.n + (size_t)r.kappa.degree + 1;
+  for (size_t i = 0; i < nk; i++) {
+    if (r.kappa.knots[i] < 0 || i <= (size_t)r.kappa.degree)
+      r.kappa.knots[i] = 0.0;
+    if (r.kappa.knots[i] > length || i >= r.kappa.n) r.kappa.knots[i] = length;
+  }
+  if (ncorners) {
+    r.corners = malloc(ncorners * sizeof *r.corners);
+    if (!r.corners) {
+      km_fn_free(&r.kappa);
+      return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+    }
+    memcpy(r.corners, corners, ncorners * sizeof *r.corners);
+    for (size_t i = 0; i < ncorners; i++)
+      if (r.corners[i].s > length) r.corners[i].s = length;
+  }
+  r.ncorners = ncorners;
+  r.length = length;
+  r.start[0] = start[0];
+  r.start[1] = start[1];
+  r.angle = angle;
+  r.closed = closed;
+  double turning = km_fn_integral(&r.kappa);
+  for (size_t i = 0; i < ncorners; i++) turning += corners[i].turn;
+  r.turning = turning;
+  *out = r;
+  return KM_OK;
+}
+
+double km_signature_theta(const km_signature *sig, double s) {
+  /* integral of kappa over [0, s] by the antiderivative on the fly */
+  km_fn F;
+  double th = sig->angle;
+  if (km_fn_antiderivative(&F, &sig->kappa, 0.0, NULL) == KM_OK) {
+    th += km_fn_value(&F, s);
+    km_fn_free(&F);
+  }
+  for (size_t i = 0; i < sig->ncorners; i++)
+    if (sig->corners[i].s <= s) th += sig->corners[i].turn;
+  return th;
+}
+
+double km_signature_max_abs_kappa(const km_signature *sig) {
+  return km_fn_max_abs(&sig->kappa);
+}
+
+double km_signature_bending_energy(const km_signature *sig) {
+  return km_fn_integral_sq(&sig->kappa);
+}
+
+/* ---- computing a signature ------------------------------------------- */
+
+typedef struct builder {
+  const km_curve *c;
+  double L;         /* total length */
+  double tol_theta; /* allowed |theta - theta~| */
+  double span_t;    /* width in t of the span being processed */
+  double span_speed; /* its mean speed: the scale of |C'| there */
+  /* pieces of theta: breaks s[0..m], coefficients th[m*(P+1)] */
+  double *s, *th;
+  size_t m, cap;
+  km_corner *corners;
+  size_t ncorners, ccap;
+  km_error *err;
+} builder;
+
+static km_status push_piece(builder *b, double s0, double s1,
+                            const double *coef) {
+  if (b->m + 1 >= b->cap) {
+    size_t cap = b->cap ? 2 * b->cap : 64;
+    if (cap > KM_MAX_PIECES)
+      return km__fail(b->err, KM_ELIMIT, KM_FIELD_NONE, -1, NAN,
+                      "signature would need more than %d pieces",
+                      KM_MAX_PIECES);
+    double *s = realloc(b->s, (cap + 1) * sizeof(double));
+    if (!s) return km__fail(b->err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+    b->s = s;
+    double *th = realloc(b->th, cap * (THETA_DEGREE + 1) * sizeof(double));
+    if (!th) return km__fail(b->err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+    b->th = th;
+    b->cap = cap;
+  }
+  if (b->m == 0) b->s[0] = s0;
+  b->s[b->m + 1] = s1;
+  memcpy(b->th + b->m * (THETA_DEGREE + 1), coef,
+         (THETA_DEGREE + 1) * sizeof(double));
+  b->m++;
+  return KM_OK;
+}
+
+static km_status push_corner(builder *b, double s, double turn) {
+  if (b->ncorners == b->ccap) {
+    size_t cap = b->ccap ? 2 * b->ccap : 16;
+    km_corner *c = realloc(b->corners, cap * sizeof *c);
+    if (!c) return km__fail(b->err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+    b->corners = c;
+    b->ccap = cap;
+  }
+  b->corners[b->ncorners].s = s;
+  b->corners[b->ncorners].turn = turn;
+  b->ncorners++;
+  return KM_OK;
+}
+
+/* Unit tangent at t as a one-sided limit (side > 0: from the right). When
+ * C'(t) vanishes the first non-vanishing higher derivative gives the
+ * direction (C'(t + sh) ~ (sh)^(k-1) C^(k)(t)); failing that, a short
+ * chord. Returns false if no direction exists (a point curve). */
+static bool tangent_limit(const builder *b, double t, int side,
+                          double dir[2]) {
+  double d[4][2];
+  km_curve_eval_side(b->c, t, side, 3, d);
+  double scale = b->span_speed;
+  double tiny = 1e-10 * scale;
+  for (int k = 1; k <= 3; k++) {
+    double n = hypot(d[k][0], d[k][1]);
+    if (n > tiny) {
+      double sg = (side < 0 && (k % 2 == 0)) ? -1.0 : 1.0;
+      dir[0] = sg * d[k][0] / n;
+      dir[1] = sg * d[k][1] / n;
+      return true;
+    }
+    tiny /= fmax(b->span_t, 1e-300);
+  }
+  /* chord over a small step inside the span */
+  double t0, t1;
+  km_curve_domain(b->c, &t0, &t1);
+  double h = 1e-6 * b->span_t;
+  double q[1][2];
+  double tq = side > 0 ? fmin(t + h, t1) : fmax(t - h, t0);
+  km_curve_eval(b->c, tq, 0, q);
+  double vx = (q[0][0] - d[0][0]) * (side > 0 ? 1 : -1);
+  double vy = (q[0][1] - d[0][1]) * (side > 0 ? 1 : -1);
+  double n = hypot(vx, vy);
+  if (!(n > 0)) return false;
+  dir[0] = vx / n;
+  dir[1] = vy / n;
+  return true;
+}
+
+
+/* Solve the (n x n) system A x = y in place by Gaussian elimination with
+ * partial pivoting. Returns false if singular. */
+static bool solve(double A[][THETA_DEGREE + 1], double *y, int n) {
+  for (int col = 0; col < n; col++) {
+    int piv = col;
+    for (int r = col + 1; r < n; r++)
+      if (fabs(A[r][col]) > fabs(A[piv][col])) piv = r;
+    if (!(fabs(A[piv][col]) > 1e-300)) return false;
+    if (piv != col) {
+      for (int k = 0; k < n; k++) {
+        double tmp = A[col][k];
+        A[col][k] = A[piv][k];
+        A[piv][k] = tmp;
+      }
+      double tmp = y[col];
+      y[col] = y[piv];
+      y[piv] = tmp;
+    }
+    for (int r = col + 1; r < n; r++) {
+      double f = A[r][col] / A[col][col];
+      for (int k = col; k < n; k++) A[r][k] -= f * A[col][k];
+      y[r] -= f * y[col];
+    }
+  }
+  for (int r = n - 1; r >= 0; r--) {
+    double v = y[r];
+    for (int k = r + 1; k < n; k++) v -= A[r][k] * y[k];
+    y[r] = v / A[r][r];
+  }
+  return true;
+}
+
+static void bernstein_row(double u, int d, double *row) {
+  /* B_k^d(u) for k = 0..d */
+  double v = 1.0 - u;
+  row[0] = 1.0;
+  for (int j = 1; j <= d; j++) {
+    double saved = 0.0;
+    for (int k = 0; k < j; k++) {
+      double tmp = row[k];
+      row[k] = saved + v * tmp;
+      saved = u * tmp;
+    }
+    row[j] = saved;
+  }
+}
+
+/* Cumulative integral of f sampled at the Chebyshev-Lobatto points
+ * x_k = -cos(k pi / n) of [-1, 1] (k = 0..n): F_k = integral from -1 to x_k
+ * of the degree-n interpolant (spectral integration; exact for
+ * polynomials of degree n). */
+static void cheb_cumulative(const double *f, int n, double *F) {
+  const double *cs = COS14; /* n == NPTS - 1 */
+  double a[NPTS + 1], bcoef[NPTS + 2];
+  for (int j = 0; j <= n; j++) {
+    double sum = 0.0;
+    for (int k = 0; k <= n; k++) {
+      double w = (k == 0 || k == n) ? 0.5 : 1.0;
+      double Tj = ((j & 1) ? -1.0 : 1.0) * cs[(j * k) % (2 * n)];
+      sum += w * f[k] * Tj;
+    }
+    a[j] = 2.0 * sum / n;
+  }
+  a[0] *= 0.5;
+  a[n] *= 0.5;
+  /* integrate the Chebyshev series term by term */
+  for (int j = 0; j <= n + 1; j++) bcoef[j] = 0.0;
+  bcoef[1] += a[0];
+  if (n >= 1) bcoef[2] += a[1] / 4.0;
+  for (int j = 2; j <= n; j++) {
+    bcoef[j + 1] += a[j] / (2.0 * (j + 1));
+    bcoef[j - 1] -= a[j] / (2.0 * (j - 1));
+  }
+  double at_minus1 = 0.0;
+  for (int j = 0; j <= n + 1; j++) at_minus1 += (j & 1) ? -bcoef[j] : bcoef[j];
+  for (int k = 0; k <= n; k++) {
+    double v = 0.0;
+    for (int j = 0; j <= n + 1; j++) {
+      double Tj = ((j & 1) ? -1.0 : 1.0) * cs[(j * k) % (2 * n)];
+      v += bcoef[j] * Tj;
+    }
+    F[k] = v - at_minus1;
+  }
+}
+
+/* Interpolate theta on the piece [ua, ub] of the current span; bisect in t
+ * until the check points agree. *s_at is the arc length at ua on entry
+ * and at ub on exit; *theta is the unwrapped angle at ua on entry (whose
+ * direction is dir_a) and at ub on exit (direction dir_b). */
+static km_status fit_piece(builder *b, double ua, double ub, double known_len,
+                           double *s_at, double *theta, const double dir_a[2],
+                           const double dir_b[2], int depth) {
+  double t[NPTS], th[NPTS], s[NPTS], dir[NPTS][2];
+  double mid = 0.5 * (ua + ub), half = 0.5 * (ub - ua);
+  for (int k = 0; k < NPTS; k++)
+    t[k] = mid - half * COS14[k];
+  t[0] = ua;
+  t[NPTS - 1] = ub;
+  dir[0][0] = dir_a[0];
+  dir[0][1] = dir_a[1];
+  dir[NPTS - 1][0] = dir_b[0];
+  dir[NPTS - 1][1] = dir_b[1];
+  double speed[NPTS], F[NPTS];
+  for (int k = 0; k < NPTS; k++) {
+    double d[2][2];
+    km_curve_eval(b->c, t[k], 1, d);
+    double n = sqrt(d[1][0] * d[1][0] + d[1][1] * d[1][1]);
+    speed[k] = n;
+    if (k == 0 || k == NPTS - 1) continue;
+    if (n > 1e-12 * b->span_speed) {
+      dir[k][0] = d[1][0] / n;
+      dir[k][1] = d[1][1] / n;
+    } else if (!tangent_limit(b, t[k], 1, dir[k])) {
+      dir[k][0] = dir[k - 1][0];
+      dir[k][1] = dir[k - 1][1];
+    }
+  }
+  /* unwrap, watching for steps too large to interpolate */
+  bool coarse = false;
+  double big_step = 0.0;
+  th[0] = *theta;
+  for (int k = 1; k < NPTS; k++) {
+    double step = atan2(dir[k - 1][0] * dir[k][1] - dir[k - 1][1] * dir[k][0],
+                        dir[k - 1][0] * dir[k][0] + dir[k - 1][1] * dir[k][1]);
+    th[k] = th[k - 1] + step;
+    if (fabs(step) > 0.5 * KM_PI) coarse = true;
+    big_step = fmax(big_step, fabs(step));
+  }
+  /* arc length at every point: spectral integration of the speed at the
+   * nodes, checked against adaptive quadrature of the whole piece */
+  cheb_cumulative(speed, NPTS - 1, F);
+  for (int k = 0; k < NPTS; k++) s[k] = *s_at + half * F[k];
+  double h = s[NPTS - 1] - s[0];
+  double ref = known_len > 0 ? known_len
+                             : km__length_adaptive(b->c, ua, ub, 1e-15 * b->L);
+  if (fabs(h - ref) > 1e-14 * b->L + 1e-13 * ref) {
+    /* the speed is not resolved by the nodes (near-degenerate leg) */
+    for (int k = 1; k < NPTS; k++)
+      s[k] = s[k - 1] +
+             km__length_adaptive(b->c, t[k - 1], t[k], 1e-15 * b->L);
+  }
+  s[NPTS - 1] = s[0] + ref;
+  h = ref;
+  bool tiny_t = (ub - ua) < 1e-13 * b->span_t;
+  if (!(h > 1e-15 * b->L)) {
+    /* a piece of (numerically) zero length: whatever turn it hides acts
+     * as a corner at this point */
+    double turn = th[NPTS - 1] - th[0];
+    if (fabs(turn) > KM_PI - CUSP_MARGIN)
+      return km__fail(b->err, KM_ECUSP, KM_FIELD_CONTROL_POINTS, -1, mid,
+                      "the tangent reverses at parameter t = %g (a cusp): "
+                      "the curve is not regular there",
+                      mid);
+    if (fabs(turn) > CORNER_NOISE) {
+      km_status st = push_corner(b, *s_at, km__wrap_angle(turn));
+      if (st) return st;
+    }
+    *theta = th[NPTS - 1];
+    return KM_OK;
+  }
+  if (coarse && tiny_t && big_step > KM_PI - 1e-3)
+    return km__fail(b->err, KM_ECUSP, KM_FIELD_CONTROL_POINTS, -1, mid,
+                    "the tangent reverses at parameter t = %g (a cusp): the "
+                    "curve is not regular there",
+                    mid);
+  double coef[THETA_DEGREE + 1];
+  bool ok = !coarse;
+  if (ok) {
+    double A[THETA_DEGREE + 1][THETA_DEGREE + 1];
+    for (int j = 0; j <= THETA_DEGREE; j++) {
+      double u = (s[2 * j] - s[0]) / h;
+      bernstein_row(u, THETA_DEGREE, A[j]);
+      coef[j] = th[2 * j];
+    }
+    ok = solve(A, coef, THETA_DEGREE + 1);
+    /* pin the ends exactly so theta is continuous across pieces */
+    if (ok) {
+      coef[0] = th[0];
+      coef[THETA_DEGREE] = th[NPTS - 1];
+    }
+    for (int k = 1; ok && k < NPTS; k += 2) {
+      double u = (s[k] - s[0]) / h;
+      if (fabs(km__bern_eval(coef, THETA_DEGREE, u) - th[k]) > b->tol_theta)
+        ok = false;
+    }
+  }
+  if (!ok && (depth >= KM_MAX_REFINE_DEPTH || tiny_t)) {
+    /* cannot resolve further: acceptable only if theta barely moves */
+    double lo = th[0], hi = th[0];
+    for (int k = 1; k < NPTS; k++) {
+      lo = fmin(lo, th[k]);
+      hi = fmax(hi, th[k]);
+    }
+    if (hi - lo > 4 * b->tol_theta + 1e-12)
+      return km__fail(b->err, KM_ENOCONVERGE, KM_FIELD_CONTROL_POINTS, -1,
+                      mid,
+                      "curvature could not be resolved near parameter t = "
+                      "%g",
+                      mid);
+    for (int j = 0; j <= THETA_DEGREE; j++)
+      coef[j] = th[0] + (th[NPTS - 1] - th[0]) * j / THETA_DEGREE;
+    ok = true;
+  }
+  if (ok) {
+    km_status st = push_piece(b, s[0], s[NPTS - 1], coef);
+    if (st) return st;
+    *s_at = s[NPTS - 1];
+    *theta = th[NPTS - 1];
+    return KM_OK;
+  }
+  /* bisect in t */
+  double dm[2];
+  if (!tangent_limit(b, mid, 1, dm)) {
+    dm[0] = dir[NPTS / 2][0];
+    dm[1] = dir[NPTS / 2][1];
+  }
+  km_status st = fit_piece(b, ua, mid, 0.0, s_at, theta, dir_a, dm, depth + 1);
+  if (st) return st;
+  return fit_piece(b, mid, ub, 0.0, s_at, theta, dm, dir_b, depth + 1);
+}
+
+static km_status check_turn(builder *b, double turn, double t, double s) {
+  if (fabs(turn) > KM_PI - CUSP_MARGIN)
+    return km__fail(b->err, KM_ECUSP, KM_FIELD_KNOTS, -1, t,
+                    "the tangent reverses at parameter t = %g (arc length "
+                    "%g): a cusp, the curve is not regular there",
+                    t, s);
+  if (fabs(turn) > CORNER_NOISE) return push_corner(b, s, turn);
+  return KM_OK;
+}
+
+km_status km_signature_compute(const km_curve *c, double tol,
+                               km_signature *out, km_error *err) {
+  builder b;
+  memset(&b, 0, sizeof b);
+  b.c = c;
+  b.err = err;
+  km_status st = KM_OK;
+  km_pp kp;
+  km__pp_init(&kp);
+  double t0, t1;
+  double *span_len = malloc(c->n * sizeof(double));
+  if (!span_len)
+    return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  double poly = 0.0;
+  for (size_t i = 1; i < c->n; i++)
+    poly += hypot(c->cp[2 * i] - c->cp[2 * i - 2],
+                  c->cp[2 * i + 1] - c->cp[2 * i - 1]);
+  double L = 0.0;
+  for (size_t i = (size_t)c->degree; i < c->n; i++) {
+    span_len[i] = c->knots[i + 1] > c->knots[i]
+                      ? km__length_adaptive(c, c->knots[i], c->knots[i + 1],
+                                            1e-15 * poly)
+                      : 0.0;
+    L += span_len[i];
+  }
+  km_curve_domain(c, &t0, &t1);
+  double extent = 0.0;
+  for (size_t i = 0; i < 2 * c->n; i++) extent = fmax(extent, fabs(c->cp[i]));
+  if (!(L > 1e-13 * extent) || !(L > 1e-300)) {
+    st = km__fail(err, KM_EDEGENERATE, KM_FIELD_CONTROL_POINTS, -1, NAN,
+                  "the curve has zero length");
+    goto cleanup;
+  }
+  b.L = L;
+  if (!(tol > 0) || !isfinite(tol)) tol = 1e-5 * L;
+  if (tol < KM_MIN_RELATIVE_TOLERANCE * L) tol = KM_MIN_RELATIVE_TOLERANCE * L;
+  b.tol_theta = fmin(0.25 * tol / L, 1e-3);
+
+  double s_at = 0.0, theta = 0.0, start_angle = 0.0;
+  double prev_dir[2] = {0, 0}, first_dir[2] = {0, 0};
+  bool have_prev = false;
+  size_t p = (size_t)c->degree;
+  for (size_t i = p; i < c->n; i++) {
+    double ua = c->knots[i], ub = c->knots[i + 1];
+    if (!(ub > ua)) continue;
+    double len = span_len[i];
+    if (!(len > 1e-15 * L)) continue; /* a span that is a single point */
+    b.span_t = ub - ua;
+    b.span_speed = len / (ub - ua);
+    double da[2], db[2];
+    if (!tangent_limit(&b, ua, 1, da) || !tangent_limit(&b, ub, -1, db)) {
+      st = km__fail(err, KM_EDEGENERATE, KM_FIELD_CONTROL_POINTS, -1, ua,
+                    "no tangent direction near parameter t = %g", ua);
+      goto cleanup;
+    }
+    if (!have_prev) {
+      start_angle = atan2(da[1], da[0]);
+      theta = start_angle;
+      first_dir[0] = da[0];
+      first_dir[1] = da[1];
+      have_prev = true;
+    } else {
+      double turn = atan2(prev_dir[0] * da[1] - prev_dir[1] * da[0],
+                          prev_dir[0] * da[0] + prev_dir[1] * da[1]);
+      st = check_turn(&b, turn, ua, s_at);
+      if (st) goto cleanup;
+      theta += turn;
+    }
+    st = fit_piece(&b, ua, ub, len, &s_at, &theta, da, db, 0);
+    if (st) goto cleanup;
+    prev_dir[0] = db[0];
+    prev_dir[1] = db[1];
+  }
+  if (b.m == 0) {
+    st = km__fail(err, KM_EDEGENERATE, KM_FIELD_CONTROL_POINTS, -1, NAN,
+                  "the curve has zero length");
+    goto cleanup;
+  }
+  if (c->closed) {
+    double turn = atan2(prev_dir[0] * first_dir[1] - prev_dir[1] * first_dir[0],
+                        prev_dir[0] * first_dir[0] + prev_dir[1] * first_dir[1]);
+    st = check_turn(&b, turn, t1, s_at);
+    if (st) goto cleanup;
+  }
+  /* the pieces' arc lengths sum to the total up to rounding: snap */
+  double scale = L / b.s[b.m];
+  for (size_t i = 0; i <= b.m; i++) b.s[i] *= scale;
+  for (size_t i = 0; i < b.ncorners; i++) {
+    b.corners[i].s *= scale;
+    if (b.corners[i].s > L) b.corners[i].s = L;
+  }
+  b.s[b.m] = L;
+  /* kappa = d theta / ds on every piece */
+  st = km__pp_alloc(&kp, THETA_DEGREE - 1, b.m);
+  if (st) {
+    st = km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
+    goto cleanup;
+  }
+  for (size_t i = 0; i < b.m; i++) {
+    kp.x[i] = b.s[i];
+    km__bern_derivative(b.th + i * (THETA_DEGREE + 1), THETA_DEGREE,
+                        b.s[i + 1] - b.s[i], kp.c + i * THETA_DEGREE);
+  }
+  kp.x[b.m] = L;
+  km_signature r;
+  km_signature_init(&r);
+  st = km__pp_to_fn(&r.kappa, &kp);
+  if (st) {
+    st = km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
+    goto cleanup;
+  }
+  double d0[1][2];
+  km_curve_eval(c, t0, 0, d0);
+  r.length = L;
+  r.start[0] = d0[0][0];
+  r.start[1] = d0[0][1];
+  r.angle = start_angle;
+  r.closed = c->closed;
+  r.corners = b.corners;
+  r.ncorners = b.ncorners;
+  b.corners = NULL;
+  double turning = km_fn_integral(&r.kappa);
+  for (size_t i = 0; i < r.ncorners; i++) turning += r.corners[i].turn;
+  r.turning = turning;
+  *out = r;
+cleanup:
+  km__pp_free(&kp);
+  free(span_len);
+  free(b.s);
+  free(b.th);
+  free(b.corners);
+  return st;
+}
