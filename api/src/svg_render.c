@@ -247,8 +247,9 @@ static void filmstrip(ctx *c, const api_svg_options *o) {
   if (o->width > 0) cw = o->width / (double)cols;
   if (o->height > 0) ch = o->height / (double)rows;
   else if (o->width > 0) ch = cw * aspect + label;
-  c->W = o->width > 0 ? o->width : cw * (double)cols;
-  c->H = o->height > 0 ? o->height : ch * (double)rows;
+  /* Automatic sizes are whole pixels: renderers round them up anyway. */
+  c->W = o->width > 0 ? o->width : ceil(cw * (double)cols);
+  c->H = o->height > 0 ? o->height : ceil(ch * (double)rows);
   char title[80];
   snprintf(title, sizeof title, "kmorph filmstrip of %zu frames", c->n);
   doc_open(c, title);
@@ -323,8 +324,9 @@ static void overlay(ctx *c, const api_svg_options *o) {
   double aspect = (bb.y1 - bb.y0) / (bb.x1 - bb.x0);
   const double legend = 24.0;
   double w = o->width > 0 ? o->width : 480.0;
-  double h = o->height > 0 ? o->height : w * fmin(fmax(aspect, 0.25), 4) +
-                                             legend;
+  double h = o->height > 0
+                 ? o->height
+                 : ceil(w * fmin(fmax(aspect, 0.25), 4) + legend);
   c->W = w;
   c->H = h;
   char title[80];
@@ -363,8 +365,9 @@ static void animate(ctx *c, const api_svg_options *o) {
   double aspect = (bb.y1 - bb.y0) / (bb.x1 - bb.x0);
   const double label = 20.0;
   double w = o->width > 0 ? o->width : 400.0;
-  double h = o->height > 0 ? o->height : w * fmin(fmax(aspect, 0.25), 4) +
-                                             label;
+  double h = o->height > 0
+                 ? o->height
+                 : ceil(w * fmin(fmax(aspect, 0.25), 4) + label);
   c->W = w;
   c->H = h;
   char title[80];
