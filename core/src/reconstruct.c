@@ -1,0 +1,447 @@
+/* reconstruct.c - curves from curvature signatures.
+ *
+ * DESIGN. theta(s) = angle + integral of kappa + corner turns is exact: on
+ * every piece of kappa it is a polynomial (the Bernstein antiderivative).
+ * Positions C(s) = start + integral of (cos theta, sin theta) are integrated
+ * by 16-point Gauss-Legendre on chunks over which theta moves at most half
+ * a radian, which puts the quadrature error at rounding level.
+ *
+ * The output is a piecewise Hermite B-spline in the arc-length parameter:
+ * cubic pieces match position and unit tangent at both ends (C1), quintic
+ * pieces also curvature (C2). Because the exact curve has unit speed,
+ * |C^(m)| <= B_{m-1}(|kappa|, |kappa'|, ...) (complete Bell polynomial),
+ * and the Hermite remainder has a one-signed Peano kernel, so on a piece of
+ * length h
+ *     cubic:   |C - H| <= h^4 / 384   * B_3(k0, k1, k2)
+ *     quintic: |C - H| <= h^6 / 46080 * B_5(k0, k1, k2, k3, k4)
+ * with k_j bounds on |kappa^(j)| over the piece (Bernstein coefficients of
+ * the restricted polynomial). Pieces are split until the bound meets the
+ * tolerance; the reported error is this bound plus rounding, so it is
+ * never below the true error.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+#include "km/limits.h"
+#include "km/reconstruct.h"
+
+#define MAXD (KM_MAX_DEGREE + 12)
+
+/* theta as pieces: breaks include kappa's and the corners' positions;
+ * kappa pieces kept beside for the bounds. */
+typedef struct theta_pieces {
+  km_pp kappa; /* degree dk */
+  km_pp theta; /* degree dk + 1, same breaks */
+} theta_pieces;
+
+static void theta_pieces_free(theta_pieces *tp) {
+  km__pp_free(&tp->kappa);
+  km__pp_free(&tp->theta);
+}
+
+static int cmp_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+static km_status build_theta(const km_signature *sig, theta_pieces *tp) {
+  km_pp k0;
+  km__pp_init(&k0);
+  km__pp_init(&tp->kappa);
+  km__pp_init(&tp->theta);
+  km_status st = km__pp_from_fn(&k0, &sig->kappa);
+  if (st) return st;
+  double L = sig->length;
+  size_t nb = k0.m + 1 + sig->ncorners;
+  double *br = malloc(nb * sizeof(double));
+  if (!br) {
+    km__pp_free(&k0);
+    return KM_ENOMEM;
+  }
+  size_t n = 0;
+  for (size_t i = 0; i <= k0.m; i++) br[n++] = k0.x[i];
+  for (size_t i = 0; i < sig->ncorners; i++) br[n++] = sig->corners[i].s;
+  qsort(br, n, sizeof(double), cmp_double);
+  size_t m = 0;
+  for (size_t i = 0; i < n; i++) {
+    double v = br[i] < 0 ? 0 : (br[i] > L ? L : br[i]);
+    if (m == 0 || v > br[m - 1]) br[m++] = v;
+  }
+  br[0] = 0.0;
+  if (br[m - 1] < L) br[m++] = L;
+  int dk = k0.degree;
+  st = km__pp_alloc(&tp->kappa, dk, m - 1);
+  if (!st) st = km__pp_alloc(&tp->theta, dk + 1, m - 1);
+  if (st) goto done;
+  double th = sig->angle;
+  size_t ci = 0;
+  for (size_t i = 0; i + 1 < m; i++) {
+    double a = br[i], b = br[i + 1], h = b - a;
+    while (ci < sig->ncorners && sig->corners[ci].s <= a) th += sig->corners[ci++].turn;
+    size_t j = km__pp_find(&k0, 0.5 * (a + b));
+    double ja = k0.x[j], jh = k0.x[j + 1] - ja;
+    double *kc = tp->kappa.c + i * (size_t)(dk + 1);
+    km__bern_restrict(k0.c + j * (size_t)(dk + 1), dk, (a - ja) / jh,
+                      (b - ja) / jh, kc);
+    double *tc = tp->theta.c + i * (size_t)(dk + 2);
+    tc[0] = th;
+    for (int k = 0; k <= dk; k++) tc[k + 1] = tc[k] + h * kc[k] / (dk + 1);
+    th = tc[dk + 1];
+    tp->kappa.x[i] = tp->theta.x[i] = a;
+  }
+  tp->kappa.x[m - 1] = tp->theta.x[m - 1] = L;
+done:
+  free(br);
+  km__pp_free(&k0);
+  if (st) theta_pieces_free(tp);
+  return st;
+}
+
+/* Integral of (cos theta, sin theta) over [u0, u1] (piece variable in
+ * [0,1]) of theta piece i of length h. */
+static void integrate_piece(const double *tc, int d, double h, double u0,
+                            double u1, double kbound, double out[2]) {
+  double len = (u1 - u0) * h;
+  /* chunks over which theta moves at most 0.5 rad */
+  int chunks = (int)ceil(kbound * len / 0.5);
+  if (chunks < 1) chunks = 1;
+  if (chunks > 1000000) chunks = 1000000;
+  double sx = 0.0, sy = 0.0, du = (u1 - u0) / chunks;
+  for (int c = 0; c < chunks; c++) {
+    double a = u0 + c * du, m = a + 0.5 * du, hw = 0.5 * du;
+    double cx = 0.0, cy = 0.0;
+    for (int k = 0; k < 16; k++) {
+      double th = km__bern_eval(tc, d, m + hw * km__gl16_x[k]);
+      cx += km__gl16_w[k] * cos(th);
+      cy += km__gl16_w[k] * sin(th);
+    }
+    sx += cx * hw;
+    sy += cy * hw;
+  }
+  out[0] = sx * h;
+  out[1] = sy * h;
+}
+
+/* Bounds on |kappa^(j)| for j = 0..nd-1 over [u0,u1] of kappa piece kc. */
+static void kappa_bounds(const double *kc, int dk, double h, double u0,
+                         double u1, int nd, double *bnd) {
+  double c[MAXD], dc[MAXD];
+  km__bern_restrict(kc, dk, u0, u1, c);
+  int d = dk;
+  double hh = (u1 - u0) * h;
+  for (int j = 0; j < nd; j++) {
+    bnd[j] = d >= 0 ? km__bern_abs_bound(c, d) : 0.0;
+    if (d <= 0) {
+      for (int q = j + 1; q < nd; q++) bnd[q] = 0.0;
+      break;
+    }
+    km__bern_derivative(c, d, hh, dc);
+    d--;
+    memcpy(c, dc, (size_t)(d + 1) * sizeof(double));
+  }
+}
+
+static double hermite_bound(int degree, const double *k, double h) {
+  if (degree == 3) {
+    double m4 = k[0] * k[0] * k[0] + 3 * k[0] * k[1] + k[2];
+    return m4 * pow(h, 4) / 384.0;
+  }
+  double x1 = k[0], x2 = k[1], x3 = k[2], x4 = k[3], x5 = k[4];
+  double m6 = pow(x1, 5) + 10 * x1 * x1 * x1 * x2 + 15 * x1 * x2 * x2 +
+              10 * x1 * x1 * x3 + 10 * x2 * x3 + 5 * x1 * x4 + x5;
+  return m6 * pow(h, 6) / 46080.0;
+}
+
+typedef struct out_piece {
+  size_t piece;  /* theta piece */
+  double u0, u1; /* sub-interval of it */
+  double bound;
+} out_piece;
+
+typedef struct plan {
+  out_piece *p;
+  size_t n, cap;
+} plan;
+
+static km_status plan_push(plan *pl, out_piece op) {
+  if (pl->n == pl->cap) {
+    size_t cap = pl->cap ? 2 * pl->cap : 64;
+    if (cap > KM_MAX_PIECES) return KM_ELIMIT;
+    out_piece *q = realloc(pl->p, cap * sizeof *q);
+    if (!q) return KM_ENOMEM;
+    pl->p = q;
+    pl->cap = cap;
+  }
+  pl->p[pl->n++] = op;
+  return KM_OK;
+}
+
+static km_status plan_range(plan *pl, const theta_pieces *tp, size_t i,
+                            double u0, double u1, int degree, double tol,
+                            int depth) {
+  int dk = tp->kappa.degree;
+  double h = tp->kappa.x[i + 1] - tp->kappa.x[i];
+  const double *kc = tp->kappa.c + i * (size_t)(dk + 1);
+  double kb[5];
+  int nd = degree == 3 ? 3 : 5;
+  kappa_bounds(kc, dk, h, u0, u1, nd, kb);
+  double e = hermite_bound(degree, kb, (u1 - u0) * h);
+  if (e <= tol || depth > 60) {
+    out_piece op = {i, u0, u1, e};
+    return plan_push(pl, op);
+  }
+  /* split into as many equal parts as the bound's order suggests */
+  int order = degree == 3 ? 4 : 6;
+  double parts = ceil(pow(e / tol, 1.0 / order) * 1.05);
+  if (parts < 2) parts = 2;
+  if (parts > 1e6) parts = 1e6;
+  int np = (int)parts;
+  for (int k = 0; k < np; k++) {
+    double a = u0 + (u1 - u0) * k / np, b = u0 + (u1 - u0) * (k + 1) / np;
+    if (k == np - 1) b = u1;
+    km_status st = plan_range(pl, tp, i, a, b, degree, tol, depth + 1);
+    if (st) return st;
+  }
+  return KM_OK;
+}
+
+km_status km_reconstruct(const km_signature *sig, int degree, double tol,
+                         km_curve *out, double *error_bound, km_error *err) {
+  if (degree != 3 && degree != 5)
+    return km__fail(err, KM_EDEGREE, KM_FIELD_DEGREE, -1, NAN,
+                    "reconstruction degree must be 3 or 5, not %d", degree);
+  double L = sig->length;
+  if (!(tol > 0) || !isfinite(tol)) tol = 1e-5 * L;
+  if (tol < KM_MIN_RELATIVE_TOLERANCE * L) tol = KM_MIN_RELATIVE_TOLERANCE * L;
+  theta_pieces tp;
+  plan pl = {NULL, 0, 0};
+  double *pos = NULL;
+  km_curve c;
+  km_curve_init(&c);
+  km_status st = build_theta(sig, &tp);
+  if (st) return km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
+  int dk = tp.kappa.degree, dt = dk + 1;
+  for (size_t i = 0; i < tp.theta.m; i++) {
+    st = plan_range(&pl, &tp, i, 0.0, 1.0, degree, 0.9 * tol, 0);
+    if (st) {
+      st = km__fail(err, st, KM_FIELD_TOLERANCE, -1, NAN,
+                    st == KM_ELIMIT ? "the tolerance needs more than %d "
+                                      "pieces: loosen it"
+                                    : "out of memory",
+                    KM_MAX_PIECES);
+      goto cleanup;
+    }
+  }
+  size_t np = pl.n;
+  /* positions and tangent data at every piece boundary */
+  pos = malloc((np + 1) * 2 * sizeof(double));
+  if (!pos) {
+    st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+    goto cleanup;
+  }
+  pos[0] = sig->start[0];
+  pos[1] = sig->start[1];
+  double max_bound = 0.0;
+  for (size_t j = 0; j < np; j++) {
+    const out_piece *op = &pl.p[j];
+    size_t i = op->piece;
+    double h = tp.theta.x[i + 1] - tp.theta.x[i];
+    double kb[1];
+    kappa_bounds(tp.kappa.c + i * (size_t)(dk + 1), dk, h, op->u0, op->u1, 1,
+                 kb);
+    double d[2];
+    integrate_piece(tp.theta.c + i * (size_t)(dt + 1), dt, h, op->u0, op->u1,
+                    kb[0], d);
+    pos[2 * j + 2] = pos[2 * j] + d[0];
+    pos[2 * j + 3] = pos[2 * j + 1] + d[1];
+    max_bound = fmax(max_bound, op->bound);
+  }
+  /* junction continuity: 0 = corner (C0), 1 = kappa jump (C1), 2 = C2 */
+  int p = degree;
+  size_t ncp = 1, nknots = 2 * (size_t)(p + 1);
+  int *cont = malloc((np + 1) * sizeof(int));
+  if (!cont) {
+    st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+    goto cleanup;
+  }
+  double kscale = km__pp_max_abs(&tp.kappa) + 1.0 / L;
+  for (size_t j = 1; j < np; j++) {
+    const out_piece *a = &pl.p[j - 1], *b = &pl.p[j];
+    double tha = km__bern_eval(tp.theta.c + a->piece * (size_t)(dt + 1), dt, a->u1);
+    double thb = km__bern_eval(tp.theta.c + b->piece * (size_t)(dt + 1), dt, b->u0);
+    double ka = km__bern_eval(tp.kappa.c + a->piece * (size_t)(dk + 1), dk, a->u1);
+    double kb = km__bern_eval(tp.kappa.c + b->piece * (size_t)(dk + 1), dk, b->u0);
+    if (fabs(thb - tha) > 1e-13)
+      cont[j] = 0;
+    else if (fabs(kb - ka) > 1e-12 * kscale)
+      cont[j] = 1;
+    else
+      cont[j] = 2;
+    if (p == 3 && cont[j] == 2) cont[j] = 1; /* cubic Hermite is C1 */
+    int mult = p - cont[j];
+    nknots += (size_t)mult;
+  }
+  ncp = nknots - (size_t)p - 1;
+  st = km__curve_alloc(&c, p, ncp, false);
+  if (st) {
+    free(cont);
+    st = km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
+    goto cleanup;
+  }
+  /* Bezier points of every piece, then the B-spline points per junction */
+  size_t kk = 0, cc = 0;
+  double s_at[2] = {0, 0};
+  for (int r = 0; r <= p; r++) c.knots[kk++] = 0.0;
+  double prevQ[6][2] = {{0}};
+  double prev_h = 0.0;
+  for (size_t j = 0; j < np; j++) {
+    const out_piece *op = &pl.p[j];
+    size_t i = op->piece;
+    double ph = tp.theta.x[i + 1] - tp.theta.x[i];
+    const double *tc = tp.theta.c + i * (size_t)(dt + 1);
+    const double *kc = tp.kappa.c + i * (size_t)(dk + 1);
+    double h = (op->u1 - op->u0) * ph;
+    double t0 = km__bern_eval(tc, dt, op->u0), t1 = km__bern_eval(tc, dt, op->u1);
+    double T0[2] = {cos(t0), sin(t0)}, T1[2] = {cos(t1), sin(t1)};
+    double P0[2] = {pos[2 * j], pos[2 * j + 1]};
+    double P1[2] = {pos[2 * j + 2], pos[2 * j + 3]};
+    double Q[6][2];
+    if (p == 3) {
+      for (int a = 0; a < 2; a++) {
+        Q[0][a] = P0[a];
+        Q[1][a] = P0[a] + h / 3.0 * T0[a];
+        Q[2][a] = P1[a] - h / 3.0 * T1[a];
+        Q[3][a] = P1[a];
+      }
+    } else {
+      double k0 = km__bern_eval(kc, dk, op->u0), k1 = km__bern_eval(kc, dk, op->u1);
+      double N0[2] = {-T0[1], T0[0]}, N1[2] = {-T1[1], T1[0]};
+      for (int a = 0; a < 2; a++) {
+        Q[0][a] = P0[a];
+        Q[1][a] = P0[a] + h / 5.0 * T0[a];
+        Q[2][a] = 2 * Q[1][a] - Q[0][a] + h * h / 20.0 * k0 * N0[a];
+        Q[5][a] = P1[a];
+        Q[4][a] = P1[a] - h / 5.0 * T1[a];
+        Q[3][a] = 2 * Q[4][a] - Q[5][a] + h * h / 20.0 * k1 * N1[a];
+      }
+    }
+    int cin = j == 0 ? -1 : cont[j];
+    if (j == 0) {
+      c.cp[2 * cc] = Q[0][0];
+      c.cp[2 * cc + 1] = Q[0][1];
+      cc++;
+    } else {
+      /* close the previous piece according to the junction type */
+      int last = p - 1; /* previous piece emitted Q1..Q(last-1) so far */
+      (void)last;
+      if (cin == 0) {
+        /* C0: previous Q(p-1), shared point */
+        c.cp[2 * cc] = prevQ[p - 1][0];
+        c.cp[2 * cc + 1] = prevQ[p - 1][1];
+        cc++;
+        c.cp[2 * cc] = Q[0][0];
+        c.cp[2 * cc + 1] = Q[0][1];
+        cc++;
+      } else if (cin == 1) {
+        /* C1: the shared point is implied */
+        c.cp[2 * cc] = prevQ[p - 1][0];
+        c.cp[2 * cc + 1] = prevQ[p - 1][1];
+        cc++;
+      } else {
+        /* C2 quintic: Q4 of the left piece, the junction and Q1 of the
+         * right piece collapse into one point (blossom f(a,u,u,u,b)) */
+        for (int a = 0; a < 2; a++)
+          c.cp[2 * cc + (size_t)a] =
+              prevQ[4][a] + (h / prev_h) * (prevQ[4][a] - prevQ[3][a]);
+        cc++;
+      }
+      int mult = p - cin;
+      for (int r = 0; r < mult; r++) c.knots[kk++] = s_at[0];
+    }
+    /* interior points of this piece, except those a C2 junction owns */
+    int first = (j > 0 && cin == 2) ? 2 : 1;
+    int lastq = p - 1; /* Q(p-1) is emitted at the next junction or end */
+    for (int q = first; q < lastq; q++) {
+      c.cp[2 * cc] = Q[q][0];
+      c.cp[2 * cc + 1] = Q[q][1];
+      cc++;
+    }
+    memcpy(prevQ, Q, sizeof Q);
+    prev_h = h;
+    s_at[0] += h;
+    (void)s_at[1];
+  }
+  /* finish: for a following C2 junction the left piece's Q3 was needed;
+   * handle by emitting Q(p-1) and Qp at the end */
+  c.cp[2 * cc] = prevQ[p - 1][0];
+  c.cp[2 * cc + 1] = prevQ[p - 1][1];
+  cc++;
+  c.cp[2 * cc] = prevQ[p][0];
+  c.cp[2 * cc + 1] = prevQ[p][1];
+  cc++;
+  for (int r = 0; r <= p; r++) c.knots[kk++] = L;
+  free(cont);
+  if (cc != ncp || kk != nknots) {
+    st = km__fail(err, KM_EINVAL, KM_FIELD_NONE, -1, NAN,
+                  "internal inconsistency building the B-spline");
+    goto cleanup;
+  }
+  /* knots are the exact curve's arc length at the piece ends; the pieces
+   * were measured in the theta pieces' own coordinates, so snap the last */
+  double bound = max_bound + 8e-16 * (double)(np + 1) *
+                                 (L + fabs(sig->start[0]) + fabs(sig->start[1]));
+  c.closed = false;
+  if (sig->closed) {
+    double gx = c.cp[2 * (ncp - 1)] - c.cp[0], gy = c.cp[2 * (ncp - 1) + 1] - c.cp[1];
+    double gap = hypot(gx, gy);
+    if (gap <= tol) {
+      c.cp[2 * (ncp - 1)] = c.cp[0];
+      c.cp[2 * (ncp - 1) + 1] = c.cp[1];
+      c.closed = true;
+      bound += gap;
+    }
+  }
+  *out = c;
+  km_curve_init(&c);
+  if (error_bound) *error_bound = bound;
+cleanup:
+  km_curve_free(&c);
+  free(pos);
+  free(pl.p);
+  theta_pieces_free(&tp);
+  return st;
+}
+
+km_status km_signature_point(const km_signature *sig, double s, double pos[2],
+                             double *theta) {
+  theta_pieces tp;
+  km_status st = build_theta(sig, &tp);
+  if (st) return st;
+  if (s < 0) s = 0;
+  if (s > sig->length) s = sig->length;
+  int dk = tp.kappa.degree, dt = dk + 1;
+  double x = sig->start[0], y = sig->start[1], th = sig->angle;
+  for (size_t i = 0; i < tp.theta.m; i++) {
+    double a = tp.theta.x[i], b = tp.theta.x[i + 1], h = b - a;
+    if (a >= s && i > 0) break;
+    double u1 = s >= b ? 1.0 : (s - a) / h;
+    double kb[1], d[2];
+    kappa_bounds(tp.kappa.c + i * (size_t)(dk + 1), dk, h, 0.0, u1, 1, kb);
+    const double *tc = tp.theta.c + i * (size_t)(dt + 1);
+    integrate_piece(tc, dt, h, 0.0, u1, kb[0], d);
+    x += d[0];
+    y += d[1];
+    th = km__bern_eval(tc, dt, u1);
+    if (s < b) break;
+  }
+  /* corners exactly at s count from the right */
+  for (size_t i = 0; i < sig->ncorners; i++)
+    if (sig->corners[i].s == s && s > 0 && s < sig->length) th += 0.0;
+  pos[0] = x;
+  pos[1] = y;
+  if (theta) *theta = th;
+  theta_pieces_free(&tp);
+  return KM_OK;
+}
