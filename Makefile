@@ -52,7 +52,7 @@ APIT_BIN  := $(APIT_SRC:%.c=$(BUILD)/%)
 SUPPORT_SRC := $(wildcard tests/support/*.c)
 
 .PHONY: all deps build run test test-unit test-asan test-server check-layers \
-        bench bench-http fuzz clean format examples
+        bench bench-http fuzz fuzz-svg clean format examples
 
 all: build
 
@@ -157,6 +157,20 @@ build/bench/%: bench/%.c $(LIBCORE)
 
 format:
 	clang-format -i core/src/*.c core/include/km/*.h api/src/*.c api/include/kmapi/*.h cli/*.c $(wildcard server/src/*.[ch])
+
+# libFuzzer on the SVG path parser and writer for FUZZ_SECONDS (default 60);
+# new inputs go to build/fuzz/svg_path-corpus, seeds stay in tests/fuzz.
+FUZZ_SECONDS ?= 60
+fuzz-svg: deps
+	@mkdir -p build/fuzz/svg_path-corpus
+	clang $(CSTD) -g -O1 -D_POSIX_C_SOURCE=200809L \
+	  -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
+	  -Iapi/src $(CORE_INC) tests/fuzz/svg_path/fuzz_svg_path.c \
+	  api/src/svg_parse.c api/src/svg_write.c $(CORE_SRC) -lm \
+	  -o build/fuzz/fuzz_svg_path
+	build/fuzz/fuzz_svg_path -max_total_time=$(FUZZ_SECONDS) -timeout=10 \
+	  -dict=tests/fuzz/svg_path/svg_path.dict \
+	  build/fuzz/svg_path-corpus tests/fuzz/svg_path/corpus
 
 clean:
 	rm -rf build
