@@ -18,7 +18,17 @@
  * closed; zero-length pieces are dropped. tol (> 0) is the distance
  * tolerance used where a repair needs one. On failure returns a status,
  * *err_offset = character offset of the problem and msg (NUL-terminated,
- * at most msgcap bytes) says what was expected. */
+ * at most msgcap bytes) says what was expected.
+ * Details: only `len` bytes are read (NUL bytes inside are errors). Pieces
+ * within min(tol, 1e-9 x extent) of a point are dropped (rounding slivers,
+ * e.g. a Z after relative moves that miss the start by 1e-16); tol <= 0
+ * means 1e-9 x extent alone. A moveto after drawing is an error unless
+ * nothing follows it. Statuses: KM_EINVAL (grammar), KM_ERANGE (a number
+ * beyond double range or |coordinate| > KM_MAX_COORDINATE),
+ * KM_EDEGENERATE (draws nothing), KM_ELIMIT, KM_ENOMEM. The offset is a
+ * byte offset, which equals the character offset: the grammar is ASCII
+ * and the first non-ASCII byte is itself the error. Numbers are read with
+ * strtod: the C locale is assumed (kmorph never calls setlocale). */
 km_status api_svg_parse_path(const char *d, size_t len, double tol,
                              km_curve *out, size_t *err_offset, char *msg,
                              size_t msgcap);
@@ -26,7 +36,16 @@ km_status api_svg_parse_path(const char *d, size_t len, double tol,
 /* The curve as an SVG path of cubic Beziers ("M x y C ..." and "Z" if
  * closed), within tol of the curve (degree > 3 and rational curves are
  * approximated; *err_bound, if not NULL, receives the bound). NULL on
- * out-of-memory. */
+ * out-of-memory.
+ * Polynomial curves of degree <= 3 are exact up to the printing of numbers
+ * (each within tol/4). Others become cubic Hermite pieces, halved until a
+ * rigorous bound (Bernstein coefficients of the error numerator over the
+ * smallest weight) is within tol/2; the bound holds at equal parameter, so
+ * it also bounds the distance between the traces. *err_bound adds the
+ * printing error actually committed; it exceeds tol only when tol is below
+ * rounding (~1e-15 of the coordinates) or the output reached its piece cap
+ * (2,000,000). tol <= 0: numbers round-trip exactly and approximations aim
+ * at 1e-9 of the largest coordinate. */
 char *api_svg_path_d(const km_curve *c, double tol, double *err_bound);
 
 /* Same, with a fixed number of cubic pieces (n_pieces >= 1), so that paths
