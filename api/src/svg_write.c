@@ -112,10 +112,19 @@ static void trim_fixed(char *s) {
   if (strcmp(s, "-0") == 0) memmove(s, s + 1, 2);
 }
 
-/* "1e-05" -> "1e-5", "1e+20" -> "1e20": same number, fewer bytes. */
+/* "2.50e-05" -> "2.5e-5", "1e+20" -> "1e20": same number, fewer bytes. */
 static void trim_exp(char *s) {
   char *e = strchr(s, 'e');
   if (!e) return;
+  /* "2.500e+01" -> "2.5e+01" first */
+  char *dot = strchr(s, '.');
+  if (dot && dot < e) {
+    char *z = e;
+    while (z > dot + 1 && z[-1] == '0') z--;
+    if (z == dot + 1) z = dot;
+    memmove(z, e, strlen(e) + 1);
+    e = z;
+  }
   char *src = e + 1, *dst = e + 1;
   if (*src == '+') src++;
   else if (*src == '-') *dst++ = *src++;
@@ -132,9 +141,22 @@ void api__svg_buf_num(api_svg_buf *b, double x, double budget, double *err) {
     if (err && fabs(x) > *err) *err = fabs(x);
     return;
   }
-  /* Shortest scientific form within budget (17 digits always round-trip). */
+  /* Shortest scientific form within budget (17 digits always round-trip).
+   * The search starts one digit below the estimate from the magnitudes,
+   * so it takes a try or two rather than seventeen. */
+  int p0 = 1, d0 = 0;
+  if (budget > 0) {
+    double est = ceil(log10(fabs(x) / budget));
+    p0 = est > 17 ? 17 : est < 2 ? 1 : (int)est - 1;
+    double dd = ceil(log10(0.5 / budget));
+    d0 = dd > 24 ? 24 : dd < 1 ? 0 : (int)dd - 1;
+  } else {
+    p0 = 15;
+    double mag = floor(log10(fabs(x)));
+    d0 = mag >= 15 ? 0 : mag < -9 ? 24 : (int)(15 - mag) - 1;
+  }
   double gote = x;
-  for (int prec = 1; prec <= 17; prec++) {
+  for (int prec = p0; prec <= 17; prec++) {
     snprintf(ex, sizeof ex, "%.*e", prec - 1, x);
     gote = strtod(ex, NULL);
     if (fabs(gote - x) <= budget) break;
@@ -145,7 +167,7 @@ void api__svg_buf_num(api_svg_buf *b, double x, double budget, double *err) {
   double gotf = x;
   bool have_fixed = false;
   if (fabs(x) < 1e16) {
-    for (int dec = 0; dec <= 24; dec++) {
+    for (int dec = d0; dec <= 24; dec++) {
       snprintf(fx, sizeof fx, "%.*f", dec, x);
       gotf = strtod(fx, NULL);
       if (fabs(gotf - x) <= budget || gotf == x) {
@@ -422,31 +444,125 @@ char *api_svg_path_d(const km_curve *c, double tol, double *err_bound) {
   return out;
 }
 
+/* ---- arc length for the fixed-count paths ------------------------------
+ * The core's length functions walk the whole curve per call; animation
+ * needs n inversions on curves of 10^5 spans, so the spans' lengths are
+ * integrated once here and inverted within one span. */
+
+static const double GL_X[8] = {0.96028985649753623, 0.79666647741362674,
+                               0.52553240991632899, 0.18343464249564980,
+                               -0.18343464249564980, -0.52553240991632899,
+                               -0.79666647741362674, -0.96028985649753623};
+static const double GL_W[8] = {0.10122853629037626, 0.22238103445337447,
+                               0.31370664587788729, 0.36268378337836198,
+                               0.36268378337836198, 0.31370664587788729,
+                               0.22238103445337447, 0.10122853629037626};
+
+static double speed(const km_curve *c, double t) {
+  double d[2][2];
+  km_curve_eval(c, t, 1, d);
+  return hypot(d[1][0], d[1][1]);
+}
+
+static double gl8(const km_curve *c, double a, double b) {
+  double m = 0.5 * (a + b), h = 0.5 * (b - a), s = 0.0;
+  for (int k = 0; k < 8; k++) s += GL_W[k] * speed(c, m + h * GL_X[k]);
+  return s * h;
+}
+
+static double seg_len(const km_curve *c, double a, double b, double whole,
+                      double tol, int depth) {
+  double m = 0.5 * (a + b);
+  double l = gl8(c, a, m), r = gl8(c, m, b);
+  if (depth >= 12 || fabs(l + r - whole) <= tol) return l + r;
+  return seg_len(c, a, m, l, 0.5 * tol, depth + 1) +
+         seg_len(c, m, b, r, 0.5 * tol, depth + 1);
+}
+
+static double len_between(const km_curve *c, double a, double b, double tol) {
+  if (!(b > a)) return 0.0;
+  return seg_len(c, a, b, gl8(c, a, b), tol, 0);
+}
+
+/* Parameters t[0..n] at arc lengths j L / n. Returns false on OOM. */
+static bool uniform_params(const km_curve *c, size_t n, double *t) {
+  double t0, t1;
+  km_curve_domain(c, &t0, &t1);
+  size_t ns = 0;
+  for (size_t i = (size_t)c->degree; i < c->n; i++)
+    if (c->knots[i + 1] > c->knots[i]) ns++;
+  double *cum = malloc((ns + 1) * sizeof *cum);
+  double *ka = malloc((ns + 1) * sizeof *ka);
+  if (!cum || !ka) {
+    free(cum);
+    free(ka);
+    return false;
+  }
+  double ext = extent(c);
+  double tol = 1e-13 * (ext > 0 ? ext : 1.0);
+  size_t k = 0;
+  cum[0] = 0.0;
+  for (size_t i = (size_t)c->degree; i < c->n; i++) {
+    if (!(c->knots[i + 1] > c->knots[i])) continue;
+    ka[k] = c->knots[i];
+    cum[k + 1] = cum[k] + len_between(c, c->knots[i], c->knots[i + 1], tol);
+    k++;
+  }
+  ka[ns] = t1;
+  double L = cum[ns];
+  t[0] = t0;
+  t[n] = t1;
+  size_t span = 0;
+  for (size_t j = 1; j < n; j++) {
+    double s = L * (double)j / (double)n;
+    if (!(L > 0) || !isfinite(L)) {
+      t[j] = t0 + (t1 - t0) * (double)j / (double)n;
+      continue;
+    }
+    while (span + 1 < ns && cum[span + 1] < s) span++;
+    double a = ka[span], b = ka[span + 1], target = s - cum[span];
+    double lo = a, hi = b, span_len = cum[span + 1] - cum[span];
+    double x = span_len > 0 ? a + (b - a) * (target / span_len) : a;
+    /* Newton on length(a, x) - target, kept inside [lo, hi]. */
+    for (int it = 0; it < 60; it++) {
+      double f = len_between(c, a, x, tol) - target;
+      if (fabs(f) <= 1e-12 * L) break;
+      if (f > 0) hi = x;
+      else lo = x;
+      double sp = speed(c, x);
+      double nx = sp > 0 ? x - f / sp : 0.5 * (lo + hi);
+      if (!(nx > lo && nx < hi)) nx = 0.5 * (lo + hi);
+      x = nx;
+    }
+    t[j] = x;
+  }
+  free(cum);
+  free(ka);
+  return true;
+}
+
 char *api_svg_path_d_fixed_z(const km_curve *c, size_t n_pieces,
                              bool with_z) {
   if (!c || c->n == 0 || !c->cp || !c->knots) return NULL;
   if (n_pieces < 1) n_pieces = 1;
-  double t0, t1;
-  km_curve_domain(c, &t0, &t1);
-  double L = km_curve_length(c);
+  double *ts = malloc((n_pieces + 1) * sizeof *ts);
+  if (!ts || !uniform_params(c, n_pieces, ts)) {
+    free(ts);
+    return NULL;
+  }
   double ext = extent(c);
   writer w;
   memset(&w, 0, sizeof w);
   api__svg_buf_init(&w.buf);
   /* Animation frames need no more than a millionth of the drawing. */
   w.budget = 1e-6 * (ext > 0 ? ext : 1.0);
-  double ta = t0, pa[3][2];
-  km_curve_eval_side(c, ta, 1, 1, pa);
+  double pa[2][2];
+  km_curve_eval_side(c, ts[0], 1, 0, pa);
   api__svg_buf_put(&w.buf, "M");
   put_pt(&w, pa[0]);
   for (size_t i = 1; i <= n_pieces; i++) {
-    double tb;
-    if (i == n_pieces) tb = t1;
-    else if (L > 0 && isfinite(L))
-      tb = km_curve_param_at_length(c, L * (double)i / (double)n_pieces);
-    else tb = t0 + (t1 - t0) * (double)i / (double)n_pieces;
-    if (tb < ta) tb = ta;
-    double pb[3][2], ra[3][2];
+    double ta = ts[i - 1], tb = ts[i] < ta ? ta : ts[i];
+    double pb[2][2], ra[2][2];
     km_curve_eval_side(c, ta, 1, 1, ra);
     km_curve_eval_side(c, tb, -1, 1, pb);
     double h = (tb - ta) / 3.0, cub[4][2];
@@ -457,8 +573,8 @@ char *api_svg_path_d_fixed_z(const km_curve *c, size_t n_pieces,
       cub[3][k] = pb[0][k];
     }
     put_cubic(&w, (const double(*)[2])cub);
-    ta = tb;
   }
+  free(ts);
   if (with_z) api__svg_buf_put(&w.buf, " Z");
   return api__svg_buf_take(&w.buf);
 }
