@@ -357,6 +357,10 @@ static size_t animate_pieces(const ctx *c) {
   most *= 2;
   if (most < 32) most = 32;
   if (most > 400) most = 400;
+  /* Keep a long animation's document to a few megabytes. */
+  size_t share = c->n ? 200000 / c->n : 400;
+  if (share < 16) share = 16;
+  if (most > share) most = share;
   return most;
 }
 
@@ -489,14 +493,14 @@ static int cmp_double(const void *a, const void *b) {
 
 /* Samples of kappa over every knot span of the function, with one-sided
  * values at both ends of each span so jumps stay jumps. */
-static bool sample_kappa(series *se) {
+static bool sample_kappa(series *se, size_t budget) {
   const km_fn *f = &se->sig->kappa;
   double L = se->sig->length;
   if (!(L > 0) || f->n == 0) return true;
   size_t spans = 0;
   for (size_t i = (size_t)f->degree; i < f->n; i++)
     if (f->knots[i + 1] > f->knots[i]) spans++;
-  size_t per = spans ? 1600 / spans : 2;
+  size_t per = spans ? budget / spans : 2;
   if (per < 2) per = 2;
   size_t cap = spans * (per + 1) + 2;
   if (spans > 4000) cap = 4002;
@@ -550,6 +554,11 @@ static void curvature_plot(ctx *c, const api_svg_options *o) {
     return;
   }
   size_t total = 0;
+  /* Samples per frame: smooth curves for a few frames, a bounded document
+   * for many. */
+  size_t budget = 400000 / c->n;
+  if (budget > 1600) budget = 1600;
+  if (budget < 100) budget = 100;
   for (size_t i = 0; i < c->n; i++) {
     km_signature_init(&se[i].own);
     se[i].sig = c->f[i].sig;
@@ -560,7 +569,7 @@ static void curvature_plot(ctx *c, const api_svg_options *o) {
         se[i].sig = &se[i].own;
       }
     }
-    if (se[i].sig && !sample_kappa(&se[i])) c->b.failed = true;
+    if (se[i].sig && !sample_kappa(&se[i], budget)) c->b.failed = true;
     total += se[i].n;
   }
   /* The range shown: all of kappa and zero, unless a few samples near a
