@@ -167,6 +167,8 @@ bool api__parse_include(api_ctx *ctx, const cJSON *root, bool allow_animate,
  * no-convergence error (the core produced something it cannot stand
  * behind) and returns false; allocation failures record 503. ---- */
 bool api__add_num(api_ctx *ctx, cJSON *obj, const char *key, double v);
+/* A finite number as a cJSON item that prints exactly (round-trips). */
+cJSON *api__number(double v);
 cJSON *api__num_array_json(api_ctx *ctx, const double *v, size_t n,
                            size_t stride);
 cJSON *api__curve_json(api_ctx *ctx, const km_curve *c, bool svg_d,

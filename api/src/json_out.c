@@ -3,16 +3,48 @@
  *
  * cJSON prints NaN and infinities as null, which would silently break the
  * contract ("numbers are JSON numbers"), so every number goes through
- * api__add_num / api__num_array_json, which check it first. Doubles print
- * with up to 17 significant digits (cJSON tries %1.15g and falls back to
- * %1.17g when that does not read back exactly), so values round-trip.
+ * api__add_num / api__num_array_json, which check it first.
+ *
+ * Numbers are printed here, not by cJSON: cJSON 1.7.15 prints %1.15g when
+ * that reads back within DBL_EPSILON *relative*, which loses the last bit
+ * (0.1 + 0.2 comes out as 0.3). We print the shortest of %.15g, %.16g and
+ * %.17g that reads back exactly and hand cJSON the text as a raw item.
  */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
 #include "svg.h"
+
+cJSON *api__number(double v) {
+  char buf[40];
+  for (int digits = 15; digits <= 17; digits++) {
+    snprintf(buf, sizeof buf, "%.*g", digits, v);
+    if (digits == 17 || strtod(buf, NULL) == v)
+      break;
+  }
+  return cJSON_CreateRaw(buf);
+}
+
+/* [x, y] */
+static cJSON *pair(const double *v) {
+  cJSON *a = cJSON_CreateArray(), *x, *y;
+  if (a == NULL)
+    return NULL;
+  x = api__number(v[0]);
+  if (x != NULL)
+    cJSON_AddItemToArray(a, x);
+  y = api__number(v[1]);
+  if (y != NULL)
+    cJSON_AddItemToArray(a, y);
+  if (x == NULL || y == NULL) {
+    cJSON_Delete(a);
+    return NULL;
+  }
+  return a;
+}
 
 static bool nonfinite(api_ctx *ctx, const char *what) {
   return api__failf(ctx, 422, API_P_NO_CONVERGE,
@@ -25,8 +57,10 @@ static bool nonfinite(api_ctx *ctx, const char *what) {
 bool api__add_num(api_ctx *ctx, cJSON *obj, const char *key, double v) {
   if (!isfinite(v))
     return nonfinite(ctx, key);
-  if (cJSON_AddNumberToObject(obj, key, v) == NULL)
+  cJSON *n = api__number(v);
+  if (n == NULL)
     return api__oom(ctx);
+  cJSON_AddItemToObject(obj, key, n);
   return true;
 }
 
@@ -43,11 +77,11 @@ cJSON *api__num_array_json(api_ctx *ctx, const double *v, size_t n,
     if (stride == 1) {
       if (!isfinite(v[i]))
         goto nonfinite_value;
-      e = cJSON_CreateNumber(v[i]);
+      e = api__number(v[i]);
     } else {
       if (!isfinite(v[2 * i]) || !isfinite(v[2 * i + 1]))
         goto nonfinite_value;
-      e = cJSON_CreateDoubleArray(&v[2 * i], 2);
+      e = pair(&v[2 * i]);
     }
     if (e == NULL) {
       cJSON_Delete(a);
@@ -133,7 +167,7 @@ cJSON *api__signature_json(api_ctx *ctx, const km_signature *sig) {
     goto fail;
   }
   {
-    cJSON *pt = cJSON_CreateDoubleArray(sig->start, 2);
+    cJSON *pt = pair(sig->start);
     if (pt == NULL) {
       api__oom(ctx);
       goto fail;
