@@ -84,4 +84,17 @@ double km__pp_integral_sq(const km_pp *p);
 km_status km__pp_blend(km_pp *out, const km_pp *a, double wa, const km_pp *b,
                        double wb, double u0, double u1);
 
+
+/* theta(s) of a signature as pieces (breaks at kappa's breaks and at the
+ * corners; corner turns folded into the pieces' start values) beside the
+ * matching kappa pieces. */
+struct km_signature;
+km_status km__build_theta(const struct km_signature *sig, km_pp *kappa,
+                          km_pp *theta);
+/* Integral of (cos theta, sin theta) over [u0,u1] of a theta piece (degree
+ * d Bernstein coefficients tc, piece length h); kbound bounds |kappa| there
+ * and sets the chunking (theta moves <= 0.5 rad per 16-point rule). */
+void km__integrate_exp(const double *tc, int d, double h, double u0,
+                       double u1, double kbound, double out[2]);
+
 #endif

@@ -46,7 +46,8 @@ static int cmp_double(const void *a, const void *b) {
   return (x > y) - (x < y);
 }
 
-static km_status build_theta(const km_signature *sig, theta_pieces *tp) {
+km_status km__build_theta(const km_signature *sig, km_pp *kappa, km_pp *theta) {
+  theta_pieces tps, *tp = &tps;
   km_pp k0;
   km__pp_init(&k0);
   km__pp_init(&tp->kappa);
@@ -95,13 +96,18 @@ static km_status build_theta(const km_signature *sig, theta_pieces *tp) {
 done:
   free(br);
   km__pp_free(&k0);
-  if (st) theta_pieces_free(tp);
-  return st;
+  if (st) {
+    theta_pieces_free(tp);
+    return st;
+  }
+  *kappa = tp->kappa;
+  *theta = tp->theta;
+  return KM_OK;
 }
 
 /* Integral of (cos theta, sin theta) over [u0, u1] (piece variable in
  * [0,1]) of theta piece i of length h. */
-static void integrate_piece(const double *tc, int d, double h, double u0,
+void km__integrate_exp(const double *tc, int d, double h, double u0,
                             double u1, double kbound, double out[2]) {
   double len = (u1 - u0) * h;
   /* chunks over which theta moves at most 0.5 rad */
@@ -220,7 +226,7 @@ km_status km_reconstruct(const km_signature *sig, int degree, double tol,
   double *pos = NULL;
   km_curve c;
   km_curve_init(&c);
-  km_status st = build_theta(sig, &tp);
+  km_status st = km__build_theta(sig, &tp.kappa, &tp.theta);
   if (st) return km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
   int dk = tp.kappa.degree, dt = dk + 1;
   for (size_t i = 0; i < tp.theta.m; i++) {
@@ -252,7 +258,7 @@ km_status km_reconstruct(const km_signature *sig, int degree, double tol,
     kappa_bounds(tp.kappa.c + i * (size_t)(dk + 1), dk, h, op->u0, op->u1, 1,
                  kb);
     double d[2];
-    integrate_piece(tp.theta.c + i * (size_t)(dt + 1), dt, h, op->u0, op->u1,
+    km__integrate_exp(tp.theta.c + i * (size_t)(dt + 1), dt, h, op->u0, op->u1,
                     kb[0], d);
     pos[2 * j + 2] = pos[2 * j] + d[0];
     pos[2 * j + 3] = pos[2 * j + 1] + d[1];
@@ -417,7 +423,7 @@ cleanup:
 km_status km_signature_point(const km_signature *sig, double s, double pos[2],
                              double *theta) {
   theta_pieces tp;
-  km_status st = build_theta(sig, &tp);
+  km_status st = km__build_theta(sig, &tp.kappa, &tp.theta);
   if (st) return st;
   if (s < 0) s = 0;
   if (s > sig->length) s = sig->length;
@@ -430,7 +436,7 @@ km_status km_signature_point(const km_signature *sig, double s, double pos[2],
     double kb[1], d[2];
     kappa_bounds(tp.kappa.c + i * (size_t)(dk + 1), dk, h, 0.0, u1, 1, kb);
     const double *tc = tp.theta.c + i * (size_t)(dt + 1);
-    integrate_piece(tc, dt, h, 0.0, u1, kb[0], d);
+    km__integrate_exp(tc, dt, h, 0.0, u1, kb[0], d);
     x += d[0];
     y += d[1];
     th = km__bern_eval(tc, dt, u1);
