@@ -19,7 +19,11 @@
 
 #include <cmocka.h>
 #include <math.h>
+#include <signal.h>
 #include <stdlib.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -178,6 +182,122 @@ static inline void tu_circle_nurbs(double cx, double cy, double r, int ccw,
     cp[2 * i + 1] = cy + r * (ccw ? uy[i] : -uy[i]);
     w[i] = (i % 2) ? sqrt(0.5) : 1.0;
   }
+}
+
+/* The rounded rectangle [x0, x0+w] x [y0, y0+h] with corner radius r as a
+ * closed, counter-clockwise degree-2 NURBS: eight Bezier pieces (lines with
+ * their middle point at the midpoint, exact quarter circles) joined with
+ * knots of multiplicity 2 on [0, 8], starting at (x0 + r, y0) heading +x
+ * along the bottom line. knots[20], cp[34], wt[17]. Tangent-continuous
+ * everywhere (the seam too); curvature jumps between 0 and 1/r at the
+ * joins, which lie at arc lengths w-2r, +pi r/2, +h-2r, +pi r/2, ... */
+static inline void tu_rounded_rect(double x0, double y0, double w, double h,
+                                   double r, double *knots, double *cp,
+                                   double *wt) {
+  /* the nine join points and the eight middle control points */
+  const double jx[9] = {x0 + r, x0 + w - r, x0 + w, x0 + w, x0 + w - r,
+                        x0 + r, x0,         x0,     x0 + r};
+  const double jy[9] = {y0,         y0,     y0 + r, y0 + h - r, y0 + h,
+                        y0 + h, y0 + h - r, y0 + r, y0};
+  const double mx[8] = {0.5 * (jx[0] + jx[1]), x0 + w, x0 + w,
+                        x0 + w,                0.5 * (jx[4] + jx[5]),
+                        x0,                    x0,     x0};
+  const double my[8] = {y0, y0, 0.5 * (jy[2] + jy[3]), y0 + h,
+                        y0 + h, y0 + h, 0.5 * (jy[6] + jy[7]), y0};
+  for (int i = 0; i < 8; i++) {
+    cp[4 * i] = jx[i];
+    cp[4 * i + 1] = jy[i];
+    cp[4 * i + 2] = mx[i];
+    cp[4 * i + 3] = my[i];
+    wt[2 * i] = 1.0;
+    wt[2 * i + 1] = (i % 2) ? sqrt(0.5) : 1.0;
+  }
+  cp[32] = jx[8];
+  cp[33] = jy[8];
+  wt[16] = 1.0;
+  knots[0] = knots[1] = knots[2] = 0.0;
+  for (int i = 1; i < 8; i++) knots[2 * i + 1] = knots[2 * i + 2] = i;
+  knots[17] = knots[18] = knots[19] = 8.0;
+}
+
+/* Control points of a gently turning random polygon: n points, legs of
+ * length step * [0.8, 1.2], each leg turning by at most maxturn from the
+ * previous one, starting at (x, y) heading `heading`. */
+static inline void tu_gentle_polygon(uint64_t *seed, size_t n, double x,
+                                     double y, double heading, double step,
+                                     double maxturn, double *cp) {
+  double dir = heading;
+  cp[0] = x;
+  cp[1] = y;
+  for (size_t i = 1; i < n; i++) {
+    double len = step * tu_uniform(seed, 0.8, 1.2);
+    cp[2 * i] = cp[2 * i - 2] + len * cos(dir);
+    cp[2 * i + 1] = cp[2 * i - 1] + len * sin(dir);
+    dir += tu_uniform(seed, -maxturn, maxturn);
+  }
+}
+
+/* Clamped knots on [0, n - p] for n control points of degree p, interior
+ * knots jittered by up to +-jitter/2 of a unit spacing (seeded). */
+static inline void tu_clamped_knots(uint64_t *seed, int p, size_t n,
+                                    double jitter, double *knots) {
+  size_t nk = n + (size_t)p + 1;
+  for (int i = 0; i <= p; i++) {
+    knots[i] = 0.0;
+    knots[nk - 1 - (size_t)i] = (double)(n - (size_t)p);
+  }
+  for (size_t i = (size_t)p + 1; i < n; i++)
+    knots[i] = (double)(i - (size_t)p) + jitter * (tu_rand(seed) - 0.5);
+}
+
+/* A polynomial B-spline is regular (C' != 0) if, on every span, the p
+ * hodograph control points that span uses lie in an open half-plane: then
+ * every convex combination of them is non-zero. Checks exactly that, with
+ * the window's mean direction as the half-plane's normal. */
+static inline int tu_is_regular(int p, size_t n, const double *knots,
+                                const double *cp) {
+  for (size_t span = (size_t)p; span < n; span++) {
+    if (!(knots[span + 1] > knots[span])) continue;
+    double q[2 * 16], mx = 0.0, my = 0.0;
+    for (int k = 0; k < p; k++) {
+      size_t i = span - (size_t)p + (size_t)k;
+      double den = knots[i + (size_t)p + 1] - knots[i + 1];
+      q[2 * k] = p * (cp[2 * i + 2] - cp[2 * i]) / den;
+      q[2 * k + 1] = p * (cp[2 * i + 3] - cp[2 * i + 1]) / den;
+      double len = hypot(q[2 * k], q[2 * k + 1]);
+      if (len == 0.0) return 0;
+      mx += q[2 * k] / len;
+      my += q[2 * k + 1] / len;
+    }
+    for (int k = 0; k < p; k++)
+      if (!(q[2 * k] * mx + q[2 * k + 1] * my > 0.0)) return 0;
+  }
+  return 1;
+}
+
+/* Tangent turn from direction (ax, ay) to (bx, by), in (-pi, pi]. */
+static inline double tu_turn(double ax, double ay, double bx, double by) {
+  return atan2(ax * by - ay * bx, ax * bx + ay * by);
+}
+
+/* Run fn(ctx) in a child process bounded by `seconds`, so that a hang or a
+ * crash in the code under test becomes one failed assertion instead of a
+ * stalled suite. fn returns a small non-negative code (e.g. -status).
+ * Returns that code, or -1 on time-out, -2 on a crash (signal). */
+static inline int tu_run_bounded(int (*fn)(void *), void *ctx,
+                                 unsigned seconds) {
+  pid_t pid = fork();
+  if (pid < 0) return -3;
+  if (pid == 0) {
+    alarm(seconds);
+    _exit(fn(ctx) & 0x7f);
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0) {
+  }
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  if (WIFSIGNALED(status) && WTERMSIG(status) == SIGALRM) return -1;
+  return -2;
 }
 
 #endif

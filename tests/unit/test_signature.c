@@ -1,0 +1,687 @@
+/* test_signature.c - curvature signatures of curves whose curvature is known:
+ * circles, polygons, lines, rounded rectangles, degenerate control legs,
+ * cusps, and the invariances (knot insertion, degree elevation, rigid
+ * motion); plus the validation of km_curve_create.
+ *
+ * Oracles: kappa = 1/R on a circle, kappa = 0 and exterior angles on
+ * polygons, closed-form arc lengths, tangent angles of cubics computed
+ * from their hodographs, and independent Gauss-Legendre arc lengths.
+ */
+#include <stdbool.h>
+#include <string.h>
+
+#include "fixtures.h"
+#include "km/curve.h"
+#include "km/signature.h"
+#include "testutil.h"
+
+static void make_curve(km_curve *c, int p, size_t n, const double *knots,
+                       const double *cp, const double *w, bool closed) {
+  km_error err;
+  km_curve_init(c);
+  assert_status(km_curve_create(c, p, n, knots, cp, w, closed, &err), KM_OK);
+}
+
+/* Signature that must succeed, at tolerance rel * length. */
+static void sign(const km_curve *c, double rel, km_signature *sig) {
+  km_error err;
+  km_signature_init(sig);
+  double L = km_curve_length(c);
+  km_status st = km_signature_compute(c, rel * L, sig, &err);
+  if (st != KM_OK) print_error("signature failed: %s\n", err.message);
+  assert_status(st, KM_OK);
+}
+
+/* The number of corners, listing the first few when it is wrong. */
+#define assert_ncorners(sig, want)                                            \
+  do {                                                                        \
+    if ((sig)->ncorners != (size_t)(want)) {                                  \
+      print_error("%zu corners, expected %d:\n", (sig)->ncorners, (int)(want)); \
+      for (size_t i_ = 0; i_ < (sig)->ncorners && i_ < 6; i_++)              \
+        print_error("  s = %.17g turn = %.17g\n", (sig)->corners[i_].s,      \
+                    (sig)->corners[i_].turn);                                 \
+      fail();                                                                 \
+    }                                                                         \
+  } while (0)
+
+static double kappa_at(const km_signature *sig, double s) {
+  return km_fn_value(&sig->kappa, s);
+}
+
+static void circle_case(int ccw) {
+  const double R = 2.5, ox = 1.0, oy = -2.0, L = 2 * M_PI * R;
+  const double sgn = ccw ? 1.0 : -1.0;
+  double kn[12], cp[18], w[9];
+  tu_circle_nurbs(ox, oy, R, ccw, kn, cp, w);
+  km_curve c;
+  make_curve(&c, 2, 9, kn, cp, w, true);
+  km_signature sig;
+  sign(&c, 1e-10, &sig);
+  assert_close(sig.length, L, 1e-12 * L);
+  assert_true(sig.closed);
+  assert_ncorners(&sig, 0);
+  assert_close(sig.turning, sgn * 2 * M_PI, 1e-9);
+  assert_close(sig.start[0], ox + R, 1e-12);
+  assert_close(sig.start[1], oy, 1e-12);
+  assert_close(tu_wrap(sig.angle - sgn * M_PI / 2), 0.0, 1e-12);
+  double a, b;
+  km_fn_domain(&sig.kappa, &a, &b);
+  assert_close(a, 0.0, 0.0);
+  assert_close(b, L, 1e-12 * L);
+  for (int i = 0; i <= 500; i++) {
+    double s = L * i / 500.0;
+    assert_close(kappa_at(&sig, s), sgn / R, 1e-9 / R);
+    assert_close(tu_wrap(km_signature_theta(&sig, s) - sgn * (M_PI / 2 + s / R)),
+                 0.0, 1e-9);
+  }
+  assert_close(km_signature_max_abs_kappa(&sig), 1.0 / R, 1e-9 / R);
+  assert_close(km_signature_bending_energy(&sig), L / (R * R), 1e-9 * L / (R * R));
+  km_signature_free(&sig);
+  km_curve_free(&c);
+}
+
+static void circle_has_constant_curvature_one_over_r(void **state) {
+  (void)state;
+  circle_case(1);
+}
+
+static void clockwise_circle_has_curvature_minus_one_over_r(void **state) {
+  (void)state;
+  circle_case(0);
+}
+
+static void polygon_case(double a, double b, int ccw) {
+  /* rectangle a x b from (1, 1), degree 1, closed */
+  double cp[10] = {1, 1, 1 + a, 1, 1 + a, 1 + b, 1, 1 + b, 1, 1};
+  if (!ccw) {
+    /* mirror in y = 1: clockwise */
+    for (int i = 0; i < 5; i++) cp[2 * i + 1] = 2.0 - cp[2 * i + 1];
+  }
+  const double kn[7] = {0, 0, 1, 2, 3, 4, 4};
+  km_curve c;
+  make_curve(&c, 1, 5, kn, cp, NULL, true);
+  km_signature sig;
+  sign(&c, 1e-10, &sig);
+  const double L = 2 * (a + b), sgn = ccw ? 1.0 : -1.0;
+  assert_close(sig.length, L, 1e-12 * L);
+  assert_ncorners(&sig, 4);
+  const double at[4] = {a, a + b, 2 * a + b, L};
+  for (int i = 0; i < 4; i++) {
+    assert_close(sig.corners[i].s, at[i], 1e-12 * L);
+    assert_close(sig.corners[i].turn, sgn * M_PI / 2, 1e-12);
+  }
+  assert_close(sig.turning, sgn * 2 * M_PI, 1e-12);
+  assert_close(tu_wrap(sig.angle), 0.0, 1e-12);
+  for (int i = 0; i <= 100; i++)
+    assert_close(kappa_at(&sig, L * i / 100.0), 0.0, 1e-12);
+  /* theta steps by each corner's turn, which counts from the corner's own
+   * s on (from the right) */
+  const double eps = 1e-9 * L;
+  assert_close(km_signature_theta(&sig, 0.5 * a), 0.0, 1e-12);
+  assert_close(km_signature_theta(&sig, a - eps), 0.0, 1e-12);
+  assert_close(km_signature_theta(&sig, a + eps), sgn * M_PI / 2, 1e-12);
+  assert_close(km_signature_theta(&sig, sig.corners[0].s), sgn * M_PI / 2,
+               1e-12);
+  assert_close(km_signature_theta(&sig, a + 0.5 * b), sgn * M_PI / 2, 1e-12);
+  assert_close(km_signature_theta(&sig, 2 * a + 1.5 * b), sgn * 3 * M_PI / 2,
+               1e-12);
+  assert_close(km_signature_theta(&sig, L - eps), sgn * 3 * M_PI / 2, 1e-12);
+  assert_close(km_signature_theta(&sig, sig.length), sgn * 2 * M_PI, 1e-12);
+  km_signature_free(&sig);
+  km_curve_free(&c);
+}
+
+static void square_has_zero_curvature_and_four_right_corners(void **state) {
+  (void)state;
+  polygon_case(3.0, 3.0, 1);
+  polygon_case(3.0, 1.0, 1);
+}
+
+static void clockwise_square_has_four_negative_corners(void **state) {
+  (void)state;
+  polygon_case(3.0, 3.0, 0);
+}
+
+static void cubic_square_and_star_from_fixtures_have_polygon_corners(
+    void **state) {
+  (void)state;
+  static const struct {
+    const char *pair;
+    char which;
+  } shapes[2] = {{"square_to_circle", 'a'}, {"circle_to_star", 'b'}};
+  for (int k = 0; k < 2; k++) {
+    tf_bspline b;
+    assert_int_equal(tf_load_shape(shapes[k].pair, shapes[k].which, &b), 0);
+    assert_int_equal(b.degree, 3);
+    km_curve c;
+    make_curve(&c, 3, b.n, b.knots, b.cp, b.w, b.closed);
+    km_signature sig;
+    sign(&c, 1e-10, &sig);
+    /* vertices are every third control point (lines as cubics) */
+    size_t nv = (b.n - 1) / 3;
+    double area2 = 0, len = 0;
+    for (size_t i = 0; i < nv; i++) {
+      const double *p = b.cp + 6 * i, *q = b.cp + 6 * ((i + 1) % nv);
+      area2 += p[0] * q[1] - q[0] * p[1];
+      len += hypot(q[0] - p[0], q[1] - p[1]);
+    }
+    assert_close(sig.length, len, 1e-12 * len);
+    assert_ncorners(&sig, nv);
+    double s = 0, sum = 0;
+    for (size_t i = 0; i < nv; i++) {
+      const double *p = b.cp + 6 * i, *q = b.cp + 6 * ((i + 1) % nv),
+                   *r = b.cp + 6 * ((i + 2) % nv);
+      s += hypot(q[0] - p[0], q[1] - p[1]);
+      double turn = tu_turn(q[0] - p[0], q[1] - p[1], r[0] - q[0], r[1] - q[1]);
+      assert_close(sig.corners[i].s, s, 1e-12 * len);
+      assert_close(sig.corners[i].turn, turn, 1e-12);
+      sum += turn;
+    }
+    /* the last corner is the seam, at s = length */
+    assert_close(sig.corners[nv - 1].s, sig.length, 1e-12 * len);
+    assert_close(sig.turning, (area2 > 0 ? 2 : -2) * M_PI, 1e-9);
+    assert_close(sum, sig.turning, 1e-9);
+    for (int i = 0; i <= 300; i++)
+      assert_close(kappa_at(&sig, len * i / 300.0), 0.0, 1e-9 / len);
+    km_signature_free(&sig);
+    km_curve_free(&c);
+    tf_bspline_free(&b);
+  }
+}
+
+static void straight_line_has_zero_curvature_and_turning(void **state) {
+  (void)state;
+  /* a straight cubic with uneven speed, heading 0.7 rad */
+  const double f[4] = {0.0, 0.1, 2.2, 3.0}, dir = 0.7;
+  double cp[8];
+  for (int i = 0; i < 4; i++) {
+    cp[2 * i] = 1.0 + f[i] * cos(dir);
+    cp[2 * i + 1] = 2.0 + f[i] * sin(dir);
+  }
+  const double kn[8] = {0, 0, 0, 0, 1, 1, 1, 1};
+  km_curve c;
+  make_curve(&c, 3, 4, kn, cp, NULL, false);
+  km_signature sig;
+  sign(&c, 1e-10, &sig);
+  assert_close(sig.length, 3.0, 3e-12);
+  assert_false(sig.closed);
+  assert_ncorners(&sig, 0);
+  assert_close(sig.turning, 0.0, 1e-12);
+  assert_close(sig.angle, dir, 1e-12);
+  assert_close(sig.start[0], 1.0, 1e-15);
+  assert_close(sig.start[1], 2.0, 1e-15);
+  for (int i = 0; i <= 50; i++) {
+    assert_close(kappa_at(&sig, 3.0 * i / 50.0), 0.0, 1e-12);
+    assert_close(km_signature_theta(&sig, 3.0 * i / 50.0), dir, 1e-12);
+  }
+  km_signature_free(&sig);
+  km_curve_free(&c);
+}
+
+/* true when x is within tol of one of the knots of f */
+static bool has_knot_near(const km_fn *f, double x, double tol) {
+  for (size_t i = 0; i < f->n + (size_t)f->degree + 1; i++)
+    if (fabs(f->knots[i] - x) <= tol) return true;
+  return false;
+}
+
+static void kappa_breakpoints_include_arc_length_images_of_knots(
+    void **state) {
+  (void)state;
+  /* rounded rectangle: kappa jumps between 0 and 1/r at known s */
+  const double W = 7.0, H = 4.0, r = 1.25;
+  double kn[20], cp[34], wt[17];
+  tu_rounded_rect(-2.0, 0.5, W, H, r, kn, cp, wt);
+  km_curve c;
+  make_curve(&c, 2, 17, kn, cp, wt, true);
+  km_signature sig;
+  sign(&c, 1e-10, &sig);
+  const double arc = M_PI * r / 2;
+  const double seg[8] = {W - 2 * r, arc, H - 2 * r, arc,
+                         W - 2 * r, arc, H - 2 * r, arc};
+  double L = 0;
+  for (int i = 0; i < 8; i++) L += seg[i];
+  assert_close(sig.length, L, 1e-12 * L);
+  assert_ncorners(&sig, 0);
+  assert_close(sig.turning, 2 * M_PI, 1e-9);
+  assert_close(tu_wrap(sig.angle), 0.0, 1e-12);
+  double s0 = 0;
+  for (int i = 0; i < 8; i++) {
+    double s1 = s0 + seg[i], want = (i % 2) ? 1.0 / r : 0.0;
+    if (i > 0) assert_true(has_knot_near(&sig.kappa, s0, 1e-9 * L));
+    /* kappa is exact inside each piece, right up to its ends */
+    for (int k = 0; k <= 20; k++) {
+      double s = s0 + seg[i] * (1e-9 + (1 - 2e-9) * k / 20.0);
+      assert_close(kappa_at(&sig, s), want, 1e-8 / r);
+    }
+    s0 = s1;
+  }
+  km_signature_free(&sig);
+  km_curve_free(&c);
+
+  /* a generic cubic: breakpoints at length_between(t0, knot) */
+  uint64_t seed = 3;
+  double gk[14], gp[20];
+  tu_gentle_polygon(&seed, 10, 0, 0, 0.3, 1.0, 0.4, gp);
+  tu_clamped_knots(&seed, 3, 10, 0.6, gk);
+  assert_true(tu_is_regular(3, 10, gk, gp));
+  make_curve(&c, 3, 10, gk, gp, NULL, false);
+  sign(&c, 1e-8, &sig);
+  for (int i = 4; i < 10; i++) {
+    double s = km_curve_length_between(&c, 0.0, gk[i]);
+    assert_true(has_knot_near(&sig.kappa, s, 1e-9 * sig.length));
+  }
+  km_signature_free(&sig);
+  km_curve_free(&c);
+}
+
+/* Max |theta_a - theta_b| and |kappa_a - kappa_b| over many s (the lengths
+ * must agree first). */
+static void assert_same_signature(const km_signature *a,
+                                  const km_signature *b, double theta_tol,
+                                  double kappa_tol) {
+  assert_close(b->length, a->length, 1e-12 * a->length);
+  assert_close(b->start[0], a->start[0], 1e-12 * a->length);
+  assert_close(b->start[1], a->start[1], 1e-12 * a->length);
+  assert_close(tu_wrap(b->angle - a->angle), 0.0, 1e-12);
+  assert_ncorners(b, a->ncorners);
+  for (size_t i = 0; i < a->ncorners; i++) {
+    assert_close(b->corners[i].s, a->corners[i].s, 1e-10 * a->length);
+    assert_close(b->corners[i].turn, a->corners[i].turn, 1e-10);
+  }
+  assert_close(b->turning, a->turning, theta_tol);
+  for (int i = 0; i <= 1000; i++) {
+    double s = a->length * (i + 0.5) / 1001.0;
+    assert_close(km_signature_theta(b, s), km_signature_theta(a, s),
+                 theta_tol);
+    assert_close(kappa_at(b, s), kappa_at(a, s), kappa_tol);
+  }
+}
+
+static void knot_insertion_and_elevation_keep_the_signature(void **state) {
+  (void)state;
+  uint64_t seed = 11;
+  double gk[12], gp[16];
+  tu_gentle_polygon(&seed, 8, 1, 2, -0.5, 1.0, 0.45, gp);
+  tu_clamped_knots(&seed, 3, 8, 0.5, gk);
+  assert_true(tu_is_regular(3, 8, gk, gp));
+  km_curve c, d;
+  km_error err;
+  make_curve(&c, 3, 8, gk, gp, NULL, false);
+  km_signature ref, sig;
+  sign(&c, 1e-10, &ref);
+  const double kt = km_fn_max_abs(&ref.kappa) * 1e-6;
+
+  /* a new knot once, and an existing knot raised to full multiplicity
+   * (a C0 knot the curve crosses smoothly: no corner) */
+  km_curve_init(&d);
+  assert_status(km_curve_insert_knot(&d, &c, 0.37 * gk[11], 1, &err), KM_OK);
+  sign(&d, 1e-10, &sig);
+  assert_same_signature(&ref, &sig, 1e-8, kt);
+  km_signature_free(&sig);
+  km_curve_free(&d);
+
+  km_curve_init(&d);
+  assert_status(km_curve_insert_knot(&d, &c, gk[6], 2, &err), KM_OK);
+  sign(&d, 1e-10, &sig);
+  assert_same_signature(&ref, &sig, 1e-8, kt);
+  km_signature_free(&sig);
+  km_curve_free(&d);
+
+  for (int times = 1; times <= 2; times++) {
+    km_curve_init(&d);
+    assert_status(km_curve_elevate(&d, &c, times, &err), KM_OK);
+    assert_int_equal(d.degree, 3 + times);
+    sign(&d, 1e-10, &sig);
+    assert_same_signature(&ref, &sig, 1e-8, kt);
+    km_signature_free(&sig);
+    km_curve_free(&d);
+  }
+  km_signature_free(&ref);
+  km_curve_free(&c);
+}
+
+/* Speed |B'(u)| of a cubic Bezier with control points p[8]. */
+static double bezier_speed(double u, const void *ctx) {
+  const double *p = ctx;
+  double v = 1 - u, d[2];
+  for (int k = 0; k < 2; k++)
+    d[k] = 3 * (v * v * (p[2 + k] - p[k]) + 2 * u * v * (p[4 + k] - p[2 + k]) +
+                u * u * (p[6 + k] - p[4 + k]));
+  return hypot(d[0], d[1]);
+}
+
+static void repeated_first_control_point_gives_the_traced_signature(
+    void **state) {
+  (void)state;
+  /* D(u) = cubic Bezier (0,0), (0,0), (2,1), (3,3): D'(u) = 3u (4 - 3u, 2),
+   * zero at u = 0 but the direction (4 - 3u, 2) never vanishes: the trace
+   * is regular, with tangent angle atan2(2, 4 - 3u), and its curvature
+   * grows like 1/sqrt(s) at the start. */
+  const double P[8] = {0, 0, 0, 0, 2, 1, 3, 3};
+  const double kn[8] = {0, 0, 0, 0, 1, 1, 1, 1};
+  km_curve c;
+  make_curve(&c, 3, 4, kn, P, NULL, false);
+  km_signature sig;
+  sign(&c, 1e-10, &sig);
+  const double L = tu_integrate(bezier_speed, P, 0.0, 1.0, 64);
+  assert_close(sig.length, L, 1e-12 * L);
+  assert_ncorners(&sig, 0);
+  assert_close(sig.angle, atan2(2.0, 4.0), 1e-9);
+  assert_close(sig.turning, atan2(2.0, 1.0) - atan2(2.0, 4.0), 1e-8);
+  for (int i = 1; i <= 100; i++) {
+    double u = i / 100.0, s = tu_integrate(bezier_speed, P, 0.0, u, 32);
+    assert_close(km_signature_theta(&sig, s), atan2(2.0, 4.0 - 3.0 * u), 1e-8);
+  }
+
+  /* the same trace without the repeated point: the right half u in [0.5,1]
+   * (de Casteljau) is a regular cubic, and its signature is the tail of
+   * the whole one */
+  double q[8], b[8];
+  for (int k = 0; k < 2; k++) {
+    for (int i = 0; i < 4; i++) q[2 * i + k] = P[2 * i + k];
+    double m01 = 0.5 * (q[k] + q[2 + k]), m12 = 0.5 * (q[2 + k] + q[4 + k]),
+           m23 = 0.5 * (q[4 + k] + q[6 + k]);
+    double m012 = 0.5 * (m01 + m12), m123 = 0.5 * (m12 + m23);
+    b[k] = 0.5 * (m012 + m123);
+    b[2 + k] = m123;
+    b[4 + k] = m23;
+    b[6 + k] = q[6 + k];
+  }
+  km_curve half;
+  make_curve(&half, 3, 4, kn, b, NULL, false);
+  km_signature hs;
+  sign(&half, 1e-10, &hs);
+  const double s0 = tu_integrate(bezier_speed, P, 0.0, 0.5, 32);
+  assert_close(hs.length, L - s0, 1e-12 * L);
+  for (int i = 0; i <= 200; i++) {
+    double s = hs.length * i / 200.0;
+    assert_close(km_signature_theta(&hs, s), km_signature_theta(&sig, s0 + s),
+                 1e-8);
+    assert_close(kappa_at(&hs, s), kappa_at(&sig, s0 + s),
+                 1e-6 * km_fn_max_abs(&hs.kappa));
+  }
+  km_signature_free(&hs);
+  km_curve_free(&half);
+  km_signature_free(&sig);
+  km_curve_free(&c);
+}
+
+static void degenerate_leg_at_a_join_is_smooth_or_a_corner(void **state) {
+  (void)state;
+  /* piece 1 is regular and ends heading (1, 1); piece 2 repeats its first
+   * control point, so its tangent at the join is the direction of P2 - P0:
+   * along (1, 1) the join is smooth, along (1, 0) it hides a corner of
+   * -pi/4 */
+  const double kn[11] = {0, 0, 0, 0, 1, 1, 1, 2, 2, 2, 2};
+  const double p1[8] = {0, 0, 1, 0, 2, 0.5, 3, 1.5};
+  const double s1 = tu_integrate(bezier_speed, p1, 0.0, 1.0, 64);
+  for (int variant = 0; variant < 2; variant++) {
+    double cp[14] = {0, 0, 1, 0, 2, 0.5, 3, 1.5, 3, 1.5, 0, 0, 6, 3};
+    if (variant == 0) {
+      cp[10] = 4.2;
+      cp[11] = 2.7;
+    } else {
+      cp[10] = 4.5;
+      cp[11] = 1.5;
+    }
+    km_curve c;
+    make_curve(&c, 3, 7, kn, cp, NULL, false);
+    km_signature sig;
+    sign(&c, 1e-10, &sig);
+    const double p2[8] = {3, 1.5, 3, 1.5, cp[10], cp[11], 6, 3};
+    const double L = s1 + tu_integrate(bezier_speed, p2, 0.0, 1.0, 64);
+    assert_close(sig.length, L, 1e-12 * L);
+    if (variant == 0) {
+      assert_ncorners(&sig, 0);
+      assert_close(km_signature_theta(&sig, s1 - 1e-9 * L), M_PI / 4, 1e-6);
+      assert_close(km_signature_theta(&sig, s1), M_PI / 4, 1e-6);
+    } else {
+      assert_ncorners(&sig, 1);
+      assert_close(sig.corners[0].s, s1, 1e-9 * L);
+      assert_close(sig.corners[0].turn, -M_PI / 4, 1e-9);
+      assert_close(km_signature_theta(&sig, s1 - 1e-9 * L), M_PI / 4, 1e-6);
+      assert_close(km_signature_theta(&sig, s1), 0.0, 1e-6);
+    }
+    /* tangent at the end: (6, 3) - P2 */
+    assert_close(tu_wrap(km_signature_theta(&sig, L) -
+                         atan2(3 - cp[11], 6 - cp[10])),
+                 0.0, 1e-8);
+    km_signature_free(&sig);
+    km_curve_free(&c);
+  }
+}
+
+static void rigid_motion_keeps_curvature_and_corners(void **state) {
+  (void)state;
+  /* two cubic pieces meeting at an angle, then rotated and translated */
+  uint64_t seed = 5;
+  double cp[14], kn[11] = {0, 0, 0, 0, 1.5, 1.5, 1.5, 3, 3, 3, 3};
+  tu_gentle_polygon(&seed, 4, 0, 0, 0.2, 1.0, 0.5, cp);
+  /* second piece leaves the join at a 1 rad turn */
+  double dir = atan2(cp[7] - cp[5], cp[6] - cp[4]) + 1.0;
+  tu_gentle_polygon(&seed, 4, cp[6], cp[7], dir, 1.3, 0.4, cp + 6);
+  km_curve c, d;
+  make_curve(&c, 3, 7, kn, cp, NULL, false);
+  const double rot = 2.2, tx = 5.0, ty = -3.0;
+  double rp[14];
+  for (int i = 0; i < 7; i++) {
+    rp[2 * i] = cos(rot) * cp[2 * i] - sin(rot) * cp[2 * i + 1] + tx;
+    rp[2 * i + 1] = sin(rot) * cp[2 * i] + cos(rot) * cp[2 * i + 1] + ty;
+  }
+  make_curve(&d, 3, 7, kn, rp, NULL, false);
+  km_signature a, b;
+  sign(&c, 1e-10, &a);
+  sign(&d, 1e-10, &b);
+  assert_ncorners(&a, 1);
+  assert_close(a.corners[0].turn, 1.0, 1e-9);
+  assert_close(b.length, a.length, 1e-12 * a.length);
+  assert_close(b.start[0], tx, 1e-12);
+  assert_close(b.start[1], ty, 1e-12);
+  assert_close(tu_wrap(b.angle - a.angle - rot), 0.0, 1e-12);
+  assert_ncorners(&b, a.ncorners);
+  assert_close(b.corners[0].s, a.corners[0].s, 1e-10 * a.length);
+  assert_close(b.corners[0].turn, a.corners[0].turn, 1e-10);
+  assert_close(b.turning, a.turning, 1e-8);
+  const double kt = 1e-6 * km_fn_max_abs(&a.kappa);
+  for (int i = 0; i <= 1000; i++) {
+    double s = a.length * (i + 0.5) / 1001.0;
+    assert_close(kappa_at(&b, s), kappa_at(&a, s), kt);
+    assert_close(tu_wrap(km_signature_theta(&b, s) -
+                         km_signature_theta(&a, s) - rot),
+                 0.0, 1e-8);
+  }
+  km_signature_free(&a);
+  km_signature_free(&b);
+  km_curve_free(&c);
+  km_curve_free(&d);
+}
+
+static void cusp_is_refused_with_its_parameter(void **state) {
+  (void)state;
+  /* C(t) = ((t - t0)^2, (t - t0)^3): C'(t0) = 0 and C'/|C'| goes from
+   * (-1, 0) to (1, 0): the tangent reverses at t0 */
+  struct {
+    double t0, lo, hi, k1, k2;
+  } cases[2] = {{0.5, 0.0, 1.0, -1, -1}, {3.3, 2.0, 6.0, 2.7, 4.5}};
+  for (int ci = 0; ci < 2; ci++) {
+    double t0 = cases[ci].t0;
+    double px[4] = {t0 * t0, -2 * t0, 1, 0};
+    double py[4] = {-t0 * t0 * t0, 3 * t0 * t0, -3 * t0, 1};
+    double kn[10];
+    size_t nk = 0;
+    for (int i = 0; i < 4; i++) kn[nk++] = cases[ci].lo;
+    if (cases[ci].k1 > 0) kn[nk++] = cases[ci].k1;
+    if (cases[ci].k2 > 0) kn[nk++] = cases[ci].k2;
+    for (int i = 0; i < 4; i++) kn[nk++] = cases[ci].hi;
+    size_t n = nk - 4;
+    double cp[12];
+    tu_poly_to_bspline(px, 3, 3, kn, n, cp, 2);
+    tu_poly_to_bspline(py, 3, 3, kn, n, cp + 1, 2);
+    km_curve c;
+    make_curve(&c, 3, n, kn, cp, NULL, false);
+    km_signature sig;
+    km_error err;
+    km_signature_init(&sig);
+    assert_status(km_signature_compute(&c, 0.0, &sig, &err), KM_ECUSP);
+    assert_int_equal(err.code, KM_ECUSP);
+    assert_close(err.param, t0, 1e-4 * (cases[ci].hi - cases[ci].lo));
+    assert_null(sig.corners);
+    km_curve_free(&c);
+  }
+
+  /* a polyline that turns back on itself: the tangent reverses at t = 1 */
+  const double pk[5] = {0, 0, 1, 2, 2}, pp[6] = {0, 0, 2, 0, 1, 0};
+  km_curve c;
+  make_curve(&c, 1, 3, pk, pp, NULL, false);
+  km_signature sig;
+  km_error err;
+  km_signature_init(&sig);
+  assert_status(km_signature_compute(&c, 0.0, &sig, &err), KM_ECUSP);
+  assert_close(err.param, 1.0, 1e-9);
+  km_curve_free(&c);
+}
+
+/* -status of the signature of the curve in ctx (for tu_run_bounded). */
+static int signature_status(void *ctx) {
+  km_signature sig;
+  km_error err;
+  km_signature_init(&sig);
+  km_status st = km_signature_compute(ctx, 0.0, &sig, &err);
+  if (st == KM_OK) km_signature_free(&sig);
+  return -(int)st;
+}
+
+static void zero_length_curve_is_degenerate(void **state) {
+  (void)state;
+  const double kn[8] = {0, 0, 0, 0, 1, 1, 1, 1};
+  const double cp[8] = {2, 3, 2, 3, 2, 3, 2, 3};
+  km_curve c;
+  make_curve(&c, 3, 4, kn, cp, NULL, false);
+  /* bounded: a failure to stop must fail this test, not stall the suite */
+  int r = tu_run_bounded(signature_status, &c, 5);
+  if (r < 0) print_error("signature of a point: %s\n",
+                         r == -1 ? "did not finish in 5 s" : "crashed");
+  assert_int_equal(r, -KM_EDEGENERATE);
+  km_curve_free(&c);
+
+  /* a degree-1 segment of zero length */
+  const double k1[4] = {0, 0, 1, 1}, p1[4] = {-1, 5, -1, 5};
+  make_curve(&c, 1, 2, k1, p1, NULL, false);
+  r = tu_run_bounded(signature_status, &c, 5);
+  assert_int_equal(r, -KM_EDEGENERATE);
+  km_curve_free(&c);
+
+  /* an empty (init'ed, never created) curve is an error, not a crash */
+  km_curve_init(&c);
+  r = tu_run_bounded(signature_status, &c, 5);
+  assert_true(r > 0);
+}
+
+/* km_curve_create must fail with `want`, naming `field` (unless field is
+ * negative) and `index` (unless index < -1), and leave out untouched. */
+static void expect_create_error(int p, size_t n, const double *kn,
+                                const double *cp, const double *w,
+                                bool closed, km_status want, int field,
+                                long index) {
+  km_curve c;
+  km_error err;
+  km_curve_init(&c);
+  memset(&err, 0, sizeof err);
+  assert_status(km_curve_create(&c, p, n, kn, cp, w, closed, &err), want);
+  assert_int_equal(err.code, want);
+  if (field >= 0) assert_int_equal(err.field, field);
+  if (index >= -1) assert_int_equal(err.index, index);
+  assert_true(err.message[0] != '\0');
+  assert_null(c.cp);
+  assert_null(c.knots);
+}
+
+static void curve_create_rejects_bad_input_naming_the_field(void **state) {
+  (void)state;
+  const double kn[9] = {0, 0, 0, 0, 0.5, 1, 1, 1, 1};
+  const double cp[12] = {0, 0, 1, 2, 3, 3, 4, 1, 5, 0, 6, 1};
+  const double w[5] = {1, 1, 1, 1, 1};
+  /* sanity: the unmodified input is valid */
+  km_curve ok;
+  make_curve(&ok, 3, 5, kn, cp, w, false);
+  km_curve_free(&ok);
+
+  /* decreasing knots: the element smaller than its predecessor */
+  const double dec[9] = {0, 0, 0, 0, -0.5, 1, 1, 1, 1};
+  expect_create_error(3, 5, dec, cp, NULL, false, KM_EKNOTS, KM_FIELD_KNOTS,
+                      4);
+  const double dec6[10] = {0, 0, 0, 0, 0.5, 0.4, 1, 1, 1, 1};
+  expect_create_error(3, 6, dec6, cp, NULL, false, KM_EKNOTS, KM_FIELD_KNOTS,
+                      5);
+  expect_create_error(0, 5, kn, cp, NULL, false, KM_EDEGREE, KM_FIELD_DEGREE,
+                      -2);
+  expect_create_error(20, 5, kn, cp, NULL, false, KM_EDEGREE,
+                      KM_FIELD_DEGREE, -2);
+  /* the knot count is n + degree + 1, so a wrong count shows as too few
+   * control points for the degree (the contract layer checks array
+   * lengths, which the core never sees) */
+  expect_create_error(3, 3, kn, cp, NULL, false, KM_ECOUNT, -1, -2);
+  expect_create_error(3, 0, kn, cp, NULL, false, KM_ECOUNT, -1, -2);
+  double bad[10];
+  memcpy(bad, cp, sizeof bad);
+  bad[5] = NAN;
+  expect_create_error(3, 5, kn, bad, NULL, false, KM_ENONFINITE,
+                      KM_FIELD_CONTROL_POINTS, 2);
+  bad[5] = INFINITY;
+  expect_create_error(3, 5, kn, bad, NULL, false, KM_ENONFINITE,
+                      KM_FIELD_CONTROL_POINTS, 2);
+  bad[5] = 1e300;
+  expect_create_error(3, 5, kn, bad, NULL, false, KM_ERANGE,
+                      KM_FIELD_CONTROL_POINTS, 2);
+  double nk[9];
+  memcpy(nk, kn, sizeof nk);
+  nk[4] = NAN;
+  expect_create_error(3, 5, nk, cp, NULL, false, KM_ENONFINITE,
+                      KM_FIELD_KNOTS, 4);
+  double ww[5] = {1, 1, 0, 1, 1};
+  expect_create_error(3, 5, kn, cp, ww, false, KM_EWEIGHT, KM_FIELD_WEIGHTS,
+                      2);
+  ww[2] = 1;
+  ww[3] = -1;
+  expect_create_error(3, 5, kn, cp, ww, false, KM_EWEIGHT, KM_FIELD_WEIGHTS,
+                      3);
+  ww[3] = NAN;
+  expect_create_error(3, 5, kn, cp, ww, false, KM_ENONFINITE,
+                      KM_FIELD_WEIGHTS, 3);
+  /* closed, but the last point is not the first */
+  expect_create_error(3, 5, kn, cp, NULL, true, KM_ECLOSED, -1, -2);
+  /* not clamped; interior multiplicity above the degree; empty domain */
+  const double unc[9] = {0, 0, 0, 0.1, 0.5, 1, 1, 1, 1};
+  expect_create_error(3, 5, unc, cp, NULL, false, KM_EKNOTS, KM_FIELD_KNOTS,
+                      -2);
+  const double m4[10] = {0, 0, 0, 0.5, 0.5, 0.5, 0.5, 1, 1, 1};
+  const double cp7[14] = {0, 0, 1, 2, 3, 3, 4, 1, 5, 0, 6, 1, 7, 0};
+  expect_create_error(2, 7, m4, cp7, NULL, false, KM_EKNOTS, KM_FIELD_KNOTS,
+                      -2);
+  const double flat[9] = {1, 1, 1, 1, 1, 1, 1, 1, 1};
+  expect_create_error(3, 5, flat, cp, NULL, false, KM_EKNOTS, KM_FIELD_KNOTS,
+                      -2);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(circle_has_constant_curvature_one_over_r),
+      cmocka_unit_test(clockwise_circle_has_curvature_minus_one_over_r),
+      cmocka_unit_test(square_has_zero_curvature_and_four_right_corners),
+      cmocka_unit_test(clockwise_square_has_four_negative_corners),
+      cmocka_unit_test(
+          cubic_square_and_star_from_fixtures_have_polygon_corners),
+      cmocka_unit_test(straight_line_has_zero_curvature_and_turning),
+      cmocka_unit_test(kappa_breakpoints_include_arc_length_images_of_knots),
+      cmocka_unit_test(knot_insertion_and_elevation_keep_the_signature),
+      cmocka_unit_test(
+          repeated_first_control_point_gives_the_traced_signature),
+      cmocka_unit_test(degenerate_leg_at_a_join_is_smooth_or_a_corner),
+      cmocka_unit_test(rigid_motion_keeps_curvature_and_corners),
+      cmocka_unit_test(cusp_is_refused_with_its_parameter),
+      cmocka_unit_test(zero_length_curve_is_degenerate),
+      cmocka_unit_test(curve_create_rejects_bad_input_naming_the_field),
+  };
+  return cmocka_run_group_tests_name("signature", tests, NULL, NULL);
+}
