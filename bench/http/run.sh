@@ -15,7 +15,7 @@ PY=/usr/bin/python3
 [ -x "$PY" ] || PY=python3
 pair=$("$PY" bench/http/bodies.py "$tmp" "$frames")
 
-build/kmorphd --bind 127.0.0.1 --port 0 --access-log 0 --queue 1024 \
+"${KMORPHD:-build/kmorphd}" --bind 127.0.0.1 --port 0 --access-log 0 --queue 1024 \
   --max-connections 1024 2>"$tmp/log" &
 pid=$!
 trap 'kill -TERM $pid 2>/dev/null; wait $pid 2>/dev/null; rm -rf "$tmp"' EXIT
@@ -56,10 +56,12 @@ read -r m_rps m_50 m_99 m_bad < <(bench /v1/morph -s "$morph_lua")
 # one loop per core for the same wall time budget.
 n=${BENCH_CLI_RUNS:-40}
 t0=$(date +%s.%N)
+loops=""
 for c in $(seq "$cores"); do
-  ( for _ in $(seq "$n"); do build/kmorph morph <"$tmp/morph.json" >/dev/null; done ) &
+  ( for _ in $(seq "$n"); do "${KMORPH_CLI:-build/kmorph}" morph <"$tmp/morph.json" >/dev/null; done ) &
+  loops="$loops $!"
 done
-wait
+wait $loops
 t1=$(date +%s.%N)
 cli_rps=$(awk -v a="$t0" -v b="$t1" -v k="$((n * cores))" 'BEGIN {printf "%.1f", k / (b - a)}')
 ratio=$(awk -v a="$cli_rps" -v b="$m_rps" 'BEGIN {printf "%.2f", (b > 0 ? a / b : 0)}')

@@ -76,6 +76,7 @@ typedef struct srv_req {
   atomic_int phase;
   api_response resp; /* written by the worker before resuming */
   bool location;     /* add Location for a created job */
+  bool counted;      /* included in srv->suspended */
   int status;
   size_t bytes;
   const char *cut; /* why the connection was closed without an answer */
@@ -439,6 +440,7 @@ static enum MHD_Result hand_off(srv_req *r)
   /* Suspend before submitting so the worker's resume always comes after. */
   atomic_store(&r->phase, PH_WAIT);
   atomic_fetch_add(&s->suspended, 1);
+  r->counted = true;
   MHD_suspend_connection(r->conn);
   srv_pool_submit(s->pool, compute_task, r);
   return MHD_YES;
@@ -842,6 +844,7 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c,
     return dispatch(r);
   case PH_READY:
     atomic_fetch_sub(&s->suspended, 1);
+    r->counted = false;
     return answer_api(r, &r->resp);
   case PH_WAIT:     /* not reached: MHD does not call while suspended */
   case PH_ANSWERED: /* already queued */
@@ -861,6 +864,12 @@ static void on_completed(void *cls, struct MHD_Connection *c, void **req_cls,
   if (r == NULL)
     return;
   *req_cls = NULL;
+  /* A client that left while its request computed: MHD completes the
+   * resumed connection without calling the handler again. (Completion
+   * never happens while a worker still owns the request: MHD does not
+   * process suspended connections.) */
+  if (r->counted)
+    atomic_fetch_sub(&s->suspended, 1);
   double dt = srv_now() - r->t0;
   const char *why = r->cut;
   if (why == NULL && toe != MHD_REQUEST_TERMINATED_COMPLETED_OK)

@@ -1,11 +1,17 @@
 """test_shutdown.py - SIGTERM drains and exits 0 within the grace period,
 also while a job is running and while a request computes."""
+import shutil
+import subprocess
+import tempfile
+import json
 import signal
+import socket
+import struct
 import threading
 import time
 import unittest
 
-from kmtest import ContractCase, Daemon, heavy_morph_body, wait_for
+from kmtest import HOST, ContractCase, Daemon, heavy_morph_body, wait_for
 
 
 class GracefulShutdown(ContractCase):
@@ -45,6 +51,30 @@ class GracefulShutdown(ContractCase):
             self.assertIn(out["r"].status, (200, 503))
             if out["r"].status == 200:
                 self.assertEqual(len(out["r"].json()["frames"]), 400)
+        finally:
+            d.stop()
+
+    @unittest.skipUnless(shutil.which("wrk"), "needs wrk")
+    def test_clients_that_leave_mid_compute_do_not_hold_the_shutdown(self):
+        # wrk stops with requests in flight on its keep-alive connections:
+        # those connections are closed while suspended for compute.
+        d = Daemon("--threads", "2", "--queue", "1024",
+                   "--shutdown-grace", "10", "--access-log", "0")
+        try:
+            with tempfile.NamedTemporaryFile("w", suffix=".lua") as lua:
+                lua.write('wrk.method = "POST"\n'
+                          'wrk.headers["Content-Type"] = "application/json"\n'
+                          "wrk.body = [==[%s]==]\n"
+                          % json.dumps(heavy_morph_body(30)))
+                lua.flush()
+                subprocess.run(["wrk", "-t", "2", "-c", "16", "-d", "2s",
+                                "-s", lua.name,
+                                "http://%s:%d/v1/morph" % (HOST, d.port)],
+                               capture_output=True, timeout=60, check=True)
+            rc, dt = d.terminate(timeout=20)
+            self.assertEqual(rc, 0)
+            self.assertLess(dt, 3.0)
+            self.assertNotIn("forced", d.text())
         finally:
             d.stop()
 
