@@ -4,13 +4,14 @@ import json
 import math
 import os
 import subprocess
+import time
 import unittest
 
 import yaml
 
 from kmtest import (DAEMON, ROOT, SPEC, ContractCase, Daemon, circle_svg,
                     close_to, metric, morph_body, open_arc, raw_exchange,
-                    raw_status, schema_errors, component)
+                    raw_status, schema_errors, component, wait_for)
 
 TWO_PI = 2 * math.pi
 
@@ -91,8 +92,14 @@ class OperationsEndpoints(ContractCase):
         self.assertEqual(r.status, 404)
         self.assertEqual(r.header("X-Request-Id"), rid)
         self.assertEqual(r.json()["request_id"], rid)
-        lines = [l for l in self.d.text().splitlines()
-                 if "request_id=%s" % rid in l]
+        # The line is written when MHD completes the request, which may be
+        # just after the client has read the answer.
+        def lines():
+            return [l for l in self.d.text().splitlines()
+                    if "request_id=%s" % rid in l]
+        wait_for(lines, 5)
+        time.sleep(0.1)
+        lines = lines()
         self.assertEqual(len(lines), 1, "one access-log line per request")
         for part in ("method=GET", 'path="/v1/nothing"', "status=404",
                      "bytes=", "duration_ms="):
