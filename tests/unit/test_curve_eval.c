@@ -324,6 +324,15 @@ static void length_of_line_with_uneven_speed_is_the_distance(void **state) {
    * is at 0.5 and t = 3.5 at 2.75 */
   assert_close(km_curve_length_between(&c, 0.5, 3.5), 2.25 * sqrt(2.0),
                1e-12);
+  /* derivatives above the degree vanish */
+  double d[4][2];
+  km_curve_eval(&c, 2.0, 3, d);
+  assert_close(d[1][0], 0.25, 1e-15);
+  assert_close(d[1][1], -0.25, 1e-15);
+  for (int k = 2; k <= 3; k++) {
+    assert_close(d[k][0], 0.0, 0.0);
+    assert_close(d[k][1], 0.0, 0.0);
+  }
   km_curve_free(&c);
 }
 
