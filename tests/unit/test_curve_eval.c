@@ -420,6 +420,28 @@ static void param_at_length_clamps_to_the_ends(void **state) {
   km_curve_free(&c);
 }
 
+/* 0 when the length of the curve in ctx is 0 up to rounding (for
+ * tu_run_bounded). */
+static int length_is_zero(void *ctx) {
+  double L = km_curve_length(ctx);
+  return L >= 0.0 && L <= 1e-13 ? 0 : 1;
+}
+
+static void length_of_a_point_curve_is_zero(void **state) {
+  (void)state;
+  /* every control point the same (away from the origin, so that de Boor's
+   * convex combinations round): the length is 0 up to rounding, and
+   * finding it must terminate; bounded so a hang fails this test only */
+  const double kn[8] = {0, 0, 0, 0, 1, 1, 1, 1};
+  const double cp[8] = {2, 3, 2, 3, 2, 3, 2, 3};
+  km_curve c;
+  make_curve(&c, 3, 4, kn, cp, NULL, false);
+  int r = tu_run_bounded(length_is_zero, &c, 5);
+  if (r == -1) print_error("km_curve_length did not finish in 5 s\n");
+  assert_int_equal(r, 0);
+  km_curve_free(&c);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(eval_bezier_t_t2_t3_is_exact),
@@ -434,6 +456,7 @@ int main(void) {
       cmocka_unit_test(length_of_nurbs_circle_is_two_pi_r),
       cmocka_unit_test(length_of_parabola_matches_asinh_closed_form),
       cmocka_unit_test(param_at_length_clamps_to_the_ends),
+      cmocka_unit_test(length_of_a_point_curve_is_zero),
   };
   return cmocka_run_group_tests_name("curve_eval", tests, NULL, NULL);
 }
