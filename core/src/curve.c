@@ -305,7 +305,7 @@ static double gl_speed(const km_curve *c, double a, double b, int n16) {
 }
 
 static double length_rec(const km_curve *c, double a, double b,
-                         double abs_tol, int depth) {
+                         double abs_tol, int depth, long *budget) {
   double g8 = gl_speed(c, a, b, 0), g16 = gl_speed(c, a, b, 1);
   /* For an integrand analytic near [a, b] the n-point error falls
    * geometrically with n, so the 16-point error is about the square of the
@@ -313,18 +313,21 @@ static double length_rec(const km_curve *c, double a, double b,
    * more can be gained. */
   double d = fabs(g16 - g8), mag = fabs(g16);
   double est16 = d < 1e-3 * mag ? d * d / mag : d;
-  if (est16 <= fmax(abs_tol, 8e-16 * mag) || depth >= 40 ||
+  /* the budget bounds the work on pathological integrands (a speed that is
+   * rounding noise around zero) */
+  if (est16 <= fmax(abs_tol, 8e-16 * mag) || depth >= 40 || --*budget <= 0 ||
       !(b - a > 1e-300))
     return g16;
   double m = 0.5 * (a + b);
-  return length_rec(c, a, m, 0.5 * abs_tol, depth + 1) +
-         length_rec(c, m, b, 0.5 * abs_tol, depth + 1);
+  return length_rec(c, a, m, 0.5 * abs_tol, depth + 1, budget) +
+         length_rec(c, m, b, 0.5 * abs_tol, depth + 1, budget);
 }
 
 double km__length_adaptive(const km_curve *c, double a, double b,
                            double abs_tol) {
   if (!(b > a)) return 0.0;
-  return length_rec(c, a, b, abs_tol, 0);
+  long budget = 4096;
+  return length_rec(c, a, b, abs_tol, 0, &budget);
 }
 
 /* A scale for absolute tolerances: the control polygon's length bounds the
@@ -344,7 +347,9 @@ double km_curve_length_between(const km_curve *c, double ta, double tb) {
   if (ta < t0) ta = t0;
   if (tb > t1) tb = t1;
   if (!(tb > ta)) return 0.0;
-  double tol = 1e-15 * fmax(polygon_length(c), 1e-300);
+  double poly = polygon_length(c);
+  if (!(poly > 0)) return 0.0; /* every control point equal: a point */
+  double tol = 1e-15 * poly;
   double L = 0.0;
   size_t p = (size_t)c->degree;
   for (size_t i = p; i < c->n; i++) {

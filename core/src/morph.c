@@ -669,7 +669,7 @@ static km_status blend_signature(const km_morph *m, double t,
   free(segs);
   if (st) goto done;
   /* merge corners at the same place */
-  qsort(cl.c, cl.n, sizeof *cl.c, cmp_corner);
+  if (cl.n > 1) qsort(cl.c, cl.n, sizeof *cl.c, cmp_corner);
   size_t nc = 0;
   for (size_t i = 0; i < cl.n; i++) {
     if (cl.c[i].s > Lt) cl.c[i].s = Lt;

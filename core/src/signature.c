@@ -28,7 +28,10 @@
 #define THETA_DEGREE 7               /* kappa pieces are of degree 6 */
 #define NPTS (2 * THETA_DEGREE + 1)  /* nodes and check points */
 #define CORNER_NOISE 1e-11           /* turns below this are rounding */
-#define CUSP_MARGIN 1e-7             /* |turn| > pi - this: a cusp */
+/* |turn| > pi - this: a cusp. Tangent estimates beside a cusp are good to
+ * about 1e-7 rad, so a hairpin must turn back within 1e-5 rad of pi to be
+ * taken for a cusp. */
+#define CUSP_MARGIN 1e-5
 
 /* cos(m pi / 14), m = 0..27: Chebyshev-Lobatto abscissae and the cosine
  * transform of NPTS = 15 points */
@@ -195,6 +198,12 @@ static km_status push_piece(builder *b, double s0, double s1,
 }
 
 static km_status push_corner(builder *b, double s, double turn) {
+  if (b->ncorners > 0 && s - b->corners[b->ncorners - 1].s <= 1e-14 * b->L) {
+    /* one corner seen in several steps: one turn */
+    b->corners[b->ncorners - 1].turn =
+        km__wrap_angle(b->corners[b->ncorners - 1].turn + turn);
+    return KM_OK;
+  }
   if (b->ncorners == b->ccap) {
     size_t cap = b->ccap ? 2 * b->ccap : 16;
     km_corner *c = realloc(b->corners, cap * sizeof *c);
@@ -398,9 +407,13 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
                       "the tangent reverses at parameter t = %g (a cusp): "
                       "the curve is not regular there",
                       mid);
-    if (fabs(turn) > CORNER_NOISE) {
+    /* bisection toward a degenerate end ends in such pieces whose turns
+     * are estimation noise; only a turn the tolerance can see is kept */
+    if (fabs(turn) > fmax(CORNER_NOISE, b->tol_theta)) {
       km_status st = push_corner(b, *s_at, km__wrap_angle(turn));
       if (st) return st;
+    } else {
+      th[NPTS - 1] = th[0];
     }
     *theta = th[NPTS - 1];
     return KM_OK;
@@ -494,7 +507,7 @@ km_status km_signature_compute(const km_curve *c, double tol,
     poly += hypot(c->cp[2 * i] - c->cp[2 * i - 2],
                   c->cp[2 * i + 1] - c->cp[2 * i - 1]);
   double L = 0.0;
-  for (size_t i = (size_t)c->degree; i < c->n; i++) {
+  for (size_t i = (size_t)c->degree; i < c->n && poly > 0; i++) {
     span_len[i] = c->knots[i + 1] > c->knots[i]
                       ? km__length_adaptive(c, c->knots[i], c->knots[i + 1],
                                             1e-15 * poly)
