@@ -188,6 +188,8 @@ static inline void at_curve_from_json(const cJSON *c, at_curve *out) {
   const cJSON *deg = cJSON_GetObjectItemCaseSensitive(c, "degree");
   const cJSON *pts = cJSON_GetObjectItemCaseSensitive(c, "control_points");
   assert_true(cJSON_IsNumber(deg));
+  /* de Boor below is for polynomial curves only. */
+  assert_null(cJSON_GetObjectItemCaseSensitive(c, "weights"));
   out->degree = deg->valueint;
   out->knots = at_numbers(cJSON_GetObjectItemCaseSensitive(c, "knots"), &nk);
   assert_true(cJSON_IsArray(pts));
