@@ -170,6 +170,8 @@ typedef struct builder {
   size_t m, cap;
   km_corner *corners;
   size_t ncorners, ccap;
+  double pending_start; /* theta the next piece must start from, or NAN */
+  size_t span_first;    /* index of the current span's first piece */
   km_error *err;
 } builder;
 
@@ -407,13 +409,19 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
                       "the tangent reverses at parameter t = %g (a cusp): "
                       "the curve is not regular there",
                       mid);
-    /* bisection toward a degenerate end ends in such pieces whose turns
-     * are estimation noise; only a turn the tolerance can see is kept */
-    if (fabs(turn) > fmax(CORNER_NOISE, b->tol_theta)) {
+    /* Bisection toward a degenerate end ends in such pieces: the turning
+     * they carry is real (kappa ~ 1/sqrt(s) there) but concentrated in a
+     * length below resolution. A small turn is handed to the neighbouring
+     * piece, whose end value absorbs it, so a smooth curve reports no
+     * corner; a large one is a corner. */
+    double prev_end = b->m > 0 ? b->s[b->m] : -1.0;
+    if (fabs(turn) < 1e-3 && b->m > b->span_first && prev_end == *s_at) {
+      b->th[(b->m - 1) * (THETA_DEGREE + 1) + THETA_DEGREE] += turn;
+    } else if (fabs(turn) < 1e-3) {
+      if (isnan(b->pending_start)) b->pending_start = th[0];
+    } else {
       km_status st = push_corner(b, *s_at, km__wrap_angle(turn));
       if (st) return st;
-    } else {
-      th[NPTS - 1] = th[0];
     }
     *theta = th[NPTS - 1];
     return KM_OK;
@@ -462,6 +470,10 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
     ok = true;
   }
   if (ok) {
+    if (!isnan(b->pending_start)) {
+      coef[0] = b->pending_start;
+      b->pending_start = NAN;
+    }
     km_status st = push_piece(b, s[0], s[NPTS - 1], coef);
     if (st) return st;
     *s_at = s[NPTS - 1];
@@ -491,10 +503,15 @@ static km_status check_turn(builder *b, double turn, double t, double s) {
 
 km_status km_signature_compute(const km_curve *c, double tol,
                                km_signature *out, km_error *err) {
+  if (!c || !c->knots || !c->cp || c->degree < KM_MIN_DEGREE ||
+      c->degree > KM_MAX_DEGREE || c->n < (size_t)c->degree + 1)
+    return km__fail(err, KM_EINVAL, KM_FIELD_NONE, -1, NAN,
+                    "not a valid curve (empty or never created)");
   builder b;
   memset(&b, 0, sizeof b);
   b.c = c;
   b.err = err;
+  b.pending_start = NAN;
   km_status st = KM_OK;
   km_pp kp;
   km__pp_init(&kp);
@@ -507,6 +524,7 @@ km_status km_signature_compute(const km_curve *c, double tol,
     poly += hypot(c->cp[2 * i] - c->cp[2 * i - 2],
                   c->cp[2 * i + 1] - c->cp[2 * i - 1]);
   double L = 0.0;
+  for (size_t i = 0; i < c->n; i++) span_len[i] = 0.0;
   for (size_t i = (size_t)c->degree; i < c->n && poly > 0; i++) {
     span_len[i] = c->knots[i + 1] > c->knots[i]
                       ? km__length_adaptive(c, c->knots[i], c->knots[i + 1],
@@ -557,8 +575,22 @@ km_status km_signature_compute(const km_curve *c, double tol,
       if (st) goto cleanup;
       theta += turn;
     }
+    size_t m0 = b.m, c0 = b.ncorners;
+    b.span_first = m0;
+    double s_start = s_at;
     st = fit_piece(&b, ua, ub, len, &s_at, &theta, da, db, 0);
     if (st) goto cleanup;
+    /* the span's pieces must end exactly at its arc length: knots are
+     * breakpoints at their exact images */
+    if (b.m > m0 && s_at - s_start > 0) {
+      double f = len / (s_at - s_start);
+      for (size_t q = m0 + 1; q <= b.m; q++) b.s[q] = s_start + (b.s[q] - s_start) * f;
+      for (size_t q = c0; q < b.ncorners; q++)
+        if (b.corners[q].s > s_start)
+          b.corners[q].s = s_start + (b.corners[q].s - s_start) * f;
+      s_at = s_start + len;
+      b.s[b.m] = s_at;
+    }
     prev_dir[0] = db[0];
     prev_dir[1] = db[1];
   }
