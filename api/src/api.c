@@ -2,12 +2,13 @@
  * problem+json, request parsing and dispatch of one request to its route.
  *
  * DESIGN: a body is first checked by a small strict RFC 8259 scanner
- * (syntax, UTF-8, nesting depth) and only then handed to cJSON. cJSON's
- * own failure path writes a process-wide static (the one behind
- * cJSON_GetErrorPtr), a data race when many threads parse bad input; with
- * the scanner in front, cJSON only fails on out-of-memory. The scanner also
- * gives the byte offset of a syntax error for the problem detail, and it
- * bounds recursion depth before cJSON's recursive descent starts.
+ * (syntax, UTF-8, nesting depth), which gives the byte offset of a syntax
+ * error for the problem detail and bounds the depth before any recursion
+ * that builds a tree. The tree is then built here with cJSON's item
+ * constructors rather than by cJSON_ParseWithLengthOpts: that function
+ * writes a process-wide static (the record behind cJSON_GetErrorPtr) on
+ * every call, success included, which is a data race when the daemon's
+ * threads parse requests at once. Bodies need no NUL terminator.
  */
 #include <ctype.h>
 #include <stdarg.h>
@@ -334,6 +335,20 @@ static bool scan_utf8(scan *s) {
   return true;
 }
 
+static unsigned hexval(unsigned char c) {
+  return isdigit(c) ? (unsigned)(c - '0') : (unsigned)(tolower(c) - 'a' + 10);
+}
+
+static bool scan_hex4(scan *s, unsigned *cp) {
+  *cp = 0;
+  for (int i = 0; i < 4; i++, s->p++) {
+    if (s->p >= s->end || !isxdigit(*s->p))
+      return scan_fail(s, "invalid \\u escape");
+    *cp = (*cp << 4) | hexval(*s->p);
+  }
+  return true;
+}
+
 static bool scan_string(scan *s) {
   s->p++; /* opening quote */
   while (s->p < s->end) {
@@ -350,10 +365,27 @@ static bool scan_string(scan *s) {
         break;
       c = *s->p;
       if (c == 'u') {
+        unsigned cp;
         s->p++;
-        for (int i = 0; i < 4; i++, s->p++)
-          if (s->p >= s->end || !isxdigit(*s->p))
-            return scan_fail(s, "invalid \\u escape");
+        if (!scan_hex4(s, &cp))
+          return false;
+        /* Only whole characters: a high surrogate must be followed by a
+         * low one, and NUL would cut the C string short. */
+        if (cp == 0)
+          return scan_fail(s, "\\u0000 is not accepted in strings");
+        if (cp >= 0xdc00 && cp <= 0xdfff)
+          return scan_fail(s, "lone low surrogate in \\u escape");
+        if (cp >= 0xd800 && cp <= 0xdbff) {
+          unsigned lo;
+          if ((size_t)(s->end - s->p) < 2 || s->p[0] != '\\' ||
+              s->p[1] != 'u')
+            return scan_fail(s, "lone high surrogate in \\u escape");
+          s->p += 2;
+          if (!scan_hex4(s, &lo))
+            return false;
+          if (lo < 0xdc00 || lo > 0xdfff)
+            return scan_fail(s, "lone high surrogate in \\u escape");
+        }
         continue;
       }
       if (strchr("\"\\/bfnrt", c) == NULL || c == '\0')
@@ -427,9 +459,179 @@ static bool scan_value(scan *s) {
   }
 }
 
+/* ------------------------------------------------- tree from valid text */
+
+/* Builds the cJSON tree from text the scanner accepted, so nothing here
+ * can be malformed; the only failure is out-of-memory (NULL). It exists
+ * because cJSON_ParseWithLengthOpts resets cJSON's process-wide error
+ * record on every call, success included: concurrent requests would race
+ * on it. cJSON_Create* and cJSON_Add* only read cJSON's global hooks. */
+typedef struct build {
+  const unsigned char *p;
+} build;
+
+static void build_ws(build *b) {
+  while (*b->p == ' ' || *b->p == '\t' || *b->p == '\n' || *b->p == '\r')
+    b->p++;
+}
+
+static unsigned build_hex4(build *b) {
+  unsigned cp = 0;
+  for (int i = 0; i < 4; i++)
+    cp = (cp << 4) | hexval(*b->p++);
+  return cp;
+}
+
+static size_t put_utf8(unsigned char *o, unsigned cp) {
+  if (cp < 0x80) {
+    o[0] = (unsigned char)cp;
+    return 1;
+  }
+  if (cp < 0x800) {
+    o[0] = (unsigned char)(0xc0 | (cp >> 6));
+    o[1] = (unsigned char)(0x80 | (cp & 0x3f));
+    return 2;
+  }
+  if (cp < 0x10000) {
+    o[0] = (unsigned char)(0xe0 | (cp >> 12));
+    o[1] = (unsigned char)(0x80 | ((cp >> 6) & 0x3f));
+    o[2] = (unsigned char)(0x80 | (cp & 0x3f));
+    return 3;
+  }
+  o[0] = (unsigned char)(0xf0 | (cp >> 18));
+  o[1] = (unsigned char)(0x80 | ((cp >> 12) & 0x3f));
+  o[2] = (unsigned char)(0x80 | ((cp >> 6) & 0x3f));
+  o[3] = (unsigned char)(0x80 | (cp & 0x3f));
+  return 4;
+}
+
+/* A string token, decoded into a malloc'd NUL-terminated buffer. Decoded
+ * text is never longer than the token (an escape of 6 or 12 bytes yields
+ * at most 4). */
+static char *build_string(build *b) {
+  const unsigned char *q = ++b->p;
+  size_t n = 0;
+  unsigned char *o;
+  while (*q != '"')
+    q += *q == '\\' ? 2 : 1;
+  o = malloc((size_t)(q - b->p) + 1);
+  if (o == NULL)
+    return NULL;
+  while (*b->p != '"') {
+    unsigned char c = *b->p++;
+    if (c != '\\') {
+      o[n++] = c;
+      continue;
+    }
+    c = *b->p++;
+    switch (c) {
+    case 'b': o[n++] = '\b'; break;
+    case 'f': o[n++] = '\f'; break;
+    case 'n': o[n++] = '\n'; break;
+    case 'r': o[n++] = '\r'; break;
+    case 't': o[n++] = '\t'; break;
+    case 'u': {
+      unsigned cp = build_hex4(b);
+      if (cp >= 0xd800 && cp <= 0xdbff) {
+        b->p += 2;
+        cp = 0x10000 + ((cp - 0xd800) << 10) + (build_hex4(b) - 0xdc00);
+      }
+      n += put_utf8(o + n, cp);
+      break;
+    }
+    default: o[n++] = c; break; /* " \ / */
+    }
+  }
+  b->p++;
+  o[n] = '\0';
+  return (char *)o;
+}
+
+static cJSON *build_number(build *b) {
+  const unsigned char *start = b->p;
+  char small[64], *text = small, *end;
+  size_t n;
+  double v;
+  while (*b->p != '\0' && strchr("+-0123456789.eE", *b->p) != NULL)
+    b->p++;
+  n = (size_t)(b->p - start);
+  if (n >= sizeof small && (text = malloc(n + 1)) == NULL)
+    return NULL;
+  memcpy(text, start, n);
+  text[n] = '\0';
+  v = strtod(text, &end);
+  if (text != small)
+    free(text);
+  return cJSON_CreateNumber(v);
+}
+
+static cJSON *build_value(build *b);
+
+static cJSON *build_container(build *b, bool object) {
+  cJSON *c = object ? cJSON_CreateObject() : cJSON_CreateArray();
+  if (c == NULL)
+    return NULL;
+  b->p++;
+  build_ws(b);
+  if (*b->p == '}' || *b->p == ']') {
+    b->p++;
+    return c;
+  }
+  for (;;) {
+    char *key = NULL;
+    cJSON *v;
+    if (object) {
+      build_ws(b);
+      if ((key = build_string(b)) == NULL)
+        goto fail;
+      build_ws(b);
+      b->p++; /* ':' */
+    }
+    v = build_value(b);
+    if (v == NULL) {
+      free(key);
+      goto fail;
+    }
+    if (object) {
+      bool added = cJSON_AddItemToObject(c, key, v);
+      free(key);
+      if (!added) {
+        cJSON_Delete(v);
+        goto fail;
+      }
+    } else {
+      cJSON_AddItemToArray(c, v);
+    }
+    build_ws(b);
+    if (*b->p++ == ',')
+      continue;
+    return c; /* '}' or ']' */
+  }
+fail:
+  cJSON_Delete(c);
+  return NULL;
+}
+
+static cJSON *build_value(build *b) {
+  build_ws(b);
+  switch (*b->p) {
+  case '{': return build_container(b, true);
+  case '[': return build_container(b, false);
+  case '"': {
+    char *str = build_string(b);
+    cJSON *v = str != NULL ? cJSON_CreateString(str) : NULL;
+    free(str);
+    return v;
+  }
+  case 't': b->p += 4; return cJSON_CreateTrue();
+  case 'f': b->p += 5; return cJSON_CreateFalse();
+  case 'n': b->p += 4; return cJSON_CreateNull();
+  default: return build_number(b);
+  }
+}
+
 cJSON *api__parse_body(api_ctx *ctx, const char *body, size_t length) {
   scan s;
-  const char *end = NULL;
   cJSON *root;
   if (length > ctx->cfg->max_body_bytes) {
     api__failf(ctx, 413, API_P_TOO_LARGE, "Body too large", NULL,
@@ -463,9 +665,25 @@ cJSON *api__parse_body(api_ctx *ctx, const char *body, size_t length) {
                  "%s at byte %zu", s.error, (size_t)(s.p - s.start));
     return NULL;
   }
-  root = cJSON_ParseWithLengthOpts(body, length, &end, false);
+  {
+    /* The builder reads up to the end of the one value, which the scanner
+     * proved lies within `length`; a NUL-terminated copy keeps its
+     * look-ahead (number tokens) inside the buffer. */
+    char *copy = malloc(length + 1);
+    build b;
+    if (copy == NULL) {
+      api__oom(ctx);
+      return NULL;
+    }
+    memcpy(copy, s.start, length);
+    copy[length] = '\0';
+    b.p = (const unsigned char *)copy;
+    if (length >= 3 && memcmp(copy, "\xef\xbb\xbf", 3) == 0)
+      b.p += 3;
+    root = build_value(&b);
+    free(copy);
+  }
   if (root == NULL) {
-    /* The scanner accepted it, so this is cJSON running out of memory. */
     api__oom(ctx);
     return NULL;
   }

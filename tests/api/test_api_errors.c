@@ -35,6 +35,21 @@ static void invalid_utf8_is_400(void **state) {
   at_problem(SIG, "{\"curve\":\"\xed\xa0\x80\"}", 400, NULL); /* surrogate */
 }
 
+static void string_escapes_are_decoded(void **state) {
+  (void)state;
+  /* "\u0062spline" is "bspline": the curve is read, and its (missing)
+   * knots are what is reported. A surrogate pair elsewhere is fine. */
+  at_problem(SIG,
+             "{\"note\":\"\\ud83d\\ude00 \\\"q\\\" \\/\","
+             "\"curve\":{\"type\":\"\\u0062spline\",\"degree\":1,"
+             "\"control_points\":[[0,0],[1,1]]}}",
+             422, "/curve/knots");
+  at_problem(SIG, "{\"a\":\"\\ud83d\"}", 400, NULL);
+  at_problem(SIG, "{\"a\":\"\\ude00\"}", 400, NULL);
+  at_problem(SIG, "{\"a\":\"\\u0000\"}", 400, NULL);
+  at_problem(SIG, "{\"a\":\"\\u12G4\"}", 400, NULL);
+}
+
 static void body_without_nul_is_read_to_its_length(void **state) {
   (void)state;
   /* The bytes after `length` must not be read: here they would make the
@@ -370,6 +385,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(malformed_json_is_400),
       cmocka_unit_test(invalid_utf8_is_400),
+      cmocka_unit_test(string_escapes_are_decoded),
       cmocka_unit_test(body_without_nul_is_read_to_its_length),
       cmocka_unit_test(nesting_deeper_than_the_limit_is_400),
       cmocka_unit_test(non_object_body_is_422_at_root),
