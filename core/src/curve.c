@@ -295,39 +295,49 @@ double km__speed(const km_curve *c, double t) {
   return sqrt(d[1][0] * d[1][0] + d[1][1] * d[1][1]);
 }
 
-static double gl_speed(const km_curve *c, double a, double b, int n16) {
+static double speed_of_curve(const void *ctx, double t) {
+  return km__speed((const km_curve *)ctx, t);
+}
+
+static double gl_rule(km__scalar_fn f, const void *ctx, double a, double b,
+                      int n16) {
   double m = 0.5 * (a + b), h = 0.5 * (b - a), sum = 0.0;
   const double *x = n16 ? km__gl16_x : km__gl8_x;
   const double *w = n16 ? km__gl16_w : km__gl8_w;
   int n = n16 ? 16 : 8;
-  for (int k = 0; k < n; k++) sum += w[k] * km__speed(c, m + h * x[k]);
+  for (int k = 0; k < n; k++) sum += w[k] * f(ctx, m + h * x[k]);
   return sum * h;
 }
 
-static double length_rec(const km_curve *c, double a, double b,
-                         double abs_tol, int depth, long *budget) {
-  double g8 = gl_speed(c, a, b, 0), g16 = gl_speed(c, a, b, 1);
+static double integrate_rec(km__scalar_fn f, const void *ctx, double a,
+                            double b, double abs_tol, int depth,
+                            long *budget) {
+  double g8 = gl_rule(f, ctx, a, b, 0), g16 = gl_rule(f, ctx, a, b, 1);
   /* For an integrand analytic near [a, b] the n-point error falls
    * geometrically with n, so the 16-point error is about the square of the
    * relative 8-point error; below a few ulps of the value itself nothing
-   * more can be gained. */
+   * more can be gained. The budget bounds the work on pathological
+   * integrands (a speed that is rounding noise around zero). */
   double d = fabs(g16 - g8), mag = fabs(g16);
   double est16 = d < 1e-3 * mag ? d * d / mag : d;
-  /* the budget bounds the work on pathological integrands (a speed that is
-   * rounding noise around zero) */
   if (est16 <= fmax(abs_tol, 8e-16 * mag) || depth >= 40 || --*budget <= 0 ||
       !(b - a > 1e-300))
     return g16;
   double m = 0.5 * (a + b);
-  return length_rec(c, a, m, 0.5 * abs_tol, depth + 1, budget) +
-         length_rec(c, m, b, 0.5 * abs_tol, depth + 1, budget);
+  return integrate_rec(f, ctx, a, m, 0.5 * abs_tol, depth + 1, budget) +
+         integrate_rec(f, ctx, m, b, 0.5 * abs_tol, depth + 1, budget);
+}
+
+double km__integrate_adaptive(km__scalar_fn f, const void *ctx, double a,
+                              double b, double abs_tol) {
+  if (!(b > a)) return 0.0;
+  long budget = 4096;
+  return integrate_rec(f, ctx, a, b, abs_tol, 0, &budget);
 }
 
 double km__length_adaptive(const km_curve *c, double a, double b,
                            double abs_tol) {
-  if (!(b > a)) return 0.0;
-  long budget = 4096;
-  return length_rec(c, a, b, abs_tol, 0, &budget);
+  return km__integrate_adaptive(speed_of_curve, c, a, b, abs_tol);
 }
 
 /* A scale for absolute tolerances: the control polygon's length bounds the
@@ -400,4 +410,57 @@ double km_curve_param_at_length(const km_curve *c, double s) {
     t = tn;
   }
   return t;
+}
+
+/* Bezier form of one span by blossoming the homogeneous control points:
+ * b_k = f(a^(p-k), b^k). */
+void km__bspan_make(km__bspan *sp, const km_curve *c, size_t i) {
+  int p = c->degree;
+  const double *U = c->knots;
+  double a = U[i], b = U[i + 1];
+  sp->degree = p;
+  sp->a = a;
+  sp->b = b;
+  sp->rational = c->w != NULL;
+  for (int k = 0; k <= p; k++) {
+    double d[KM__BSPAN_MAX][3];
+    for (int j = 0; j <= p; j++) {
+      size_t g = i - (size_t)p + (size_t)j;
+      double w = c->w ? c->w[g] : 1.0;
+      d[j][0] = c->cp[2 * g] * w;
+      d[j][1] = c->cp[2 * g + 1] * w;
+      d[j][2] = w;
+    }
+    for (int r = 1; r <= p; r++) {
+      double u = r <= p - k ? a : b;
+      for (int j = p; j >= r; j--) {
+        double lo = U[i - (size_t)p + (size_t)j];
+        double hi = U[i + 1 + (size_t)j - (size_t)r];
+        double al = (u - lo) / (hi - lo);
+        for (int q = 0; q < 3; q++) d[j][q] = (1.0 - al) * d[j - 1][q] + al * d[j][q];
+      }
+    }
+    for (int q = 0; q < 3; q++) sp->h[k][q] = d[p][q];
+  }
+}
+
+void km__bspan_eval(const km__bspan *sp, double t, double pos[2],
+                    double der[2]) {
+  int p = sp->degree;
+  double len = sp->b - sp->a, u = (t - sp->a) / len, v = 1.0 - u;
+  double d[KM__BSPAN_MAX][3];
+  memcpy(d, sp->h, sizeof(double) * 3 * (size_t)(p + 1));
+  for (int r = 1; r < p; r++)
+    for (int j = 0; j <= p - r; j++)
+      for (int q = 0; q < 3; q++) d[j][q] = v * d[j][q] + u * d[j + 1][q];
+  double H[3], dH[3];
+  for (int q = 0; q < 3; q++) {
+    H[q] = v * d[0][q] + u * d[1][q];
+    dH[q] = p * (d[1][q] - d[0][q]) / len;
+  }
+  double w = H[2];
+  pos[0] = H[0] / w;
+  pos[1] = H[1] / w;
+  der[0] = (dH[0] - pos[0] * dH[2]) / w;
+  der[1] = (dH[1] - pos[1] * dH[2]) / w;
 }

@@ -13,6 +13,7 @@
 #include "km/status.h"
 
 #define KM_PI 3.14159265358979323846
+#define KM__BSPAN_MAX 10 /* KM_MAX_DEGREE + 1 */
 
 /* Record an error: code, field, element index, parameter and a message
  * formatted by km__format (a small printf subset: %s %d %ld %zu %g; no
@@ -38,6 +39,24 @@ extern const double km__gl16_x[16], km__gl16_w[16];
 double km__speed(const km_curve *c, double t);
 double km__length_adaptive(const km_curve *c, double a, double b,
                            double abs_tol);
+/* Adaptive Gauss-Legendre (8 vs 16 points, bisection) of f over [a, b]. */
+typedef double (*km__scalar_fn)(const void *ctx, double t);
+double km__integrate_adaptive(km__scalar_fn f, const void *ctx, double a,
+                              double b, double abs_tol);
+
+/* One knot span of a curve in Bezier form (homogeneous x w, y w, w), for
+ * fast evaluation of position and first derivative inside the span. */
+typedef struct km__bspan {
+  int degree;
+  double a, b;                          /* parameter interval */
+  double h[KM__BSPAN_MAX][3];           /* homogeneous control points */
+  bool rational;
+} km__bspan;
+/* Fill sp with span [knots[i], knots[i+1]] of c (a non-empty span). */
+void km__bspan_make(km__bspan *sp, const km_curve *c, size_t i);
+/* Position and derivative with respect to t at t in [a, b]. */
+void km__bspan_eval(const km__bspan *sp, double t, double pos[2],
+                    double der[2]);
 
 /* Span index i with knots[i] <= t < knots[i+1] (last non-empty span at the
  * domain end); side < 0 picks knots[i] < t <= knots[i+1]. */

@@ -172,6 +172,7 @@ typedef struct builder {
   size_t ncorners, ccap;
   double pending_start; /* theta the next piece must start from, or NAN */
   size_t span_first;    /* index of the current span's first piece */
+  km__bspan span;       /* the current span in Bezier form */
   km_error *err;
 } builder;
 
@@ -303,6 +304,17 @@ static void bernstein_row(double u, int d, double *row) {
   }
 }
 
+static double span_speed_at(const void *ctx, double t) {
+  double p[2], d[2];
+  km__bspan_eval(ctx, t, p, d);
+  return sqrt(d[0] * d[0] + d[1] * d[1]);
+}
+
+/* arc length inside the current span */
+static double span_length(const builder *b, double ua, double ub) {
+  return km__integrate_adaptive(span_speed_at, &b->span, ua, ub, 1e-15 * b->L);
+}
+
 /* Cumulative integral of f sampled at the Chebyshev-Lobatto points
  * x_k = -cos(k pi / n) of [-1, 1] (k = 0..n): F_k = integral from -1 to x_k
  * of the degree-n interpolant (spectral integration; exact for
@@ -361,7 +373,7 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
   double speed[NPTS], F[NPTS];
   for (int k = 0; k < NPTS; k++) {
     double d[2][2];
-    km_curve_eval(b->c, t[k], 1, d);
+    km__bspan_eval(&b->span, t[k], d[0], d[1]);
     double n = sqrt(d[1][0] * d[1][0] + d[1][1] * d[1][1]);
     speed[k] = n;
     if (k == 0 || k == NPTS - 1) continue;
@@ -389,13 +401,11 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
   cheb_cumulative(speed, NPTS - 1, F);
   for (int k = 0; k < NPTS; k++) s[k] = *s_at + half * F[k];
   double h = s[NPTS - 1] - s[0];
-  double ref = known_len > 0 ? known_len
-                             : km__length_adaptive(b->c, ua, ub, 1e-15 * b->L);
+  double ref = known_len > 0 ? known_len : span_length(b, ua, ub);
   if (fabs(h - ref) > 1e-14 * b->L + 1e-13 * ref) {
     /* the speed is not resolved by the nodes (near-degenerate leg) */
     for (int k = 1; k < NPTS; k++)
-      s[k] = s[k - 1] +
-             km__length_adaptive(b->c, t[k - 1], t[k], 1e-15 * b->L);
+      s[k] = s[k - 1] + span_length(b, t[k - 1], t[k]);
   }
   s[NPTS - 1] = s[0] + ref;
   h = ref;
@@ -526,10 +536,12 @@ km_status km_signature_compute(const km_curve *c, double tol,
   double L = 0.0;
   for (size_t i = 0; i < c->n; i++) span_len[i] = 0.0;
   for (size_t i = (size_t)c->degree; i < c->n && poly > 0; i++) {
-    span_len[i] = c->knots[i + 1] > c->knots[i]
-                      ? km__length_adaptive(c, c->knots[i], c->knots[i + 1],
-                                            1e-15 * poly)
-                      : 0.0;
+    if (c->knots[i + 1] > c->knots[i]) {
+      km__bspan sp;
+      km__bspan_make(&sp, c, i);
+      span_len[i] = km__integrate_adaptive(span_speed_at, &sp, c->knots[i],
+                                           c->knots[i + 1], 1e-15 * poly);
+    }
     L += span_len[i];
   }
   km_curve_domain(c, &t0, &t1);
@@ -555,6 +567,7 @@ km_status km_signature_compute(const km_curve *c, double tol,
     double len = span_len[i];
     if (!(len > 1e-15 * L)) continue; /* a span that is a single point */
     b.span_t = ub - ua;
+    km__bspan_make(&b.span, c, i);
     b.span_speed = len / (ub - ua);
     double da[2], db[2];
     if (!tangent_limit(&b, ua, 1, da) || !tangent_limit(&b, ub, -1, db)) {
