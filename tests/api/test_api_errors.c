@@ -183,6 +183,21 @@ static void non_finite_numbers_are_422(void **state) {
              "/tolerance");
 }
 
+static void bad_svg_path_names_d_and_the_offset(void **state) {
+  (void)state;
+  /* "L 1" lacks its y coordinate; the message says where. */
+  cJSON *j = at_expect_problem(
+      SIG, "{\"curve\":{\"type\":\"svg\",\"d\":\"M 0 0 L 1\"}}", 422,
+      "/curve/d");
+  const cJSON *m = cJSON_GetObjectItem(
+      cJSON_GetArrayItem(cJSON_GetObjectItem(j, "errors"), 0), "message");
+  assert_non_null(strstr(m->valuestring, "offset"));
+  cJSON_Delete(j);
+  at_problem(SIG, "{\"curve\":{\"type\":\"svg\",\"d\":\"Q\"}}", 422,
+             "/curve/d");
+  at_problem(SIG, "{\"curve\":{\"type\":\"svg\"}}", 422, "/curve/d");
+}
+
 static void decreasing_knot_is_named(void **state) {
   (void)state;
   cJSON *j = at_expect_problem(
@@ -393,6 +408,7 @@ int main(void) {
       cmocka_unit_test(unknown_route_is_404),
       cmocka_unit_test(missing_and_mistyped_fields_name_the_field),
       cmocka_unit_test(non_finite_numbers_are_422),
+      cmocka_unit_test(bad_svg_path_names_d_and_the_offset),
       cmocka_unit_test(decreasing_knot_is_named),
       cmocka_unit_test(wrong_knot_count_is_named),
       cmocka_unit_test(degree_out_of_range_is_named),

@@ -162,6 +162,23 @@ static void signature_input_is_returned_as_given(void **state) {
   cJSON_Delete(j);
 }
 
+static void svg_path_signature_has_its_corner(void **state) {
+  (void)state;
+  /* Two sides of a 3-4-5 right angle, drawn in SVG: length 7, straight
+   * pieces, one corner of +pi/2 at s = 3 (y points down in SVG data, but
+   * the service works in the coordinates as given). */
+  cJSON *j = signature_of(
+      "{\"curve\":{\"type\":\"svg\",\"d\":\"M 0 0 h 3 v 4\"}}");
+  const cJSON *sig = cJSON_GetObjectItemCaseSensitive(j, "signature");
+  assert_close(num(sig, "length"), 7.0, 1e-12);
+  const cJSON *corners = cJSON_GetObjectItemCaseSensitive(sig, "corners");
+  assert_int_equal(cJSON_GetArraySize(corners), 1);
+  assert_close(num(cJSON_GetArrayItem(corners, 0), "s"), 3.0, 1e-12);
+  assert_close(num(cJSON_GetArrayItem(corners, 0), "turn"), M_PI / 2, 1e-12);
+  assert_close(num(sig, "turning"), M_PI / 2, 1e-12);
+  cJSON_Delete(j);
+}
+
 static void unknown_top_level_fields_are_ignored(void **state) {
   (void)state;
   cJSON *j = signature_of(
@@ -198,6 +215,7 @@ int main(void) {
       cmocka_unit_test(segment_signature_is_straight),
       cmocka_unit_test(square_signature_has_four_right_angle_corners),
       cmocka_unit_test(signature_input_is_returned_as_given),
+      cmocka_unit_test(svg_path_signature_has_its_corner),
       cmocka_unit_test(unknown_top_level_fields_are_ignored),
       cmocka_unit_test(numbers_round_trip_through_json),
   };
