@@ -1,0 +1,165 @@
+# kmorph-lib.sh - shared by the kmorph curl scripts (sourced, not run):
+# the service URL, curve arguments, and one HTTP exchange that turns any
+# problem+json answer into a message on stderr and a non-zero exit.
+#
+# KMORPH_URL   the service (default http://127.0.0.1:8080)
+# KMORPH_CURL  extra curl options, e.g. "--max-time 30"
+
+KMORPH_URL=${KMORPH_URL:-http://127.0.0.1:8080}
+KMORPH_URL=${KMORPH_URL%/}
+km_prog=$(basename "$0")
+
+km_die() { echo "$km_prog: $*" >&2; exit 1; }
+km_usage_error() { echo "$km_prog: $*" >&2; echo "try '$km_prog -h'" >&2; exit 2; }
+
+command -v curl >/dev/null || km_die "curl is not installed"
+command -v jq >/dev/null || km_die "jq is not installed"
+
+# km_curve ARG: a curve object (JSON) on stdout. ARG is an SVG path d
+# string ("M 0 0 L 10 0"), a JSON curve object ('{"type": ...}'), @FILE
+# with either of those, or @- for standard input. A file holding a
+# signature (or a /v1/signature answer) becomes a signature curve.
+km_curve() {
+  local arg=$1 text
+  case $arg in
+    @-) text=$(cat) ;;
+    @*) [ -r "${arg#@}" ] || km_usage_error "cannot read ${arg#@}"; text=$(cat -- "${arg#@}") ;;
+    *) text=$arg ;;
+  esac
+  if printf '%s' "$text" | jq -e 'type == "object"' >/dev/null 2>&1; then
+    printf '%s' "$text" | jq -c '
+      if has("type") then .
+      elif has("signature") then {type: "signature", signature: .signature}
+      elif has("kappa") then {type: "signature", signature: .}
+      elif has("control_points") then {type: "bspline"} + .
+      else error("not a curve: expected type, signature, kappa or control_points") end' 2>/dev/null ||
+      km_usage_error "not a curve: $(printf '%.60s' "$text")"
+  else
+    case $text in
+      [MmZz]*|" "*) jq -cn --arg d "$text" '{type: "svg", d: $d}' ;;
+      *) km_usage_error "not an SVG path (must start with M) nor JSON: $(printf '%.60s' "$text")" ;;
+    esac
+  fi
+}
+
+# km_call METHOD PATH [BODY_FILE [ACCEPT]]: the answer's body goes to
+# $km_body (a temporary file), its status to $km_status and its headers
+# to $km_headers. Exits with a readable message on any error.
+km_tmp=$(mktemp -d "${TMPDIR:-/tmp}/kmorph.XXXXXX")
+trap 'rm -rf "$km_tmp"' EXIT
+km_body=$km_tmp/body
+km_headers=$km_tmp/headers
+km_call() {
+  local method=$1 path=$2 data=${3:-} accept=${4:-application/json}
+  local args=(-sS -X "$method" -o "$km_body" -D "$km_headers" -w '%{http_code}'
+              -H "Accept: $accept, application/problem+json")
+  [ -n "$data" ] && args+=(-H "Content-Type: application/json" --data-binary "@$data")
+  # shellcheck disable=SC2086
+  km_status=$(curl "${args[@]}" ${KMORPH_CURL:-} "$KMORPH_URL$path" 2>"$km_tmp/err") ||
+    km_die "cannot reach $KMORPH_URL: $(tail -n 1 "$km_tmp/err")"
+  if [ "$km_status" -ge 400 ]; then
+    if jq -e 'type == "object" and has("status")' "$km_body" >/dev/null 2>&1; then
+      jq -r --arg p "$km_prog" '"\($p): \(.status) \(.title): \(.detail // "")",
+             (.errors // [] | .[] | "  at \(.pointer): \(.message)")' "$km_body" >&2
+    else
+      echo "$km_prog: HTTP $km_status: $(head -c 300 "$km_body")" >&2
+    fi
+    exit 1
+  fi
+}
+
+# km_header NAME: the value of a response header of the last km_call.
+km_header() {
+  tr -d '\r' <"$km_headers" | awk -v n="$(printf '%s' "$1" | tr 'A-Z' 'a-z')" -F': ' \
+    'tolower($1) == n { sub(/^[^:]*: /, ""); print; exit }'
+}
+
+# Options shared by km-morph and km-job (their -h prints this).
+km_morph_options='  -n FRAMES    number of evenly spaced frames (default 11)
+  -T TIMES     explicit times instead, comma-separated: 0,0.25,1
+  -m METHOD    curvature (default) or linear
+  -b BLEND     turning (default) or paper
+  -M MATCHES   auto, or pairs of arc-length fractions as JSON: [[0.2,0.3]]
+  -c CLOSURE   closed curves: auto, lsq, c0, c1, g2, none
+  -a ANCHOR    placement: fit (default), start, centroid
+  -O ORIENT    closed curves: auto, keep
+  -t TOL       tolerance in the curves'"'"' units
+  -g DEGREE    3 or 5
+  -k           per-frame metrics (length, max |kappa|, self-intersections, ...)
+  -d           include each frame'"'"'s SVG path data (svg_d)
+  -l LAYOUT    answer in SVG: filmstrip, overlay, animate or curvature_plot
+  -o FILE      write the answer to FILE (FILE.svg asks for SVG, filmstrip
+               unless -l says otherwise) instead of standard output
+  -r FILE      start from the morph request in FILE (JSON); options and
+               curves given on the command line replace its fields
+FROM and TO are curves: an SVG path d string ("M 0 0 L 10 0 ..."), a JSON
+curve object, @FILE holding either (or a signature), or @- for stdin.'
+
+# km_morph_request ARGS...: parse the morph options and curves into the
+# request file $km_req; sets $km_out (output file or empty) and $km_svg
+# (1 when SVG is asked for).
+km_req=$km_tmp/request.json
+km_morph_request() {
+  local opt base='{}' edits=() OPTIND=1
+  km_out=
+  km_svg=0
+  local layout=
+  while getopts ':hn:T:m:b:M:c:a:O:t:g:kdl:o:r:' opt; do
+    case $opt in
+      h) km_help; exit 0 ;;
+      n) edits+=(--argjson n "$OPTARG" '.frames = $n | del(.times)') ;;
+      T) edits+=(--arg ts "$OPTARG" '.times = ($ts | split(",") | map(tonumber)) | del(.frames)') ;;
+      m) edits+=(--arg v "$OPTARG" '.method = $v') ;;
+      b) edits+=(--arg v "$OPTARG" '.blend = $v') ;;
+      M) if [ "$OPTARG" = auto ]; then edits+=('.matches = "auto"')
+         else edits+=(--argjson v "$OPTARG" '.matches = $v'); fi ;;
+      c) edits+=(--arg v "$OPTARG" '.closure = $v') ;;
+      a) edits+=(--arg v "$OPTARG" '.anchor = $v') ;;
+      O) edits+=(--arg v "$OPTARG" '.orient = $v') ;;
+      t) edits+=(--argjson v "$OPTARG" '.tolerance = $v') ;;
+      g) edits+=(--argjson v "$OPTARG" '.degree = $v') ;;
+      k) edits+=('.metrics = true') ;;
+      d) edits+=('.include = ((.include // []) + ["svg_d"] | unique)') ;;
+      l) layout=$OPTARG ;;
+      o) km_out=$OPTARG ;;
+      r) [ -r "$OPTARG" ] || km_usage_error "cannot read $OPTARG"; base=$(cat -- "$OPTARG") ;;
+      :) km_usage_error "-$OPTARG needs a value" ;;
+      *) km_usage_error "unknown option -$OPTARG" ;;
+    esac
+  done
+  shift $((OPTIND - 1))
+  printf '%s' "$base" | jq -e 'type == "object"' >/dev/null 2>&1 || km_usage_error "the -r request is not a JSON object"
+  printf '%s' "$base" >"$km_req"
+  if [ $# -eq 2 ]; then
+    local from to
+    from=$(km_curve "$1") || exit $?
+    to=$(km_curve "$2") || exit $?
+    jq -c --argjson a "$from" --argjson b "$to" '.from = $a | .to = $b' "$km_req" >"$km_req.new" && mv "$km_req.new" "$km_req"
+  elif [ $# -ne 0 ]; then
+    km_usage_error "give two curves, FROM and TO (or none with -r)"
+  fi
+  jq -e 'has("from") and has("to")' "$km_req" >/dev/null || km_usage_error "FROM and TO curves are needed"
+  case $km_out in *.svg) [ -n "$layout" ] || layout=filmstrip ;; esac
+  [ -n "$layout" ] && { km_svg=1; edits+=(--arg l "$layout" '.format = "svg" | .svg = ((.svg // {}) + {layout: $l})'); }
+  # Apply the edits one by one: each is [--arg name value ...] filter.
+  local i=0 n=${#edits[@]} a=()
+  while [ $i -lt $n ]; do
+    case ${edits[$i]} in
+      --arg|--argjson) a+=("${edits[$i]}" "${edits[$((i + 1))]}" "${edits[$((i + 2))]}"); i=$((i + 3)) ;;
+      *) jq -c "${a[@]}" "${edits[$i]}" "$km_req" >"$km_req.new" 2>"$km_tmp/err" ||
+           km_usage_error "bad option value: $(tail -n 1 "$km_tmp/err")"
+         mv "$km_req.new" "$km_req"; a=(); i=$((i + 1)) ;;
+    esac
+  done
+}
+
+# km_emit: the last answer's body to $km_out or standard output.
+km_emit() {
+  if [ -n "$km_out" ]; then
+    cp "$km_body" "$km_out" || km_die "cannot write $km_out"
+    echo "$km_prog: wrote $km_out ($(wc -c <"$km_out") bytes)" >&2
+  else
+    cat "$km_body"
+    [ "$(tail -c 1 "$km_body" | od -An -c | tr -d ' ')" = '\n' ] || echo
+  fi
+}

@@ -1,0 +1,175 @@
+#!/usr/bin/env bash
+# test_curl.sh - the curl scripts (clients/curl) against a live kmorphd:
+# usage, every endpoint, the job flow with progress, SVG output, and
+# errors (problem detail on stderr, non-zero exit). Expected numbers come
+# from circles and squares, not from the service. Prints "ok"/"FAIL" per
+# check and a closing "N passed, N failed" line.
+set -u
+here=$(cd "$(dirname "$0")" && pwd)
+. "$here/../lib/daemon.sh"
+bin=$km_root/clients/curl
+work=$(mktemp -d "${TMPDIR:-/tmp}/kmorph-curl-test.XXXXXX")
+passed=0
+failed=0
+check() { # check NAME COMMAND...: passes when COMMAND succeeds
+  local name=$1; shift
+  if ( "$@" ) >"$work/check.out" 2>&1; then passed=$((passed + 1)); echo "ok   $name"
+  else failed=$((failed + 1)); echo "FAIL $name"; sed 's/^/     | /' "$work/check.out" | tail -n 15; fi
+}
+# near A B EPS: |A - B| <= EPS
+near() { awk -v a="$1" -v b="$2" -v e="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; if (d <= e) exit 0; print a " is not within " e " of " b; exit 1 }'; }
+
+start_daemon --max-job-frames 50000 || { echo "0 passed, 1 failed"; exit 1; }
+trap 'stop_daemon; rm -rf "$work"' EXIT
+
+PI=3.141592653589793
+CIRCLE10="M 10 0 A 10 10 0 1 1 -10 0 A 10 10 0 1 1 10 0 Z"
+SQUARE100="M 0 0 L 100 0 L 100 100 L 0 100 Z"
+CIRCLE50="M 150 50 A 50 50 0 1 1 50 50 A 50 50 0 1 1 150 50 Z"
+SPIRAL_A='{"length": 4, "start": {"point": [0, 0], "angle": 0}, "kappa": {"degree": 1, "knots": [0, 0, 4, 4], "coefficients": [0, 4]}}'
+SPIRAL_B='{"length": 4, "start": {"point": [0, 0], "angle": 0}, "kappa": {"degree": 1, "knots": [0, 0, 4, 4], "coefficients": [0, -2]}}'
+
+t_usage() {
+  for s in km-signature km-reconstruct km-morph km-job km-job-status km-job-cancel km-health; do
+    out=$("$bin/$s" -h) || { echo "$s -h failed"; return 1; }
+    grep -q "^usage: $s" <<<"$out" || { echo "$s -h: $out"; return 1; }
+  done
+}
+check "every script prints usage with -h and exits 0" t_usage
+
+t_health() { [ "$("$bin/km-health")" = "ok ready" ]; }
+check "km-health says ok ready" t_health
+
+t_signature() {
+  "$bin/km-signature" -s 7 -t 1e-8 "$CIRCLE10" >"$work/sig.json" || return 1
+  near "$(jq .signature.length "$work/sig.json")" "$(awk -v p=$PI 'BEGIN{printf "%.17g\n", 20*p}')" 1e-6 &&
+  jq -e '.samples | length == 7 and all(.[]; (.[1] - 0.1 | fabs) < 1e-7)' "$work/sig.json" >/dev/null &&
+  near "$(jq '.signature.turning | fabs' "$work/sig.json")" "$(awk -v p=$PI 'BEGIN{printf "%.17g\n", 2*p}')" 1e-7
+}
+check "km-signature of a circle of radius 10: length 20 pi, kappa 1/10, turning 2 pi" t_signature
+
+t_reconstruct() {
+  "$bin/km-reconstruct" -t 1e-7 @"$work/sig.json" >"$work/rec.json" || return 1
+  near "$(jq .curve.length "$work/rec.json")" "$(awk -v p=$PI 'BEGIN{printf "%.17g\n", 20*p}')" 1e-5 &&
+  jq -e '.error_bound > 0 and .error_bound <= 1e-7' "$work/rec.json" >/dev/null &&
+  # Every control point of a cubic B-spline of a circle is at distance >= r from its centre.
+  jq -e '.curve.control_points | all(.[]; ((.[0] * .[0] + .[1] * .[1]) | sqrt) >= 10 - 1e-6)' "$work/rec.json" >/dev/null
+}
+check "km-reconstruct of that signature returns the circle (length 20 pi, bound within the tolerance)" t_reconstruct
+
+t_reconstruct_path() {
+  d=$("$bin/km-reconstruct" -p "$SPIRAL_A") || return 1
+  [[ $d == M0,0C* ]] && [[ $d != *Z ]]
+}
+check "km-reconstruct -p prints the paper's open spiral as path data from its start (0, 0)" t_reconstruct_path
+
+t_morph_lengths() {
+  "$bin/km-morph" -n 5 -k "$SQUARE100" "$CIRCLE50" >"$work/m.json" || return 1
+  [ "$(jq '.frames | length' "$work/m.json")" = 5 ] || return 1
+  # The turning blend interpolates length linearly: L_t = (1-t) 400 + t 100 pi.
+  for i in 0 1 2 3 4; do
+    want=$(awk -v i=$i -v p=$PI 'BEGIN { t = i / 4; printf "%.17g\n", (1 - t) * 400 + t * 100 * p }')
+    near "$(jq ".frames[$i].metrics.length" "$work/m.json")" "$want" 1e-6 || return 1
+  done
+}
+check "km-morph square -> circle: 5 frames whose lengths go linearly from 400 to 100 pi" t_morph_lengths
+
+t_morph_times() {
+  "$bin/km-morph" -T 0,0.3,1 -M auto -m curvature -a centroid -c lsq -t 1e-4 "$SQUARE100" "$CIRCLE50" >"$work/t.json" &&
+  [ "$(jq -c '[.frames[].t]' "$work/t.json")" = "[0,0.3,1]" ]
+}
+check "km-morph -T gives frames at exactly those times, with -M/-a/-c/-t accepted" t_morph_times
+
+t_morph_linear() {
+  "$bin/km-morph" -n 5 -k -m linear "$SPIRAL_A" "$SPIRAL_B" >"$work/lin.json" &&
+  "$bin/km-morph" -n 5 -k "$SPIRAL_A" "$SPIRAL_B" >"$work/cur.json" &&
+  jq -e '.method == "linear" and any(.frames[]; .metrics.self_intersections > 0)' "$work/lin.json" >/dev/null &&
+  jq -e '.method == "curvature" and all(.frames[]; .metrics.self_intersections == 0)' "$work/cur.json" >/dev/null
+}
+check "km-morph of the paper's spirals: linear self-intersects, curvature does not" t_morph_linear
+
+t_morph_request_file() {
+  jq -n --argjson a "$SPIRAL_A" --argjson b "$SPIRAL_B" \
+    '{from: {type: "signature", signature: $a}, to: {type: "signature", signature: $b}, frames: 9, include: ["svg_d"]}' >"$work/req.json"
+  "$bin/km-morph" -r "$work/req.json" -n 3 >"$work/r.json" &&
+  jq -e '(.frames | length) == 3 and all(.frames[]; .curve.svg_d | startswith("M"))' "$work/r.json" >/dev/null
+}
+check "km-morph -r takes a request file and options override its fields" t_morph_request_file
+
+t_morph_svg() {
+  "$bin/km-morph" -n 4 -o "$work/film.svg" "$SQUARE100" "$CIRCLE50" 2>/dev/null || return 1
+  head -c 200 "$work/film.svg" | grep -q "<svg" || return 1
+  if command -v xmllint >/dev/null; then xmllint --noout "$work/film.svg" || return 1; fi
+  "$bin/km-morph" -n 4 -l animate "$SQUARE100" "$CIRCLE50" | grep -q "<animate"
+}
+check "km-morph -o FILE.svg writes a well-formed SVG filmstrip; -l animate animates" t_morph_svg
+
+t_job() {
+  "$bin/km-job" -i 0.05 -n 4000 -k -o "$work/job.json" "$SQUARE100" "$CIRCLE50" 2>"$work/job.err" || { cat "$work/job.err"; return 1; }
+  grep -q "submitted" "$work/job.err" && grep -Eq "done 100% \(4000/4000 frames\)" "$work/job.err" || { cat "$work/job.err"; return 1; }
+  jq -e '(.frames | length) == 4000' "$work/job.json" >/dev/null || return 1
+  near "$(jq '.frames[2000].metrics.length' "$work/job.json")" "$(awk -v p=$PI 'BEGIN { t = 2000 / 3999; printf "%.17g\n", (1 - t) * 400 + t * 100 * p }')" 1e-6
+}
+check "km-job polls with progress to 'done 100%' and saves all 4000 frames" t_job
+
+t_job_svg() {
+  "$bin/km-job" -q -n 20 -o "$work/job.svg" "$SQUARE100" "$CIRCLE50" 2>/dev/null &&
+  head -c 200 "$work/job.svg" | grep -q "<svg"
+}
+check "km-job -o FILE.svg saves the job's result as SVG" t_job_svg
+
+t_job_status_cancel() {
+  "$bin/km-job" -q -n 3 "$SQUARE100" "$CIRCLE50" >/dev/null 2>"$work/q.err" || return 1
+  id=$(curl -s -X POST -H 'Content-Type: application/json' --data-binary @"$work/req.json" "$KMORPH_URL/v1/jobs" | jq -r .id)
+  for _ in $(seq 1 50); do
+    [ "$("$bin/km-job-status" "$id" | jq -r .state)" = done ] && break; sleep 0.1
+  done
+  "$bin/km-job-status" "$id" | jq -e '.state == "done" and .frames_total == 9' >/dev/null || return 1
+  "$bin/km-job-cancel" "$id" 2>/dev/null || return 1
+  # A finished job that was forgotten is gone: 404 with the problem on stderr.
+  if "$bin/km-job-status" "$id" 2>"$work/gone.err"; then return 1; fi
+  grep -q "404" "$work/gone.err"
+}
+check "km-job-status reports a done job; km-job-cancel forgets it; then status fails with 404" t_job_status_cancel
+
+t_job_interrupted() {
+  "$bin/km-job" -i 0.05 -n 50000 "$SQUARE100" "$CIRCLE50" >/dev/null 2>"$work/int.err" &
+  pid=$!
+  for _ in $(seq 1 100); do grep -q submitted "$work/int.err" && break; sleep 0.05; done
+  id=$(sed -n 's/.*job \([0-9a-f]*\) submitted.*/\1/p' "$work/int.err")
+  kill -TERM "$pid"
+  wait "$pid"
+  rc=$?
+  [ -n "$id" ] && [ "$rc" -ne 0 ] || { echo "id=$id rc=$rc"; cat "$work/int.err"; return 1; }
+  "$bin/km-job-status" "$id" | jq -e '.state == "cancelled" and .frames_done < 50000' >/dev/null
+}
+check "km-job stopped by a signal cancels its job on the service" t_job_interrupted
+
+t_invalid() {
+  if "$bin/km-morph" "M 0 0 L 1 0" "M 0 0 L 1 0 Z" >"$work/inv.out" 2>"$work/inv.err"; then return 1; fi
+  [ ! -s "$work/inv.out" ] && grep -q "422 Invalid curve" "$work/inv.err" && grep -q "at /to/d:" "$work/inv.err"
+}
+check "an invalid curve exits non-zero with the 422 problem detail and its JSON pointer" t_invalid
+
+t_bad_value() {
+  if "$bin/km-morph" -m sideways "$SQUARE100" "$CIRCLE50" 2>"$work/bv.err"; then return 1; fi
+  grep -q "/method" "$work/bv.err"
+}
+check "an unknown method exits non-zero naming /method" t_bad_value
+
+t_unreachable() {
+  if KMORPH_URL=http://127.0.0.1:9 "$bin/km-health" 2>"$work/un.err"; then return 1; fi
+  grep -q "cannot reach http://127.0.0.1:9" "$work/un.err"
+}
+check "an unreachable service exits non-zero saying which URL" t_unreachable
+
+t_usage_errors() {
+  "$bin/km-morph" "$SQUARE100" 2>/dev/null; [ $? -eq 2 ] || return 1
+  "$bin/km-morph" -x "$SQUARE100" "$CIRCLE50" 2>/dev/null; [ $? -eq 2 ] || return 1
+  "$bin/km-signature" "not a curve" 2>/dev/null; [ $? -eq 2 ] || return 1
+  "$bin/km-job-status" 2>/dev/null >/dev/null; [ $? -eq 2 ]
+}
+check "usage errors (missing curve, unknown option, not a curve) exit with status 2" t_usage_errors
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
