@@ -266,6 +266,16 @@ static void refine(ctx *x, size_t ka, double ua, size_t kb, double ub) {
   }
   if (fabs(ta - tb) <= x->eps_t) return; /* the same point of the curve */
   double na = hypot(Da[0], Da[1]), nb = hypot(Db[0], Db[1]);
+  /* Two parameters a few tolerances apart along the curve are one point
+   * seen twice (their positions agree to tol trivially), not a crossing:
+   * compare their distance along the curve with tol. */
+  {
+    const double *U = x->bz->knots;
+    double wa = U[(size_t)x->p * (ka + 2)] - U[(size_t)x->p * (ka + 1)];
+    double wb = U[(size_t)x->p * (kb + 2)] - U[(size_t)x->p * (kb + 1)];
+    double speed = fmax(wa > 0 ? na / wa : 0.0, wb > 0 ? nb / wb : 0.0);
+    if (fabs(ta - tb) * speed <= 4.0 * x->tol) return;
+  }
   if (!(na > 0 && nb > 0)) return;
   double sine = fabs(Da[0] * Db[1] - Da[1] * Db[0]) / (na * nb);
   if (!(sine >= MIN_CROSSING_SINE)) return;
