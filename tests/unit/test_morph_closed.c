@@ -1,0 +1,790 @@
+/* test_morph_closed.c - curvature morphs of closed curves: closure (lsq and
+ * the paper's c0 / c1 / g2), circles through circles, the paper blend's
+ * turning defect, corners as turning jumps, and the shape pairs of
+ * tests/fixtures/shapes.json (end frames, length law, closure, simple
+ * frames).
+ *
+ * Oracles: circles (distance to the centroid, curvature 1/r with
+ * r = (1-t) r_a + t r_b), the total turning L_t ((1-t) T_a/L_a + t T_b/L_b)
+ * of the paper's formula, corner turns (1-t) turn_a + t turn_b at frame arc
+ * length (1-t) s_a + t s_b, L_t = (1-t) L_a + t L_b, input curves sampled
+ * densely (compared as point sets, since the start of a closed `to` may be
+ * moved), and seams checked from both sides of the returned curve.
+ */
+#include <stdbool.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "fixtures.h"
+#include "km/curve.h"
+#include "km/morph.h"
+#include "km/reconstruct.h"
+#include "km/signature.h"
+#include "testutil.h"
+
+/* ---- inputs ------------------------------------------------------------- */
+
+static void make_curve(km_curve *c, int p, size_t n, const double *knots,
+                       const double *cp, const double *w, bool closed) {
+  km_error err;
+  km_curve_init(c);
+  assert_status(km_curve_create(c, p, n, knots, cp, w, closed, &err), KM_OK);
+}
+
+/* constant-curvature closed signature: a circle of radius r through
+ * (0, 0) heading +x, counter-clockwise */
+static void circle_signature(km_signature *sig, double r) {
+  const double knots[4] = {0, 0, 2 * M_PI * r, 2 * M_PI * r};
+  const double coef[2] = {1 / r, 1 / r};
+  km_fn kappa;
+  km_error err;
+  km_fn_init(&kappa);
+  assert_status(km_fn_create(&kappa, 1, 2, knots, coef, &err), KM_OK);
+  const double start[2] = {0, 0};
+  km_signature_init(sig);
+  assert_status(km_signature_create(sig, 2 * M_PI * r, start, 0.0, &kappa, NULL,
+                                    0, true, &err),
+                KM_OK);
+  km_fn_free(&kappa);
+}
+
+/* the unit circle (exact NURBS) and the ellipse x^2/4 + y^2 = 1 shifted by
+ * (0.5, 0.2) (the same NURBS stretched: affine maps are exact on NURBS) */
+static void circle_and_ellipse(km_curve *circle, km_curve *ellipse) {
+  double kn[12], cp[18], w[9];
+  tu_circle_nurbs(0, 0, 1, 1, kn, cp, w);
+  make_curve(circle, 2, 9, kn, cp, w, true);
+  for (int i = 0; i < 9; i++) {
+    cp[2 * i] = 2 * cp[2 * i] + 0.5;
+    cp[2 * i + 1] += 0.2;
+  }
+  make_curve(ellipse, 2, 9, kn, cp, w, true);
+}
+
+static void rounded_square(km_curve *c) {
+  double kn[20], cp[34], w[17];
+  tu_rounded_rect(-1, -1, 2, 2, 0.4, kn, cp, w);
+  make_curve(c, 2, 17, kn, cp, w, true);
+}
+
+/* a smooth five-pointed star r = 1.2 (1 + 0.25 cos 5 phi), interpolated
+ * through 100 points (periodic cubic) */
+static void smooth_star(km_curve *c) {
+  double pts[200];
+  for (int i = 0; i < 100; i++) {
+    double ph = 2 * M_PI * i / 100.0, r = 1.2 * (1 + 0.25 * cos(5 * ph));
+    pts[2 * i] = 0.3 + r * cos(ph);
+    pts[2 * i + 1] = -0.1 + r * sin(ph);
+  }
+  km_error err;
+  km_curve_init(c);
+  assert_status(km_curve_interpolate(c, pts, 100, true, &err), KM_OK);
+  assert_true(c->closed);
+}
+
+/* the square [-1,1]^2 as a closed polyline starting mid-bottom, so its
+ * corners sit at s = 1, 3, 5, 7 of L = 8 */
+static void square_polyline(km_curve *c) {
+  const double cp[12] = {0, -1, 1, -1, 1, 1, -1, 1, -1, -1, 0, -1};
+  const double kn[8] = {0, 0, 1, 3, 5, 7, 8, 8};
+  make_curve(c, 1, 6, kn, cp, NULL, true);
+}
+
+static void shape_curve(const char *pair, char which, km_curve *c) {
+  tf_bspline b;
+  assert_int_equal(tf_load_shape(pair, which, &b), 0);
+  make_curve(c, b.degree, b.n, b.knots, b.cp, b.w, b.closed);
+  tf_bspline_free(&b);
+}
+
+static const char *const PAIRS[6] = {"circle_to_star", "square_to_circle",
+                                     "U_to_S",         "spiral_open",
+                                     "arrow_rot90",    "crescent_to_heart"};
+
+/* ---- running a morph ---------------------------------------------------- */
+
+static km_morph *morph_new(const km_morph_input *a, const km_morph_input *b,
+                           const km_morph_options *o) {
+  km_morph *m = NULL;
+  km_error err;
+  km_status st = km_morph_create(&m, a, b, o, &err);
+  if (st != KM_OK) print_error("km_morph_create: %s\n", err.message);
+  assert_status(st, KM_OK);
+  assert_non_null(m);
+  return m;
+}
+
+typedef struct frame {
+  km_curve c;
+  km_frame_metrics mt;
+  km_signature sig;
+} frame;
+
+static void frame_get(const km_morph *m, double t, frame *f) {
+  km_error err;
+  km_curve_init(&f->c);
+  km_signature_init(&f->sig);
+  memset(&f->mt, 0, sizeof f->mt);
+  km_status st = km_morph_frame(m, t, &f->c, &f->mt, &f->sig, &err);
+  if (st != KM_OK) print_error("km_morph_frame(t = %g): %s\n", t, err.message);
+  assert_status(st, KM_OK);
+}
+
+static void frame_free(frame *f) {
+  km_curve_free(&f->c);
+  km_signature_free(&f->sig);
+}
+
+/* ---- geometry ------------------------------------------------------------ */
+
+static size_t spans_of(const km_curve *c) {
+  size_t spans = 0;
+  for (size_t i = (size_t)c->degree; i < c->n; i++)
+    if (c->knots[i + 1] > c->knots[i]) spans++;
+  return spans;
+}
+
+static size_t per_span(const km_curve *c, size_t total) {
+  size_t s = spans_of(c), per = total / (s ? s : 1);
+  return per < 4 ? 4 : per;
+}
+
+/* `per` samples per knot span, uniform in the parameter, plus the end */
+static double *curve_points(const km_curve *c, size_t per, size_t *np) {
+  double *p = malloc(2 * (spans_of(c) * per + 1) * sizeof *p);
+  assert_non_null(p);
+  size_t k = 0;
+  for (size_t i = (size_t)c->degree; i < c->n; i++) {
+    double a = c->knots[i], b = c->knots[i + 1];
+    if (!(b > a)) continue;
+    for (size_t j = 0; j < per; j++) {
+      double d[1][2];
+      km_curve_eval(c, a + (b - a) * (double)j / (double)per, 0, d);
+      p[2 * k] = d[0][0];
+      p[2 * k + 1] = d[0][1];
+      k++;
+    }
+  }
+  double t0, t1, d[1][2];
+  km_curve_domain(c, &t0, &t1);
+  km_curve_eval(c, t1, 0, d);
+  p[2 * k] = d[0][0];
+  p[2 * k + 1] = d[0][1];
+  *np = k + 1;
+  return p;
+}
+
+/* largest distance between the curve and the chords of its samples */
+static double chord_error(const km_curve *c, size_t per) {
+  double worst = 0.0;
+  for (size_t i = (size_t)c->degree; i < c->n; i++) {
+    double a = c->knots[i], b = c->knots[i + 1];
+    if (!(b > a)) continue;
+    for (size_t j = 0; j < per; j++) {
+      double u0 = a + (b - a) * (double)j / (double)per;
+      double u1 = a + (b - a) * (double)(j + 1) / (double)per;
+      double p0[1][2], p1[1][2], pm[1][2];
+      km_curve_eval_side(c, u0, 1, 0, p0);
+      km_curve_eval_side(c, u1, -1, 0, p1);
+      km_curve_eval(c, 0.5 * (u0 + u1), 0, pm);
+      double dx = p1[0][0] - p0[0][0], dy = p1[0][1] - p0[0][1];
+      double len = hypot(dx, dy);
+      double dist = len > 0 ? fabs((pm[0][0] - p0[0][0]) * dy - (pm[0][1] - p0[0][1]) * dx) / len
+                            : hypot(pm[0][0] - p0[0][0], pm[0][1] - p0[0][1]);
+      if (dist > worst) worst = dist;
+    }
+  }
+  return worst;
+}
+
+static double seg_dist(const double *p, const double *a, const double *b) {
+  double dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy;
+  double u = l2 > 0 ? ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2 : 0.0;
+  if (u < 0) u = 0;
+  if (u > 1) u = 1;
+  return hypot(p[0] - a[0] - u * dx, p[1] - a[1] - u * dy);
+}
+
+static double directed_dist(const double *P, size_t np, const double *Q,
+                            size_t nq) {
+  double worst = 0.0;
+  for (size_t i = 0; i < np; i++) {
+    double best = INFINITY;
+    for (size_t j = 0; j + 1 < nq; j++) {
+      double d = seg_dist(P + 2 * i, Q + 2 * j, Q + 2 * j + 2);
+      if (d < best) best = d;
+    }
+    if (best > worst) worst = best;
+  }
+  return worst;
+}
+
+/* Distance between the traces of two curves, as point sets: each one's
+ * samples against the other's polyline, less that polyline's measured chord
+ * error. */
+static double curves_distance(const km_curve *a, const km_curve *b) {
+  size_t pa = per_span(a, 1200), pb = per_span(b, 1200), na, nb;
+  double *A = curve_points(a, pa, &na), *B = curve_points(b, pb, &nb);
+  double d1 = directed_dist(A, na, B, nb) - chord_error(b, pb);
+  double d2 = directed_dist(B, nb, A, na) - chord_error(a, pa);
+  free(A);
+  free(B);
+  return d1 > d2 ? d1 : d2;
+}
+
+/* arc-length centroid, 20-point Gauss-Legendre on 8 panels per span */
+static void curve_centroid(const km_curve *c, double out[2]) {
+  double x[20], w[20], L = 0.0, cx = 0.0, cy = 0.0;
+  tu_gauss_legendre(20, x, w);
+  for (size_t i = (size_t)c->degree; i < c->n; i++) {
+    double a = c->knots[i], b = c->knots[i + 1];
+    if (!(b > a)) continue;
+    for (int p = 0; p < 8; p++) {
+      double lo = a + (b - a) * p / 8.0, h = (b - a) / 8.0;
+      for (int k = 0; k < 20; k++) {
+        double d[2][2];
+        km_curve_eval(c, lo + 0.5 * h * (x[k] + 1.0), 1, d);
+        double ds = 0.5 * h * w[k] * hypot(d[1][0], d[1][1]);
+        L += ds;
+        cx += ds * d[0][0];
+        cy += ds * d[0][1];
+      }
+    }
+  }
+  out[0] = cx / L;
+  out[1] = cy / L;
+}
+
+/* position, tangent angle and curvature at the start (side +1) or the end
+ * (side -1) of a curve */
+static void seam_side(const km_curve *c, int side, double p[2], double *angle,
+                      double *kappa) {
+  double t0, t1, d[3][2];
+  km_curve_domain(c, &t0, &t1);
+  km_curve_eval_side(c, side > 0 ? t0 : t1, side > 0 ? 1 : -1, 2, d);
+  p[0] = d[0][0];
+  p[1] = d[0][1];
+  *angle = atan2(d[1][1], d[1][0]);
+  double sp = hypot(d[1][0], d[1][1]);
+  *kappa = (d[1][0] * d[2][1] - d[1][1] * d[2][0]) / (sp * sp * sp);
+}
+
+/* total turning of a signature: integral of kappa plus the corners */
+static double total_turning(const km_signature *sig) {
+  double T = km_fn_integral(&sig->kappa);
+  for (size_t i = 0; i < sig->ncorners; i++) T += sig->corners[i].turn;
+  return T;
+}
+
+/* Frame t closes: the returned curve's ends coincide, and the exact curve
+ * of sig_out closes to 1e-9 x length. */
+static void assert_frame_closes(const frame *f, const char *what, double t) {
+  double p0[2], p1[2], a0, a1, k0, k1;
+  assert_true(f->c.closed);
+  seam_side(&f->c, 1, p0, &a0, &k0);
+  seam_side(&f->c, -1, p1, &a1, &k1);
+  assert_close(hypot(p1[0] - p0[0], p1[1] - p0[1]), 0.0, 1e-12 * f->sig.length);
+  double end[2];
+  assert_status(km_signature_point(&f->sig, f->sig.length, end, NULL), KM_OK);
+  double gap = hypot(end[0] - f->sig.start[0], end[1] - f->sig.start[1]);
+  if (gap > 1e-9 * f->sig.length)
+    print_error("%s, t = %g: the frame's exact curve ends %.3g from its start "
+                "(length %.6g)\n",
+                what, t, gap, f->sig.length);
+  assert_le(gap, 1e-9 * f->sig.length);
+}
+
+/* ---- closure -------------------------------------------------------------- */
+
+static void check_pair_closes(const km_curve *a, const km_curve *b,
+                              const char *what) {
+  km_morph_input A = {a, NULL}, B = {b, NULL};
+  km_morph_options o;
+  km_morph_options_default(&o);
+  km_morph *m = morph_new(&A, &B, &o);
+  double La = km_curve_length(a), Lb = km_curve_length(b);
+  for (int i = 0; i <= 6; i++) {
+    double t = i / 6.0;
+    frame f;
+    frame_get(m, t, &f);
+    assert_frame_closes(&f, what, t);
+    assert_rel(f.mt.length, (1 - t) * La + t * Lb, 1e-9);
+    /* the tangent closes too: one full turn */
+    assert_close(total_turning(&f.sig), 2 * M_PI, 1e-9);
+    frame_free(&f);
+  }
+  km_morph_free(m);
+}
+
+static void circle_to_ellipse_frames_close(void **state) {
+  (void)state;
+  km_curve c, e;
+  circle_and_ellipse(&c, &e);
+  check_pair_closes(&c, &e, "circle to ellipse");
+  km_curve_free(&c);
+  km_curve_free(&e);
+}
+
+static void rounded_square_to_star_frames_close(void **state) {
+  (void)state;
+  km_curve sq, st;
+  rounded_square(&sq);
+  smooth_star(&st);
+  check_pair_closes(&sq, &st, "rounded square to star");
+  km_curve_free(&sq);
+  km_curve_free(&st);
+}
+
+/* the paper's control-polygon closures keep their own promise at the seam
+ * of the returned curve: C0, C1 (same tangent direction), G2 (curvature
+ * too, within a loose numeric tolerance: the frame's curve is itself a
+ * tolerance-bounded approximation) */
+static void paper_closures_keep_their_seam_promise(void **state) {
+  (void)state;
+  km_curve c, e, sq, st;
+  circle_and_ellipse(&c, &e);
+  rounded_square(&sq);
+  smooth_star(&st);
+  const km_curve *from[2] = {&c, &sq}, *to[2] = {&e, &st};
+  const km_closure how[3] = {KM_CLOSURE_C0, KM_CLOSURE_C1, KM_CLOSURE_G2};
+  for (int pr = 0; pr < 2; pr++) {
+    km_morph_input A = {from[pr], NULL}, B = {to[pr], NULL};
+    for (int h = 0; h < 3; h++) {
+      for (int deg = 3; deg <= 5; deg += 2) {
+        km_morph_options o;
+        km_morph_options_default(&o);
+        o.closure = how[h];
+        o.degree = deg;
+        km_morph *m = morph_new(&A, &B, &o);
+        for (int i = 1; i <= 3; i++) {
+          double t = i / 4.0, p0[2], p1[2], a0, a1, k0, k1;
+          frame f;
+          frame_get(m, t, &f);
+          assert_true(f.c.closed);
+          seam_side(&f.c, 1, p0, &a0, &k0);
+          seam_side(&f.c, -1, p1, &a1, &k1);
+          assert_close(hypot(p1[0] - p0[0], p1[1] - p0[1]), 0.0, 1e-12 * f.sig.length);
+          if (how[h] != KM_CLOSURE_C0) {
+            if (fabs(tu_wrap(a1 - a0)) > 1e-9)
+              print_error("pair %d, closure %d, degree %d, t = %g: tangent "
+                          "angles %.12f and %.12f at the seam\n",
+                          pr, h, deg, t, a0, a1);
+            assert_close(tu_wrap(a1 - a0), 0.0, 1e-9);
+          }
+          if (how[h] == KM_CLOSURE_G2) {
+            double kscale = f.mt.max_abs_kappa;
+            if (fabs(k1 - k0) > 1e-3 * kscale)
+              print_error("pair %d, degree %d, t = %g: curvature %.9f at the "
+                          "start, %.9f at the end\n",
+                          pr, deg, t, k0, k1);
+            assert_close(k1, k0, 1e-3 * kscale);
+          }
+          frame_free(&f);
+        }
+        km_morph_free(m);
+      }
+    }
+  }
+  km_curve_free(&c);
+  km_curve_free(&e);
+  km_curve_free(&sq);
+  km_curve_free(&st);
+}
+
+/* ---- circles -------------------------------------------------------------- */
+
+static void circles_of_radius_one_and_two_morph_through_circles(void **state) {
+  (void)state;
+  km_signature s1, s2;
+  circle_signature(&s1, 1.0);
+  circle_signature(&s2, 2.0);
+  km_morph_input A = {NULL, &s1}, B = {NULL, &s2};
+  km_morph_options o;
+  km_morph_options_default(&o);
+  km_morph *m = morph_new(&A, &B, &o);
+  const double tol = 1e-5 * 4 * M_PI;
+  for (int i = 0; i <= 8; i++) {
+    double t = i / 8.0, r = (1 - t) + 2 * t;
+    frame f;
+    frame_get(m, t, &f);
+    /* before any correction the blended circle already closes */
+    assert_le(f.mt.closure_gap, 1e-9 * 2 * M_PI * r);
+    assert_rel(f.mt.length, 2 * M_PI * r, 1e-9);
+    for (int j = 0; j <= 200; j++)
+      assert_close(km_fn_value(&f.sig.kappa, f.sig.length * j / 200.0), 1 / r, 1e-9 / r);
+    assert_close(total_turning(&f.sig), 2 * M_PI, 1e-9);
+    assert_frame_closes(&f, "circles", t);
+    /* every point of the curve at distance r from the centroid */
+    double c[2];
+    curve_centroid(&f.c, c);
+    size_t np;
+    double *P = curve_points(&f.c, 50, &np);
+    for (size_t k = 0; k < np; k++)
+      assert_close(hypot(P[2 * k] - c[0], P[2 * k + 1] - c[1]), r, 2 * tol);
+    free(P);
+    frame_free(&f);
+  }
+  km_morph_free(m);
+  km_signature_free(&s1);
+  km_signature_free(&s2);
+}
+
+/* The paper's formula taken literally: the middle frame turns
+ * L_t ((1-t) T_a / L_a + t T_b / L_b) = 3 pi (pi + pi / 2) / (2 pi) ... that
+ * is 3 pi (1/2 + 1/4) = 2.25 pi at t = 1/2, not 2 pi. */
+static void paper_blend_on_circles_shows_the_turning_defect(void **state) {
+  (void)state;
+  km_signature s1, s2;
+  circle_signature(&s1, 1.0);
+  circle_signature(&s2, 2.0);
+  km_morph_input A = {NULL, &s1}, B = {NULL, &s2};
+  const km_closure how[2] = {KM_CLOSURE_NONE, KM_CLOSURE_AUTO};
+  for (int h = 0; h < 2; h++) {
+    km_morph_options o;
+    km_morph_options_default(&o);
+    o.blend = KM_BLEND_PAPER;
+    o.closure = how[h];
+    km_morph *m = morph_new(&A, &B, &o);
+    for (int i = 1; i <= 3; i++) {
+      double t = i / 4.0, La = 2 * M_PI, Lb = 4 * M_PI, Lt = (1 - t) * La + t * Lb;
+      double want = Lt * ((1 - t) * 2 * M_PI / La + t * 2 * M_PI / Lb);
+      frame f;
+      frame_get(m, t, &f);
+      assert_close(total_turning(&f.sig), want, 1e-9);
+      if (t == 0.5) assert_close(want, 2.25 * M_PI, 1e-12);
+      assert_true(fabs(total_turning(&f.sig) - 2 * M_PI) > 0.1);
+      /* paper blend: kappa_t = (1-t) + t / 2 everywhere (before a closure
+       * correction, which changes kappa but not the total turning) */
+      if (how[h] == KM_CLOSURE_NONE)
+        assert_close(km_fn_value(&f.sig.kappa, 0.3 * Lt), 1 - t / 2, 1e-12);
+      frame_free(&f);
+    }
+    km_morph_free(m);
+  }
+  km_signature_free(&s1);
+  km_signature_free(&s2);
+}
+
+/* ---- corners -------------------------------------------------------------- */
+
+/* the 2 x 1 rectangle from (0,0): corners at s = 2, 3, 5 (turn pi/2) and
+ * the seam (s = 6, pi/2); the rhombus of side 1 and angle 60 degrees from
+ * (0,0): corners at s = 1 (pi/3), 2 (2pi/3), 3 (pi/3), seam (2pi/3) */
+static void rectangle_and_rhombus(km_curve *rect, km_curve *rh) {
+  const double cr[10] = {0, 0, 2, 0, 2, 1, 0, 1, 0, 0};
+  const double kr[7] = {0, 0, 2, 3, 5, 6, 6};
+  make_curve(rect, 1, 5, kr, cr, NULL, true);
+  const double h = sqrt(3) / 2;
+  const double ch[10] = {0, 0, 1, 0, 1.5, h, 0.5, h, 0, 0};
+  const double kh[7] = {0, 0, 1, 2, 3, 4, 4};
+  make_curve(rh, 1, 5, kh, ch, NULL, true);
+}
+
+static void matched_corners_blend_as_turning_jumps(void **state) {
+  (void)state;
+  km_curve rect, rh;
+  rectangle_and_rhombus(&rect, &rh);
+  const double pairs[6] = {2.0 / 6, 0.25, 3.0 / 6, 0.5, 5.0 / 6, 0.75};
+  const double turn_a[4] = {M_PI / 2, M_PI / 2, M_PI / 2, M_PI / 2};
+  const double turn_b[4] = {M_PI / 3, 2 * M_PI / 3, M_PI / 3, 2 * M_PI / 3};
+  const double ra[4] = {2.0 / 6, 3.0 / 6, 5.0 / 6, 1.0};
+  const double rb[4] = {0.25, 0.5, 0.75, 1.0};
+  for (int blend = 0; blend < 2; blend++) {
+    km_morph_options o;
+    km_morph_options_default(&o);
+    o.matches = pairs;
+    o.nmatches = 3;
+    o.blend = blend ? KM_BLEND_PAPER : KM_BLEND_TURNING;
+    km_morph_input A = {&rect, NULL}, B = {&rh, NULL};
+    km_morph *m = morph_new(&A, &B, &o);
+    for (int i = 0; i <= 4; i++) {
+      double t = i / 4.0, Lt = (1 - t) * 6 + t * 4;
+      frame f;
+      frame_get(m, t, &f);
+      if (blend == 0) assert_frame_closes(&f, "rectangle to rhombus", t);
+      assert_rel(f.mt.length, Lt, 1e-9);
+      /* each matched corner once, at (1-t) s_a + t s_b, turning
+       * (1-t) turn_a + t turn_b (the seam corner may sit at 0 or L_t) */
+      size_t found = 0;
+      for (size_t c = 0; c < f.sig.ncorners; c++) {
+        double s = f.sig.corners[c].s, turn = f.sig.corners[c].turn;
+        if (fabs(turn) < 1e-12) continue;
+        int hit = -1;
+        for (int k = 0; k < 4; k++) {
+          double want = (1 - t) * ra[k] * 6 + t * rb[k] * 4;
+          if (fabs(s - want) <= 1e-9 * Lt || (k == 3 && fabs(s) <= 1e-9 * Lt)) hit = k;
+        }
+        if (hit < 0) print_error("t = %g: unexpected corner at s = %.12g\n", t, s);
+        assert_true(hit >= 0);
+        if (blend == 0 || (t > 0 && t < 1)) {
+          /* the turning blend weighs turns by (1-t), t; so does the paper's
+           * formula for equal segment lengths only, so check it there */
+        }
+        if (blend == 0)
+          assert_close(turn, (1 - t) * turn_a[hit] + t * turn_b[hit], 1e-9);
+        found++;
+      }
+      assert_int_equal(found, 4);
+      frame_free(&f);
+    }
+    km_morph_free(m);
+  }
+  km_curve_free(&rect);
+  km_curve_free(&rh);
+}
+
+/* no matches: the square's corners (r = 1/8, 3/8, 5/8, 7/8) fade into a
+ * smooth star as turns (1-t) pi/2 at s = r L_t, and every frame closes */
+static void square_corners_fade_into_a_smooth_star(void **state) {
+  (void)state;
+  km_curve sq, st;
+  square_polyline(&sq);
+  smooth_star(&st);
+  km_morph_input A = {&sq, NULL}, B = {&st, NULL};
+  km_morph_options o;
+  km_morph_options_default(&o);
+  km_morph *m = morph_new(&A, &B, &o);
+  double Lb = km_curve_length(&st);
+  for (int i = 0; i <= 4; i++) {
+    double t = i / 4.0, Lt = (1 - t) * 8 + t * Lb;
+    frame f;
+    frame_get(m, t, &f);
+    assert_frame_closes(&f, "square to star", t);
+    size_t found = 0;
+    for (size_t c = 0; c < f.sig.ncorners; c++) {
+      if (fabs(f.sig.corners[c].turn) < 1e-9) continue;
+      double r = f.sig.corners[c].s / Lt;
+      assert_close(fmod(r * 8, 2.0), 1.0, 1e-9);
+      assert_close(f.sig.corners[c].turn, (1 - t) * M_PI / 2, 1e-9);
+      found++;
+    }
+    assert_int_equal(found, t < 1 ? 4 : 0);
+    assert_int_equal(f.mt.self_intersections, 0);
+    frame_free(&f);
+  }
+  km_morph_free(m);
+  km_curve_free(&sq);
+  km_curve_free(&st);
+}
+
+/* ---- curvature bound with closure ----------------------------------------- */
+
+static void closed_frames_respect_the_curvature_bound(void **state) {
+  (void)state;
+  km_curve c, e, sq, st;
+  circle_and_ellipse(&c, &e);
+  rounded_square(&sq);
+  smooth_star(&st);
+  const km_curve *from[2] = {&c, &sq}, *to[2] = {&e, &st};
+  uint64_t seed = 0xfeedULL;
+  long failures = 0;
+  for (int pr = 0; pr < 2; pr++) {
+    km_signature sa, sb;
+    km_error err;
+    double tol = 1e-5 * fmax(km_curve_length(from[pr]), km_curve_length(to[pr]));
+    assert_status(km_signature_compute(from[pr], 0.1 * tol, &sa, &err), KM_OK);
+    assert_status(km_signature_compute(to[pr], 0.1 * tol, &sb, &err), KM_OK);
+    double kmax = fmax(km_signature_max_abs_kappa(&sa), km_signature_max_abs_kappa(&sb));
+    for (int trial = 0; trial < 3; trial++) {
+      double pairs[6];
+      size_t n = (size_t)trial;
+      double a = 0, b = 0;
+      for (size_t i = 0; i < n; i++) {
+        a += tu_uniform(&seed, 0.05, 0.9 * (1 - a) / (double)(n - i));
+        b += tu_uniform(&seed, 0.05, 0.9 * (1 - b) / (double)(n - i));
+        pairs[2 * i] = a;
+        pairs[2 * i + 1] = b;
+      }
+      km_morph_options o;
+      km_morph_options_default(&o);
+      o.matches = pairs;
+      o.nmatches = n;
+      km_morph_input A = {from[pr], &sa}, B = {to[pr], &sb};
+      km_morph *m = morph_new(&A, &B, &o);
+      for (int i = 1; i <= 3; i++) {
+        frame f;
+        frame_get(m, i / 4.0, &f);
+        if (!(f.mt.max_abs_kappa <= kmax * (1 + 1e-9))) {
+          print_error("%s, %zu matches, t = %g: max |kappa| %.9g, inputs' "
+                      "%.9g, closure gap before %.3g\n",
+                      pr ? "rounded square to star" : "circle to ellipse", n,
+                      i / 4.0, f.mt.max_abs_kappa, kmax, f.mt.closure_gap);
+          failures++;
+        }
+        frame_free(&f);
+      }
+      km_morph_free(m);
+    }
+    km_signature_free(&sa);
+    km_signature_free(&sb);
+  }
+  km_curve_free(&c);
+  km_curve_free(&e);
+  km_curve_free(&sq);
+  km_curve_free(&st);
+  assert_int_equal(failures, 0);
+}
+
+/* identity preservation on a closed pair: proportional matches give the
+ * frames of no matches (the ellipse's start already aligns with the
+ * circle's, so no start is moved either way) */
+static void proportional_matches_on_a_closed_pair_give_the_global_morph(void **state) {
+  (void)state;
+  km_curve c, e;
+  circle_and_ellipse(&c, &e);
+  km_morph_input A = {&c, NULL}, B = {&e, NULL};
+  km_morph_options o;
+  km_morph_options_default(&o);
+  km_morph *plain = morph_new(&A, &B, &o);
+  const double pairs[4] = {0.3, 0.3, 0.55, 0.55};
+  o.matches = pairs;
+  o.nmatches = 2;
+  km_morph *matched = morph_new(&A, &B, &o);
+  double tol = 1e-5 * km_curve_length(&e);
+  for (int i = 0; i <= 4; i++) {
+    frame f, g;
+    frame_get(plain, i / 4.0, &f);
+    frame_get(matched, i / 4.0, &g);
+    double t0, t1, worst = 0.0;
+    km_curve_domain(&f.c, &t0, &t1);
+    for (int j = 0; j <= 500; j++) {
+      double pf[1][2], pg[1][2], u = t0 + (t1 - t0) * j / 500.0;
+      km_curve_eval(&f.c, u, 0, pf);
+      km_curve_eval(&g.c, u, 0, pg);
+      worst = fmax(worst, hypot(pf[0][0] - pg[0][0], pf[0][1] - pg[0][1]));
+    }
+    assert_le(worst, 2 * tol);
+    frame_free(&f);
+    frame_free(&g);
+  }
+  km_morph_free(plain);
+  km_morph_free(matched);
+  km_curve_free(&c);
+  km_curve_free(&e);
+}
+
+/* ---- the shape pairs of shapes.json --------------------------------------- */
+
+static void fixture_pairs_end_frames_length_and_closure(void **state) {
+  (void)state;
+  for (int p = 0; p < 6; p++) {
+    km_curve a, b;
+    shape_curve(PAIRS[p], 'a', &a);
+    shape_curve(PAIRS[p], 'b', &b);
+    km_morph_input A = {&a, NULL}, B = {&b, NULL};
+    km_morph_options o;
+    km_morph_options_default(&o);
+    km_morph *m = morph_new(&A, &B, &o);
+    double La = km_curve_length(&a), Lb = km_curve_length(&b);
+    double tol = 1e-5 * fmax(La, Lb);
+    const double ts[5] = {0.0, 0.3, 0.5, 0.8, 1.0};
+    for (int i = 0; i < 5; i++) {
+      double t = ts[i];
+      frame f;
+      frame_get(m, t, &f);
+      assert_rel(f.mt.length, (1 - t) * La + t * Lb, 1e-9);
+      if (a.closed) assert_frame_closes(&f, PAIRS[p], t);
+      if (t == 0.0 || t == 1.0) {
+        double d = curves_distance(&f.c, t == 0.0 ? &a : &b);
+        if (d > tol)
+          print_error("%s: frame %g is %.3g from the input (tolerance %.3g)\n",
+                      PAIRS[p], t, d, tol);
+        assert_le(d, tol);
+      }
+      frame_free(&f);
+    }
+    km_morph_free(m);
+    km_curve_free(&a);
+    km_curve_free(&b);
+  }
+}
+
+/* Where neither input crosses itself, no frame of the default morph may.
+ * Every pair is tried; all failures are listed before the test fails. */
+static void fixture_pairs_default_frames_do_not_self_intersect(void **state) {
+  (void)state;
+  long failures = 0;
+  for (int p = 0; p < 6; p++) {
+    km_curve a, b;
+    shape_curve(PAIRS[p], 'a', &a);
+    shape_curve(PAIRS[p], 'b', &b);
+    double tol = 1e-5 * fmax(km_curve_length(&a), km_curve_length(&b));
+    if (km_curve_self_intersections(&a, tol) != 0 ||
+        km_curve_self_intersections(&b, tol) != 0) {
+      print_error("%s: an input crosses itself; skipped\n", PAIRS[p]);
+      km_curve_free(&a);
+      km_curve_free(&b);
+      continue;
+    }
+    km_morph_input A = {&a, NULL}, B = {&b, NULL};
+    km_morph_options o;
+    km_morph_options_default(&o);
+    km_morph *m = morph_new(&A, &B, &o);
+    for (int i = 0; i <= 10; i++) {
+      double t = i / 10.0;
+      frame f;
+      frame_get(m, t, &f);
+      long n = f.mt.self_intersections;
+      if (n != 0) {
+        print_error("%s: frame t = %g crosses itself %ld times\n", PAIRS[p], t, n);
+        failures++;
+      }
+      frame_free(&f);
+    }
+    km_morph_free(m);
+    km_curve_free(&a);
+    km_curve_free(&b);
+  }
+  assert_int_equal(failures, 0);
+}
+
+/* arrow_rot90: the same polygon turned by 90 degrees. The curvature morph
+ * of congruent shapes keeps the shape: every frame has the input's
+ * curvature and corners (after the start is aligned). */
+static void congruent_shapes_morph_through_congruent_frames(void **state) {
+  (void)state;
+  km_curve a, b;
+  shape_curve("arrow_rot90", 'a', &a);
+  shape_curve("arrow_rot90", 'b', &b);
+  km_morph_input A = {&a, NULL}, B = {&b, NULL};
+  km_morph_options o;
+  km_morph_options_default(&o);
+  km_morph *m = morph_new(&A, &B, &o);
+  double L = km_curve_length(&a);
+  assert_rel(km_curve_length(&b), L, 1e-9);
+  frame f0;
+  frame_get(m, 0.0, &f0);
+  for (int i = 1; i <= 3; i++) {
+    frame f;
+    frame_get(m, i / 4.0, &f);
+    assert_rel(f.mt.length, L, 1e-9);
+    /* corners: same count, places and turns as frame 0 */
+    size_t n0 = 0, n1 = 0;
+    for (size_t c = 0; c < f0.sig.ncorners; c++) n0 += fabs(f0.sig.corners[c].turn) > 1e-6;
+    for (size_t c = 0; c < f.sig.ncorners; c++) n1 += fabs(f.sig.corners[c].turn) > 1e-6;
+    assert_int_equal(n1, n0);
+    frame_free(&f);
+  }
+  frame_free(&f0);
+  km_morph_free(m);
+  km_curve_free(&a);
+  km_curve_free(&b);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(circle_to_ellipse_frames_close),
+      cmocka_unit_test(rounded_square_to_star_frames_close),
+      cmocka_unit_test(paper_closures_keep_their_seam_promise),
+      cmocka_unit_test(circles_of_radius_one_and_two_morph_through_circles),
+      cmocka_unit_test(paper_blend_on_circles_shows_the_turning_defect),
+      cmocka_unit_test(matched_corners_blend_as_turning_jumps),
+      cmocka_unit_test(square_corners_fade_into_a_smooth_star),
+      cmocka_unit_test(closed_frames_respect_the_curvature_bound),
+      cmocka_unit_test(proportional_matches_on_a_closed_pair_give_the_global_morph),
+      cmocka_unit_test(fixture_pairs_end_frames_length_and_closure),
+      cmocka_unit_test(fixture_pairs_default_frames_do_not_self_intersect),
+      cmocka_unit_test(congruent_shapes_morph_through_congruent_frames),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
