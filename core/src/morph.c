@@ -833,6 +833,7 @@ static km_status close_lsq(const km_signature *sig, km_signature *out,
       M[i * NF + j] = v / h;
     }
   double gap_first = -1.0;
+  bool changed = false;
   for (int it = 0; it < 40; it++) {
     double G[2] = {0, 0}, J[2][NF];
     memset(J, 0, sizeof J);
@@ -858,6 +859,7 @@ static km_status close_lsq(const km_signature *sig, km_signature *out,
     double g = hypot(G[0], G[1]);
     if (gap_first < 0) gap_first = g;
     if (g <= 1e-12 * L) break;
+    changed = true;
     /* minimum-norm Newton step in the metric M */
     double Y[2][NF];
     for (int r = 0; r < 2; r++) {
@@ -889,6 +891,10 @@ static km_status close_lsq(const km_signature *sig, km_signature *out,
     }
   }
   *gap0 = gap_first;
+  if (!changed) {
+    st = km_signature_copy(out, sig, err);
+    goto done;
+  }
   /* kappa~ = kappa + psi' (psi' is quadratic on each basis interval) */
   st = km__pp_alloc(&dpsi, 2, NB);
   if (st) goto done;
@@ -1135,16 +1141,16 @@ km_status km_morph_frame(const km_morph *m, double t, km_curve *out,
   km_closure how = m->opt.closure == KM_CLOSURE_AUTO ? KM_CLOSURE_LSQ : m->opt.closure;
   km_status st = blend_signature(m, t, &blended, err);
   if (st) goto done;
-  if (m->closed) {
+  if (m->closed && how == KM_CLOSURE_LSQ) {
+    /* close_lsq measures the gap itself (its first residual) */
+    st = close_lsq(&blended, &closed, &gap, err);
+    if (st) goto done;
+    use = &closed;
+  } else if (m->closed) {
     double end[2];
     st = km_signature_point(&blended, blended.length, end, NULL);
     if (st) goto done;
     gap = hypot(end[0] - blended.start[0], end[1] - blended.start[1]);
-    if (how == KM_CLOSURE_LSQ && gap > 1e-12 * blended.length) {
-      st = close_lsq(&blended, &closed, &gap, err);
-      if (st) goto done;
-      use = &closed;
-    }
   }
   st = km_reconstruct(use, m->opt.degree, 0.9 * m->tol, &f, &bound, err);
   if (st) goto done;

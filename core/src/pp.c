@@ -148,8 +148,33 @@ static double blossom(const km_fn *f, size_t i, const double *u) {
   return d[p];
 }
 
+/* True if every distinct knot of f has multiplicity degree + 1: then the
+ * coefficients already are the pieces' Bernstein coefficients (the layout
+ * km__pp_to_fn writes). */
+static bool is_piecewise_bezier(const km_fn *f) {
+  size_t nk = f->n + (size_t)f->degree + 1, run = 1;
+  for (size_t i = 1; i < nk; i++) {
+    if (f->knots[i] == f->knots[i - 1]) {
+      run++;
+    } else {
+      if (run != (size_t)f->degree + 1) return false;
+      run = 1;
+    }
+  }
+  return run == (size_t)f->degree + 1;
+}
+
 km_status km__pp_from_fn(km_pp *out, const km_fn *f) {
   int p = f->degree;
+  if (is_piecewise_bezier(f)) {
+    size_t m = f->n / (size_t)(p + 1);
+    km_pp r;
+    if (km__pp_alloc(&r, p, m)) return KM_ENOMEM;
+    for (size_t i = 0; i <= m; i++) r.x[i] = f->knots[i * (size_t)(p + 1)];
+    memcpy(r.c, f->coef, f->n * sizeof(double));
+    *out = r;
+    return KM_OK;
+  }
   size_t m = 0;
   for (size_t i = (size_t)p; i < f->n; i++)
     if (f->knots[i + 1] > f->knots[i]) m++;
