@@ -1,0 +1,194 @@
+"""python3 -m kmorph - the kmorph service from the command line.
+
+Subcommands: signature, reconstruct, morph, job, status, cancel, health.
+Curves are SVG path d strings ("M 0 0 L 10 0"), JSON curve objects, or
+@FILE / @- holding either (a file with a signature becomes a signature
+curve). Errors print the service's problem detail on stderr and exit 1;
+usage errors exit 2.
+"""
+import argparse
+import json
+import sys
+
+from . import Client, JobCancelled, KmorphError, DEFAULT_URL
+
+
+def _read_arg(text):
+    if text == "@-":
+        return sys.stdin.read()
+    if text.startswith("@"):
+        try:
+            with open(text[1:], encoding="utf-8") as f:
+                return f.read()
+        except OSError as e:
+            raise SystemExit(_usage_error("cannot read %s: %s" % (text[1:], e.strerror)))
+    return text
+
+
+def _usage_error(msg):
+    print("kmorph: " + msg, file=sys.stderr)
+    return 2
+
+
+def curve_arg(text):
+    """A curve object from a command-line argument."""
+    text = _read_arg(text)
+    s = text.strip()
+    if s.startswith("{"):
+        try:
+            obj = json.loads(s)
+        except ValueError as e:
+            raise SystemExit(_usage_error("not JSON: %s" % e))
+        if "type" in obj:
+            return obj
+        if "signature" in obj:
+            return {"type": "signature", "signature": obj["signature"]}
+        if "kappa" in obj:
+            return {"type": "signature", "signature": obj}
+        if "control_points" in obj:
+            return dict(obj, type="bspline")
+        raise SystemExit(_usage_error("not a curve: expected type, signature, kappa or control_points"))
+    if s[:1] in ("M", "m"):
+        return {"type": "svg", "d": s}
+    raise SystemExit(_usage_error("not an SVG path (must start with M) nor JSON: %.60s" % s))
+
+
+def _morph_request(a):
+    req = {}
+    if a.request:
+        try:
+            req = json.loads(_read_arg("@" + a.request))
+        except ValueError as e:
+            raise SystemExit(_usage_error("the -r request is not JSON: %s" % e))
+    if a.curves:
+        if len(a.curves) != 2:
+            raise SystemExit(_usage_error("give two curves, FROM and TO"))
+        req["from"], req["to"] = curve_arg(a.curves[0]), curve_arg(a.curves[1])
+    if "from" not in req or "to" not in req:
+        raise SystemExit(_usage_error("FROM and TO curves are needed"))
+    if a.frames is not None:
+        req["frames"] = a.frames
+        req.pop("times", None)
+    if a.times is not None:
+        req["times"] = [float(x) for x in a.times.split(",")]
+        req.pop("frames", None)
+    for key in ("method", "blend", "closure", "anchor", "orient", "tolerance", "degree"):
+        if getattr(a, key) is not None:
+            req[key] = getattr(a, key)
+    if a.matches is not None:
+        req["matches"] = "auto" if a.matches == "auto" else json.loads(a.matches)
+    if a.metrics:
+        req["metrics"] = True
+    if a.svg_d:
+        req["include"] = sorted(set(req.get("include", []) + ["svg_d"]))
+    layout = a.layout or ("filmstrip" if a.output and a.output.endswith(".svg") else None)
+    if layout:
+        req["format"] = "svg"
+        req.setdefault("svg", {})["layout"] = layout
+    return req
+
+
+def _emit(answer, output):
+    text = answer if isinstance(answer, str) else json.dumps(answer, indent=1)
+    if output:
+        with open(output, "w", encoding="utf-8") as f:
+            f.write(text)
+        print("kmorph: wrote %s (%d bytes)" % (output, len(text.encode())), file=sys.stderr)
+    else:
+        sys.stdout.write(text if text.endswith("\n") else text + "\n")
+
+
+def _morph_options(p):
+    p.add_argument("curves", nargs="*", metavar="CURVE", help="FROM and TO")
+    p.add_argument("-n", "--frames", type=int, help="evenly spaced frames (default 11)")
+    p.add_argument("-T", "--times", help="explicit times, comma-separated: 0,0.25,1")
+    p.add_argument("-m", "--method", choices=["curvature", "linear"])
+    p.add_argument("-b", "--blend", choices=["turning", "paper"])
+    p.add_argument("-M", "--matches", help='"auto" or pairs as JSON: [[0.2,0.3]]')
+    p.add_argument("-c", "--closure", choices=["auto", "lsq", "c0", "c1", "g2", "none"])
+    p.add_argument("-a", "--anchor", choices=["fit", "start", "centroid"])
+    p.add_argument("-O", "--orient", choices=["auto", "keep"])
+    p.add_argument("-t", "--tolerance", type=float)
+    p.add_argument("-g", "--degree", type=int, choices=[3, 5])
+    p.add_argument("-k", "--metrics", action="store_true", help="per-frame metrics")
+    p.add_argument("-d", "--svg-d", action="store_true", help="include svg_d in each frame")
+    p.add_argument("-l", "--layout", choices=["filmstrip", "overlay", "animate", "curvature_plot"],
+                   help="answer in SVG with this layout")
+    p.add_argument("-o", "--output", help="write to this file (FILE.svg asks for SVG)")
+    p.add_argument("-r", "--request", help="start from the morph request in this JSON file")
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(prog="python3 -m kmorph",
+                                 description="Morph planar curves with a kmorph service.")
+    ap.add_argument("-u", "--url", help="the service (default $KMORPH_URL or %s)" % DEFAULT_URL)
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    p = sub.add_parser("signature", help="curvature signature of a curve")
+    p.add_argument("curve")
+    p.add_argument("-t", "--tolerance", type=float)
+    p.add_argument("-s", "--samples", type=int, help="also N samples [s, kappa]")
+    p.add_argument("-o", "--output")
+    p = sub.add_parser("reconstruct", help="the curve of a signature")
+    p.add_argument("signature", help="JSON signature or /v1/signature answer, @FILE or @-")
+    p.add_argument("-t", "--tolerance", type=float)
+    p.add_argument("-g", "--degree", type=int, choices=[3, 5])
+    p.add_argument("-p", "--path", action="store_true", help="print only the SVG path d")
+    p.add_argument("-o", "--output")
+    _morph_options(sub.add_parser("morph", help="a morph, synchronously"))
+    p = sub.add_parser("job", help="a morph as a job, with progress on stderr")
+    _morph_options(p)
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
+    p = sub.add_parser("status", help="state and progress of a job")
+    p.add_argument("id")
+    p = sub.add_parser("cancel", help="cancel (or forget) a job")
+    p.add_argument("id")
+    sub.add_parser("health", help="is the service alive and ready")
+    a = ap.parse_args(argv)
+    km = Client(a.url)
+    try:
+        if a.cmd == "signature":
+            _emit(km.signature(curve_arg(a.curve), a.tolerance, a.samples), a.output)
+        elif a.cmd == "reconstruct":
+            text = _read_arg(a.signature)
+            try:
+                sig = json.loads(text)
+            except ValueError as e:
+                return _usage_error("the signature is not JSON: %s" % e)
+            sig = sig.get("signature", sig)
+            r = km.reconstruct(sig, a.tolerance, a.degree, ["svg_d"] if a.path else None)
+            _emit(r["curve"]["svg_d"] if a.path else r, a.output)
+        elif a.cmd == "morph":
+            _emit(km.morph(_morph_request(a)), a.output)
+        elif a.cmd == "job":
+            last = [None]
+
+            def progress(s):
+                line = "job %s %s %d%% (%d/%d frames)" % (
+                    s["id"], s["state"], int(s["progress"] * 100), s["frames_done"], s["frames_total"])
+                if not a.quiet and line != last[0]:
+                    print("kmorph: " + line, file=sys.stderr, flush=True)
+                    last[0] = line
+            _emit(km.morph_job(_morph_request(a), on_progress=progress), a.output)
+        elif a.cmd == "status":
+            _emit(km.job(a.id), None)
+        elif a.cmd == "cancel":
+            km.cancel_job(a.id)
+            print("kmorph: job %s cancelled" % a.id, file=sys.stderr)
+        elif a.cmd == "health":
+            print("%s %s" % (km.health()["status"], km.ready()["status"]))
+    except JobCancelled as e:
+        print("kmorph: %s" % e, file=sys.stderr)
+        return 1
+    except KmorphError as e:
+        print("kmorph: %s" % e, file=sys.stderr)
+        for err in e.errors:
+            print("  at %s: %s" % (err.get("pointer"), err.get("message")), file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("kmorph: interrupted", file=sys.stderr)
+        return 130
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
