@@ -21,7 +21,8 @@ LDFLAGS := $(SANFLAGS) $(EXTRA_LDFLAGS)
 # System packages the build and the tests need (Debian 12 names).
 PACKAGES := gcc make pkg-config libcmocka-dev libcjson-dev libmicrohttpd-dev \
             clang libclang-rt-14-dev curl jq valgrind libxml2-utils \
-            librsvg2-bin nodejs npm wrk python3 python3-yaml python3-jsonschema
+            librsvg2-bin nodejs npm wrk python3 python3-yaml python3-jsonschema \
+            chromium
 
 CJSON_CFLAGS := -I/usr/include/cjson
 CJSON_LIBS   := -lcjson
@@ -51,7 +52,7 @@ UNIT_BIN  := $(UNIT_SRC:%.c=$(BUILD)/%)
 APIT_BIN  := $(APIT_SRC:%.c=$(BUILD)/%)
 SUPPORT_SRC := $(wildcard tests/support/*.c)
 
-.PHONY: all deps build run test test-unit test-asan test-server check-layers \
+.PHONY: all deps build run test test-unit test-asan test-server test-clients check-layers \
         bench bench-http fuzz fuzz-svg clean format examples
 
 all: build
@@ -131,12 +132,19 @@ test: deps
 	@$(MAKE) --no-print-directory BUILD=build/asan SAN=address OPT=-O1 test-unit
 	@echo "== kmorphd over HTTP: contract, jobs, load, shutdown"
 	@$(MAKE) --no-print-directory test-server || true
+	@echo "== clients: curl, JS, Python and the web page in Chromium"
+	@$(MAKE) --no-print-directory test-clients || true
 	@tests/summarise.sh
 
 # The daemon over real HTTP (loopback, ephemeral ports); appends its counts
 # to build/test-results.txt like the other suites.
 test-server: build
 	@tests/server/run.sh
+
+# The clients (clients/) against live daemons on ephemeral loopback ports,
+# and the web page in headless Chromium; appends its counts like the others.
+test-clients: build
+	@tests/clients/run.sh
 
 # Throughput and latency of kmorphd with wrk (see bench/http/run.sh).
 bench-http: deps build
