@@ -278,17 +278,19 @@ static double binom(int n, int k) {
 
 double km__pp_integral_sq(const km_pp *p) {
   int d = p->degree;
+  /* product of two degree-d Bernstein polynomials: coefficient k of degree
+   * 2d is sum over a of C(d,a) C(d,k-a) / C(2d,k) f_a g_(k-a); the integral
+   * over the piece is h times their mean */
+  double w[FN_MAX_DEGREE + 2][FN_MAX_DEGREE + 2];
+  for (int a = 0; a <= d; a++)
+    for (int b = 0; b <= d; b++)
+      w[a][b] = binom(d, a) * binom(d, b) / binom(2 * d, a + b);
   double total = 0.0;
   for (size_t i = 0; i < p->m; i++) {
     const double *c = p->c + i * (size_t)(d + 1);
     double h = p->x[i + 1] - p->x[i], s = 0.0;
-    /* product coefficients of degree 2d, their mean times h */
-    for (int k = 0; k <= 2 * d; k++) {
-      double v = 0.0;
-      for (int a = k - d < 0 ? 0 : k - d; a <= d && a <= k; a++)
-        v += binom(d, a) * binom(d, k - a) * c[a] * c[k - a];
-      s += v / binom(2 * d, k);
-    }
+    for (int a = 0; a <= d; a++)
+      for (int b = 0; b <= d; b++) s += w[a][b] * c[a] * c[b];
     total += h * s / (2 * d + 1);
   }
   return total;

@@ -753,7 +753,8 @@ typedef struct qnode {
 } qnode;
 
 /* Gauss-Legendre nodes over the theta pieces, split at the uniform breaks
- * of the closure basis and chunked so theta moves <= 0.5 rad per rule. */
+ * of the closure basis and chunked so theta moves <= 0.5 rad per 8-point
+ * rule (exact to rounding there, see km__integrate_exp). */
 static km_status closure_nodes(const km_pp *kp, const km_pp *tp, double h,
                                qnode **out, size_t *nout) {
   size_t cap = 0, n = 0;
@@ -773,7 +774,7 @@ static km_status closure_nodes(const km_pp *kp, const km_pp *tp, double h,
       for (int c = 0; c < chunks; c++) {
         double ca = lo + (hi - lo) * c / chunks, cb = lo + (hi - lo) * (c + 1) / chunks;
         double mid = 0.5 * (ca + cb), hw = 0.5 * (cb - ca);
-        if (n + 16 > cap) {
+        if (n + 8 > cap) {
           cap = cap ? 2 * cap : 1024;
           if (cap > 64 * (size_t)KM_MAX_PIECES) {
             free(q);
@@ -786,10 +787,10 @@ static km_status closure_nodes(const km_pp *kp, const km_pp *tp, double h,
           }
           q = nq;
         }
-        for (int k = 0; k < 16; k++) {
-          double s = mid + hw * km__gl16_x[k];
+        for (int k = 0; k < 8; k++) {
+          double s = mid + hw * km__gl8_x[k];
           q[n].s = s;
-          q[n].w = hw * km__gl16_w[k];
+          q[n].w = hw * km__gl8_w[k];
           q[n].theta = km__bern_eval(tp->c + i * (size_t)(dt + 1), dt, (s - a) / len);
           n++;
         }
