@@ -155,9 +155,27 @@ run: deps build
 	else echo "kmorphd not built yet: CLI demo"; \
 	  $(CLI) signature < docs/examples/circle-signature.json; fi
 
-bench: deps
+bench: deps bench-morph
 	@$(MAKE) --no-print-directory build/bench/bench_core
 	build/bench/bench_core
+
+# 60-frame morphs (bench/bench_morph.c), and the shapes.json pairs beside
+# flubber from npm (bench/flubber, a benchmark-only dependency; skipped
+# without npm).
+.PHONY: bench-morph
+bench-morph: deps
+	@$(MAKE) --no-print-directory build/bench/bench_morph
+	@rm -f build/bench/flubber.txt; \
+	if [ -d bench/flubber/node_modules/flubber ] || \
+	   (cd bench/flubber && npm ci --no-audit --no-fund >/dev/null 2>&1); then \
+	  (cd bench/flubber && node bench_flubber.js ../../tests/fixtures/shapes.json) \
+	    > build/bench/flubber.txt || rm -f build/bench/flubber.txt; \
+	else echo "flubber could not be installed with npm: kmorph figures only"; fi
+	build/bench/bench_morph build/bench/flubber.txt
+
+build/bench/bench_morph: bench/bench_morph.c $(LIBCORE)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) $(CORE_INC) $(CJSON_CFLAGS) $< -o $@ $(LIBCORE) $(CJSON_LIBS) -lm $(LDFLAGS)
 
 build/bench/%: bench/%.c $(LIBCORE)
 	@mkdir -p $(@D)
