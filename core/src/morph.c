@@ -35,6 +35,7 @@
  * they carry) are aligned by dynamic programming over both sequences,
  * rewarding pairs of like turning and penalising drift in r.
  */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -249,39 +250,73 @@ static km_status reverse_input(input *in, double tol, km_error *err) {
   return recompute_sig(in, tol, err);
 }
 
-/* Best cyclic shift of b's start (fraction of Lb) aligning theta_b to
- * theta_a up to a constant, by least squares over ALIGN_N samples. */
-static double best_shift(const input *a, const input *b) {
+/* Best cyclic shift of b's start (fraction of Lb): least squares over
+ * ALIGN_N samples of the turning functions (up to a constant: the rotation
+ * is free) plus the positions about the centroids, scaled to radians by the
+ * mean radius L / 2 pi. The position term decides where the turning term
+ * cannot (a circle's every start is equally good by turning, but only one
+ * keeps a square's corners on the circle's diagonals). */
+#define SHIFT_CANDIDATES 4
+
+/* Fills cand[] with up to SHIFT_CANDIDATES shifts, best first: the
+ * deepest local minima of the cost over all shifts. Returns the count. */
+static size_t best_shifts(const input *a, const input *b, double *cand) {
   static const int N = ALIGN_N;
-  double *ta = malloc(2 * (size_t)N * sizeof(double));
-  if (!ta) return 0.0;
-  double *tb = ta + N;
+  double *buf = malloc(7 * (size_t)N * sizeof(double));
+  if (!buf) {
+    cand[0] = 0.0;
+    return 1;
+  }
+  double *ta = buf, *tb = buf + N, *pa = buf + 2 * N, *pb = buf + 4 * N;
+  double *cost = buf + 6 * N;
   double La = a->sig.length, Lb = b->sig.length;
+  double R = 0.5 * (La + Lb) / (2 * KM_PI);
   for (int j = 0; j < N; j++) {
-    ta[j] = theta_at(a, La * (j + 0.5) / N);
-    tb[j] = theta_at(b, Lb * (j + 0.5) / N);
+    double r = (j + 0.5) / N, q[2];
+    ta[j] = theta_at(a, La * r);
+    tb[j] = theta_at(b, Lb * r);
+    table_at(a, r, q);
+    pa[2 * j] = (q[0] - a->centroid[0]) / R;
+    pa[2 * j + 1] = (q[1] - a->centroid[1]) / R;
+    table_at(b, r, q);
+    pb[2 * j] = (q[0] - b->centroid[0]) / R;
+    pb[2 * j + 1] = (q[1] - b->centroid[1]) / R;
   }
   double total_b = b->sig.turning;
-  double best = INFINITY;
-  int bestk = 0;
   for (int k = 0; k < N; k++) {
-    double sum = 0.0, sum2 = 0.0;
+    double sum = 0.0, sum2 = 0.0, pos = 0.0;
     for (int j = 0; j < N; j++) {
-      int q = j + k;
-      double v = q < N ? tb[q] : tb[q - N] + total_b;
+      int q = j + k < N ? j + k : j + k - N;
+      double v = j + k < N ? tb[q] : tb[q] + total_b;
       double d = ta[j] - v;
       sum += d;
       sum2 += d * d;
+      double dx = pa[2 * j] - pb[2 * q], dy = pa[2 * j + 1] - pb[2 * q + 1];
+      pos += dx * dx + dy * dy;
     }
-    double var = sum2 - sum * sum / N;
-    /* keep the given start unless another is clearly better */
-    if (var < best - 1e-9 * (1.0 + fabs(best))) {
-      best = var;
-      bestk = k;
-    }
+    cost[k] = sum2 - sum * sum / N + pos;
   }
-  free(ta);
-  return (double)bestk / N;
+  /* local minima, deepest first; the given start wins ties */
+  size_t n = 0;
+  int idx[SHIFT_CANDIDATES];
+  for (int k = 0; k < N; k++) {
+    double c = cost[k], l = cost[(k + N - 1) % N], r = cost[(k + 1) % N];
+    if (!(c <= l && c <= r)) continue;
+    if (k > 0 && c >= cost[0] - 1e-9 * (1.0 + fabs(cost[0]))) continue;
+    size_t pos = n;
+    while (pos > 0 && cost[idx[pos - 1]] > c) pos--;
+    if (pos >= SHIFT_CANDIDATES) continue;
+    if (n < SHIFT_CANDIDATES) n++;
+    for (size_t q = n - 1; q > pos; q--) idx[q] = idx[q - 1];
+    idx[pos] = k;
+  }
+  if (n == 0) {
+    idx[0] = 0;
+    n = 1;
+  }
+  for (size_t q = 0; q < n; q++) cand[q] = (double)idx[q] / N;
+  free(buf);
+  return n;
 }
 
 /* ---- correspondence ---------------------------------------------------- */
@@ -428,9 +463,13 @@ static km_status prepare_input(input *in, const km_morph_input *src,
   return input_tables(in);
 }
 
-km_status km_morph_create(km_morph **out, const km_morph_input *from,
-                          const km_morph_input *to,
-                          const km_morph_options *opt, km_error *err) {
+/* forced_shift: NULL to choose the start of a closed `to` by the alignment
+ * cost (the candidates are returned in cand/ncand), else that shift. */
+static km_status create_impl(km_morph **out, const km_morph_input *from,
+                             const km_morph_input *to,
+                             const km_morph_options *opt,
+                             const double *forced_shift, double *cand,
+                             size_t *ncand, km_error *err) {
   km_morph *m = calloc(1, sizeof *m);
   if (!m) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   for (int i = 0; i < 2; i++) {
@@ -479,7 +518,13 @@ km_status km_morph_create(km_morph **out, const km_morph_input *from,
       goto fail;
     }
     if (opt->nmatches == 0) {
-      double shift = best_shift(a, b);
+      double shift = 0.0;
+      if (forced_shift) {
+        shift = *forced_shift;
+      } else {
+        *ncand = best_shifts(a, b, cand);
+        shift = cand[0];
+      }
       if (shift > 0) {
         st = rotate_start(b, shift * b->sig.length, 0.1 * tol, err);
         if (st) goto fail;
@@ -530,6 +575,49 @@ km_status km_morph_create(km_morph **out, const km_morph_input *from,
 fail:
   km_morph_free(m);
   return st;
+}
+
+static long preview_crossings(const km_morph *m) {
+  long total = 0;
+  for (int k = 1; k <= 5; k++) {
+    km_curve c;
+    km_frame_metrics mt;
+    if (km_morph_frame(m, k / 6.0, &c, &mt, NULL, NULL) != KM_OK) return LONG_MAX;
+    km_curve_free(&c);
+    if (mt.self_intersections > 0) total += mt.self_intersections;
+  }
+  return total;
+}
+
+km_status km_morph_create(km_morph **out, const km_morph_input *from,
+                          const km_morph_input *to,
+                          const km_morph_options *opt, km_error *err) {
+  double cand[SHIFT_CANDIDATES];
+  size_t ncand = 0;
+  km_morph *m = NULL;
+  km_status st = create_impl(&m, from, to, opt, NULL, cand, &ncand, err);
+  if (st) return st;
+  /* Among starts that align about as well, prefer one whose frames do not
+   * cross themselves: preview five frames of the best and, only if they
+   * cross, of the next candidates. */
+  if (ncand > 1 && opt->method == KM_METHOD_CURVATURE) {
+    long best = preview_crossings(m);
+    for (size_t i = 1; i < ncand && best > 0; i++) {
+      km_morph *alt = NULL;
+      if (create_impl(&alt, from, to, opt, &cand[i], NULL, NULL, NULL) != KM_OK)
+        continue;
+      long x = preview_crossings(alt);
+      if (x < best) {
+        km_morph_free(m);
+        m = alt;
+        best = x;
+      } else {
+        km_morph_free(alt);
+      }
+    }
+  }
+  *out = m;
+  return KM_OK;
 }
 
 size_t km_morph_matches_used(const km_morph *m, double *pairs, size_t cap) {
