@@ -269,6 +269,54 @@ static void seam_side(const km_curve *c, int side, double p[2], double *angle,
   *kappa = (d[1][0] * d[2][1] - d[1][1] * d[2][0]) / (sp * sp * sp);
 }
 
+/* Proper crossings of the polyline through a curve's dense samples (an
+ * independent check of metrics.self_intersections): segments sorted by
+ * their smallest x, swept; neighbours (and the closing pair) skipped. */
+typedef struct pseg {
+  double x0, y0, x1, y1, xmin, xmax;
+  size_t i;
+} pseg;
+
+static int by_xmin(const void *a, const void *b) {
+  double u = ((const pseg *)a)->xmin, v = ((const pseg *)b)->xmin;
+  return (u > v) - (u < v);
+}
+
+static long polyline_crossings(const km_curve *c, size_t total) {
+  size_t per = per_span(c, total), np;
+  double *P = curve_points(c, per, &np);
+  size_t ns = np - 1;
+  pseg *S = malloc(ns * sizeof *S);
+  assert_non_null(S);
+  for (size_t i = 0; i < ns; i++) {
+    S[i].x0 = P[2 * i];
+    S[i].y0 = P[2 * i + 1];
+    S[i].x1 = P[2 * i + 2];
+    S[i].y1 = P[2 * i + 3];
+    S[i].xmin = fmin(S[i].x0, S[i].x1);
+    S[i].xmax = fmax(S[i].x0, S[i].x1);
+    S[i].i = i;
+  }
+  qsort(S, ns, sizeof *S, by_xmin);
+  long n = 0;
+  for (size_t a = 0; a < ns; a++) {
+    for (size_t b = a + 1; b < ns && S[b].xmin <= S[a].xmax; b++) {
+      size_t ia = S[a].i, ib = S[b].i, lo = ia < ib ? ia : ib, hi = ia < ib ? ib : ia;
+      if (hi - lo <= 1 || (c->closed && lo == 0 && hi == ns - 1)) continue;
+      double rx = S[a].x1 - S[a].x0, ry = S[a].y1 - S[a].y0;
+      double qx = S[b].x1 - S[b].x0, qy = S[b].y1 - S[b].y0;
+      double den = rx * qy - ry * qx;
+      if (den == 0) continue;
+      double wx = S[b].x0 - S[a].x0, wy = S[b].y0 - S[a].y0;
+      double u = (wx * qy - wy * qx) / den, v = (wx * ry - wy * rx) / den;
+      if (u >= 0 && u < 1 && v >= 0 && v < 1) n++;
+    }
+  }
+  free(S);
+  free(P);
+  return n;
+}
+
 /* total turning of a signature: integral of kappa plus the corners */
 static double total_turning(const km_signature *sig) {
   double T = km_fn_integral(&sig->kappa);
@@ -516,10 +564,8 @@ static void matched_corners_blend_as_turning_jumps(void **state) {
         }
         if (hit < 0) print_error("t = %g: unexpected corner at s = %.12g\n", t, s);
         assert_true(hit >= 0);
-        if (blend == 0 || (t > 0 && t < 1)) {
-          /* the turning blend weighs turns by (1-t), t; so does the paper's
-           * formula for equal segment lengths only, so check it there */
-        }
+        /* the turning blend weighs turns by (1-t) and t; the paper's
+         * formula scales them by segment lengths, so only places count */
         if (blend == 0)
           assert_close(turn, (1 - t) * turn_a[hit] + t * turn_b[hit], 1e-9);
         found++;
@@ -699,6 +745,68 @@ static void fixture_pairs_end_frames_length_and_closure(void **state) {
   }
 }
 
+/* The same pairs with matches "auto", with degree-5 frames, and with the
+ * linear baseline: end frames are the inputs, closed pairs give closed
+ * frames, and curvature frames keep the length law. */
+static void fixture_pairs_with_auto_matches_degree_5_and_linear(void **state) {
+  (void)state;
+  for (int p = 0; p < 6; p++) {
+    km_curve a, b;
+    shape_curve(PAIRS[p], 'a', &a);
+    shape_curve(PAIRS[p], 'b', &b);
+    double La = km_curve_length(&a), Lb = km_curve_length(&b);
+    double tol = 1e-5 * fmax(La, Lb);
+    for (int variant = 0; variant < 3; variant++) {
+      km_morph_input A = {&a, NULL}, B = {&b, NULL};
+      km_morph_options o;
+      km_morph_options_default(&o);
+      if (variant == 0) o.auto_matches = true;
+      if (variant == 1) o.degree = 5;
+      if (variant == 2) o.method = KM_METHOD_LINEAR;
+      km_morph *m = morph_new(&A, &B, &o);
+      size_t nm = km_morph_matches_used(m, NULL, 0);
+      if (nm > 0) {
+        double *pr = malloc(2 * nm * sizeof *pr);
+        assert_int_equal(km_morph_matches_used(m, pr, nm), nm);
+        for (size_t i = 0; i < nm; i++) {
+          assert_true(pr[2 * i] > (i ? pr[2 * i - 2] : 0.0) && pr[2 * i] < 1.0);
+          assert_true(pr[2 * i + 1] > (i ? pr[2 * i - 1] : 0.0) && pr[2 * i + 1] < 1.0);
+        }
+        free(pr);
+      }
+      const double ts[3] = {0.0, 0.5, 1.0};
+      for (int i = 0; i < 3; i++) {
+        double t = ts[i];
+        frame f;
+        frame_get(m, t, &f);
+        if (variant == 1) assert_int_equal(f.c.degree, 5);
+        if (variant != 2) {
+          assert_rel(f.mt.length, (1 - t) * La + t * Lb, 1e-9);
+          if (a.closed) assert_frame_closes(&f, PAIRS[p], t);
+        } else if (a.closed) {
+          /* lerped control polygons of closed curves stay closed */
+          double p0[2], p1[2], a0, a1, k0, k1;
+          seam_side(&f.c, 1, p0, &a0, &k0);
+          seam_side(&f.c, -1, p1, &a1, &k1);
+          assert_close(hypot(p1[0] - p0[0], p1[1] - p0[1]), 0.0, 1e-12 * La);
+        }
+        if (t == 0.0 || t == 1.0) {
+          double d = curves_distance(&f.c, t == 0.0 ? &a : &b);
+          if (d > tol)
+            print_error("%s, variant %d: frame %g is %.3g from the input "
+                        "(tolerance %.3g)\n",
+                        PAIRS[p], variant, t, d, tol);
+          assert_le(d, tol);
+        }
+        frame_free(&f);
+      }
+      km_morph_free(m);
+    }
+    km_curve_free(&a);
+    km_curve_free(&b);
+  }
+}
+
 /* Where neither input crosses itself, no frame of the default morph may.
  * Every pair is tried; all failures are listed before the test fails. */
 static void fixture_pairs_default_frames_do_not_self_intersect(void **state) {
@@ -724,9 +832,11 @@ static void fixture_pairs_default_frames_do_not_self_intersect(void **state) {
       double t = i / 10.0;
       frame f;
       frame_get(m, t, &f);
-      long n = f.mt.self_intersections;
-      if (n != 0) {
-        print_error("%s: frame t = %g crosses itself %ld times\n", PAIRS[p], t, n);
+      long n = f.mt.self_intersections, poly = polyline_crossings(&f.c, 6000);
+      if (n != 0 || poly != 0) {
+        print_error("%s: frame t = %g crosses itself %ld times (its dense "
+                    "polyline %ld times)\n",
+                    PAIRS[p], t, n, poly);
         failures++;
       }
       frame_free(&f);
@@ -771,6 +881,53 @@ static void congruent_shapes_morph_through_congruent_frames(void **state) {
   km_curve_free(&b);
 }
 
+/* whether an integer stands in a message as a whole number */
+static int message_has_integer(const char *msg, long want) {
+  const char *p = msg;
+  while (*p) {
+    if ((*p >= '0' && *p <= '9') || (*p == '-' && p[1] >= '0' && p[1] <= '9')) {
+      char *end;
+      long v = strtol(p, &end, 10);
+      if (v == want && *end != '.') return 1;
+      p = end;
+    } else {
+      p++;
+    }
+  }
+  return 0;
+}
+
+/* A limacon r = 0.5 + cos(phi) loops twice around its inner loop's
+ * centre: turning number 2 against the unit circle's 1. */
+static void a_curve_looping_twice_is_rejected_against_a_circle(void **state) {
+  (void)state;
+  double pts[240];
+  for (int i = 0; i < 120; i++) {
+    double ph = 2 * M_PI * (i + 0.5) / 120.0, r = 0.5 + cos(ph);
+    pts[2 * i] = r * cos(ph);
+    pts[2 * i + 1] = r * sin(ph);
+  }
+  km_curve loop, c, e;
+  km_error err;
+  km_curve_init(&loop);
+  assert_status(km_curve_interpolate(&loop, pts, 120, true, &err), KM_OK);
+  circle_and_ellipse(&c, &e);
+  km_morph_input A = {&c, NULL}, B = {&loop, NULL};
+  km_morph_options o;
+  km_morph_options_default(&o);
+  km_morph *m = NULL;
+  assert_status(km_morph_create(&m, &A, &B, &o, &err), KM_ETURNING);
+  assert_null(m);
+  /* both numbers are named, as whole integers */
+  if (!message_has_integer(err.message, 1) || !message_has_integer(err.message, 2))
+    print_error("message: %s\n", err.message);
+  assert_true(message_has_integer(err.message, 1));
+  assert_true(message_has_integer(err.message, 2));
+  km_curve_free(&loop);
+  km_curve_free(&c);
+  km_curve_free(&e);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(circle_to_ellipse_frames_close),
@@ -783,8 +940,10 @@ int main(void) {
       cmocka_unit_test(closed_frames_respect_the_curvature_bound),
       cmocka_unit_test(proportional_matches_on_a_closed_pair_give_the_global_morph),
       cmocka_unit_test(fixture_pairs_end_frames_length_and_closure),
+      cmocka_unit_test(fixture_pairs_with_auto_matches_degree_5_and_linear),
       cmocka_unit_test(fixture_pairs_default_frames_do_not_self_intersect),
       cmocka_unit_test(congruent_shapes_morph_through_congruent_frames),
+      cmocka_unit_test(a_curve_looping_twice_is_rejected_against_a_circle),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
