@@ -1,0 +1,688 @@
+// app.js - the kmorph page: choose, paste or draw two curves, morph them
+// with the curvature method and the linear baseline (synchronously, or as
+// jobs with a progress bar for long morphs), then play, scrub and inspect
+// the frames. All service calls go through kmorph.js.
+import { Client, KmorphError, curveToPath, samplePoints, bounds } from "./kmorph.js";
+import { CURVES, PAIRS } from "./examples.js";
+
+const km = new Client();
+const $ = (sel, root = document) => root.querySelector(sel);
+const SVGNS = "http://www.w3.org/2000/svg";
+
+/* Above this many frames a morph goes through the job API. */
+const JOB_FRAMES = 150;
+/* Filmstrip thumbnails at most (evenly chosen frames beyond that). */
+const FILM_MAX = 40;
+/* Frames of the curvature plot at most (a subset of the morph's times). */
+const PLOT_MAX = 21;
+
+const state = {
+  input: { from: null, to: null },      /* parsed curve objects */
+  display: { from: "", to: "" },       /* SVG d of each input, for the editor */
+  drawing: null,                        /* "from" | "to" while clicking points */
+  drawn: { from: [], to: [] },
+  picking: false,
+  pending: null,                        /* a picked fraction on `from` awaiting its partner */
+  matches: [],
+  results: [],                          /* [{method, result, request}] */
+  panels: [],
+  t: 0,
+  playing: false,
+  controller: null,
+};
+
+// ------------------------------------------------------------ curve input
+
+/** A curve object from the text of a curve field (SVG d or JSON). Throws
+ * an Error with a readable message. */
+function parseCurve(text) {
+  const s = text.trim();
+  if (!s) throw new Error("give a curve: an SVG path d string or a JSON curve");
+  if (s.startsWith("{")) {
+    let o;
+    try { o = JSON.parse(s); } catch (e) { throw new Error("not valid JSON: " + e.message); }
+    if (o.type) return o;
+    if (o.signature) return { type: "signature", signature: o.signature };
+    if (o.kappa) return { type: "signature", signature: o };
+    if (o.control_points) return { type: "bspline", ...o };
+    throw new Error("a JSON curve needs type, signature, kappa or control_points");
+  }
+  if (!/^[Mm]/.test(s)) throw new Error("an SVG path must start with M (or paste a JSON curve)");
+  return { type: "svg", d: s };
+}
+
+function curveText(curve) {
+  return curve.type === "svg" ? curve.d : JSON.stringify(curve);
+}
+
+function setFieldError(which, message) {
+  const el = $("#error-" + which);
+  el.textContent = message || "";
+  const field = which === "from" || which === "to" ? $("#field-" + which) : null;
+  if (field) field.classList.toggle("has-error", !!message);
+}
+
+/** The SVG d to show for an input curve: its own d, the B-spline drawn
+ * here, or (signatures and fitted points) the service's reconstruction. */
+async function displayPath(curve) {
+  if (curve.type === "svg") return curve.d;
+  if (curve.type === "bspline") return curveToPath(curve);
+  let sig = curve.signature;
+  if (curve.type === "points") {
+    try {
+      sig = (await km.signature(curve)).signature;
+    } catch (e) { throw retarget(e, "/curve", ""); }
+  }
+  try {
+    return (await km.reconstruct(sig, { include: ["svg_d"] })).curve.svg_d;
+  } catch (e) { throw retarget(e, "/signature", curve.type === "signature" ? "/signature" : ""); }
+}
+
+/* Problems about a helper request point at its own fields; say it the
+ * way the curve field understands. */
+function retarget(e, from, to) {
+  if (e instanceof KmorphError)
+    e.errors = e.errors.map((x) => ({ ...x, pointer: (x.pointer || "").replace(from, to) }));
+  return e;
+}
+
+let previewSeq = { from: 0, to: 0 };
+async function updateCurve(which) {
+  const seq = ++previewSeq[which];
+  const text = $("#curve-" + which).value;
+  let curve;
+  try {
+    curve = parseCurve(text);
+  } catch (e) {
+    state.input[which] = null;
+    state.display[which] = "";
+    setFieldError(which, e.message);
+    renderEditor();
+    return;
+  }
+  state.input[which] = curve;
+  try {
+    const d = await displayPath(curve);
+    if (seq !== previewSeq[which]) return;
+    state.display[which] = d;
+    setFieldError(which, "");
+  } catch (e) {
+    if (seq !== previewSeq[which]) return;
+    state.display[which] = curve.type === "points" ? pointsPath(curve.points, curve.closed) : "";
+    setFieldError(which, problemText(e));
+  }
+  renderEditor();
+}
+
+function pointsPath(pts, closed) {
+  if (!pts.length) return "";
+  return "M" + pts.map((p) => `${p[0]},${p[1]}`).join("L") + (closed ? "Z" : "");
+}
+
+function problemText(e) {
+  if (e instanceof KmorphError) {
+    const lines = [`${e.title || "Error"}${e.status ? ` (${e.status})` : ""}: ${e.detail}`];
+    return lines.join("\n");
+  }
+  return e && e.message ? e.message : String(e);
+}
+
+// ----------------------------------------------------------------- editor
+
+function svgEl(name, attrs = {}, parent) {
+  const el = document.createElementNS(SVGNS, name);
+  for (const [k, v] of Object.entries(attrs)) el.setAttribute(k, v);
+  if (parent) parent.appendChild(el);
+  return el;
+}
+
+function renderEditor() {
+  const svg = $("#editor"), g = $("#editor-content");
+  g.replaceChildren();
+  for (const which of ["from", "to"]) {
+    const d = state.drawing === which ? pointsPath(state.drawn[which], $(`.draw-closed[data-which=${which}]`).checked)
+                                      : state.display[which];
+    if (d) svgEl("path", { d, class: which, "data-which": which }, g);
+  }
+  if (!state.drawing) fitViewBox(svg, g);
+  const r = viewScale(svg) * 4;
+  if (state.drawing)
+    for (const p of state.drawn[state.drawing]) svgEl("circle", { cx: p[0], cy: p[1], r, class: "ctrl" }, g);
+  for (const [a, b] of state.matches) {
+    const pa = pointAt("from", a), pb = pointAt("to", b);
+    if (!pa || !pb) continue;
+    svgEl("line", { x1: pa.x, y1: pa.y, x2: pb.x, y2: pb.y, class: "match" }, g);
+    svgEl("circle", { cx: pa.x, cy: pa.y, r, class: "match", fill: "var(--from)" }, g);
+    svgEl("circle", { cx: pb.x, cy: pb.y, r, class: "match", fill: "var(--to)" }, g);
+  }
+  if (state.pending != null) {
+    const p = pointAt("from", state.pending);
+    if (p) svgEl("circle", { cx: p.x, cy: p.y, r: r * 1.5, class: "match", fill: "var(--from)" }, g);
+  }
+  renderMatchList();
+}
+
+function fitViewBox(svg, g) {
+  let box = null;
+  try { box = g.getBBox(); } catch { box = null; }
+  if (!box || !(box.width > 0 || box.height > 0)) { svg.setAttribute("viewBox", "0 0 200 200"); return; }
+  const pad = Math.max(box.width, box.height) * 0.08 || 1;
+  svg.setAttribute("viewBox", `${box.x - pad} ${box.y - pad} ${box.width + 2 * pad} ${box.height + 2 * pad}`);
+}
+
+function viewScale(svg) {
+  const vb = svg.viewBox.baseVal, w = svg.clientWidth || 600, h = svg.clientHeight || 260;
+  return Math.max(vb.width / w, vb.height / h) || 1;
+}
+
+function pathOf(which) { return $(`#editor path.${which}`); }
+
+function pointAt(which, fraction) {
+  const p = pathOf(which);
+  if (!p) return null;
+  return p.getPointAtLength(fraction * p.getTotalLength());
+}
+
+/** The arc-length fraction of the point of `which` nearest to (x, y). */
+function nearestFraction(which, x, y) {
+  const p = pathOf(which);
+  if (!p) return null;
+  const L = p.getTotalLength(), n = 400;
+  let best = 0, bestD = Infinity;
+  for (let i = 0; i <= n; i++) {
+    const q = p.getPointAtLength(L * i / n), d = Math.hypot(q.x - x, q.y - y);
+    if (d < bestD) { bestD = d; best = i / n; }
+  }
+  return Math.round(best * 1e4) / 1e4;
+}
+
+function editorPoint(ev) {
+  const svg = $("#editor"), pt = svg.createSVGPoint();
+  pt.x = ev.clientX; pt.y = ev.clientY;
+  const m = svg.getScreenCTM();
+  const q = m ? pt.matrixTransform(m.inverse()) : pt;
+  return [Math.round(q.x * 100) / 100, Math.round(q.y * 100) / 100];
+}
+
+function onEditorClick(ev) {
+  if (state.drawing) {
+    const which = state.drawing;
+    state.drawn[which].push(editorPoint(ev));
+    $("#curve-" + which).value = JSON.stringify({ type: "points", points: state.drawn[which],
+                                                  closed: $(`.draw-closed[data-which=${which}]`).checked });
+    renderEditor();
+    return;
+  }
+  if (state.picking) {
+    const [x, y] = editorPoint(ev);
+    if (state.pending == null) {
+      state.pending = nearestFraction("from", x, y);
+    } else {
+      const b = nearestFraction("to", x, y);
+      if (b != null) state.matches.push([state.pending, b]);
+      state.matches.sort((p, q) => p[0] - q[0]);
+      state.pending = null;
+      $("#matches-mode").value = "pairs";
+    }
+    renderEditor();
+  }
+}
+
+function toggleDraw(which) {
+  const btn = $(`.draw[data-which=${which}]`);
+  if (state.drawing === which) {
+    state.drawing = null;
+    btn.textContent = "Draw";
+    $("#editor").classList.remove("drawing");
+    $("#editor-hint").textContent = "The two input curves.";
+    updateCurve(which);
+    return;
+  }
+  if (state.drawing) toggleDraw(state.drawing);
+  stopPicking();
+  state.drawing = which;
+  state.drawn[which] = [];
+  btn.textContent = "Done";
+  $("#editor").classList.add("drawing");
+  $("#editor-hint").textContent = `Click control points of the ${which} curve, then Done.`;
+  renderEditor();
+}
+
+function stopPicking() {
+  state.picking = false;
+  state.pending = null;
+  $("#editor").classList.remove("picking");
+  $("#pick-matches").textContent = "Pick pairs";
+}
+
+function renderMatchList() {
+  const ul = $("#match-list");
+  ul.replaceChildren();
+  for (const [a, b] of state.matches) {
+    const li = document.createElement("li");
+    li.textContent = `from ${a.toFixed(4)} ↔ to ${b.toFixed(4)} (arc-length fractions)`;
+    ul.appendChild(li);
+  }
+}
+
+// ------------------------------------------------------------------ morph
+
+function optionsRequest() {
+  const req = { metrics: true, include: ["svg_d"] };
+  const frames = Number($("#frames").value);
+  req.frames = Number.isInteger(frames) ? frames : $("#frames").value;
+  req.closure = $("#closure").value;
+  req.anchor = $("#anchor").value;
+  req.blend = $("#blend").value;
+  const tol = $("#tolerance").value.trim();
+  if (tol !== "") {
+    const v = Number(tol);
+    req.tolerance = Number.isFinite(v) ? v : tol;
+  }
+  const mode = $("#matches-mode").value;
+  if (mode === "auto") req.matches = "auto";
+  else if (mode === "pairs" && state.matches.length) req.matches = state.matches;
+  return req;
+}
+
+const FIELD_OF = [
+  [/^\/from(\/|$)/, "from"], [/^\/to(\/|$)/, "to"],
+  [/^\/(frames|times|matches|closure|anchor|blend|tolerance|method|orient|degree)(\/|$)/, "options"],
+];
+const INPUT_OF = { frames: "#frames", times: "#frames", matches: "#matches-mode", closure: "#closure",
+                   anchor: "#anchor", blend: "#blend", tolerance: "#tolerance", method: "#method" };
+
+function clearErrors() {
+  for (const w of ["from", "to", "options", "general"]) setFieldError(w, "");
+  for (const sel of Object.values(INPUT_OF)) $(sel).parentElement.classList.remove("has-error");
+}
+
+/** Show a service problem next to the field(s) it points at. */
+function showProblem(e, method) {
+  const prefix = method ? `${method}: ` : "";
+  if (!(e instanceof KmorphError) || !e.errors.length) {
+    setFieldError("general", prefix + problemText(e));
+    return;
+  }
+  const per = {};
+  for (const x of e.errors) {
+    const hit = FIELD_OF.find(([re]) => re.test(x.pointer || ""));
+    const where = hit ? hit[1] : "general";
+    (per[where] ||= []).push(`${x.message}${where === "general" || where === "options" ? ` (${x.pointer})` : ""}`);
+    const key = (x.pointer || "").split("/")[1];
+    if (where === "options" && INPUT_OF[key]) $(INPUT_OF[key]).parentElement.classList.add("has-error");
+  }
+  for (const [where, msgs] of Object.entries(per))
+    setFieldError(where, `${prefix}${e.title} (${e.status}): ${msgs.join("; ")}`);
+}
+
+function setBusy(busy) {
+  $("#morph").disabled = busy;
+  $("#cancel").disabled = !busy;
+}
+
+async function runMorph() {
+  clearErrors();
+  for (const which of ["from", "to"]) {
+    try { state.input[which] = parseCurve($("#curve-" + which).value); } catch (e) {
+      setFieldError(which, e.message);
+      return;
+    }
+  }
+  const base = { from: state.input.from, to: state.input.to, ...optionsRequest() };
+  const choice = $("#method").value;
+  const methods = choice === "both" ? ["curvature", "linear"] : [choice];
+  const asJob = $("#use-job").checked || (Number(base.frames) > JOB_FRAMES);
+  const ac = new AbortController();
+  state.controller = ac;
+  setBusy(true);
+  const bar = $("#progress");
+  bar.hidden = false;
+  if (asJob) bar.value = 0; else bar.removeAttribute("value");
+  const progress = Object.fromEntries(methods.map((m) => [m, 0]));
+  $("#status").textContent = asJob ? "submitting jobs…" : "morphing…";
+  const started = performance.now();
+  const runs = methods.map(async (method) => {
+    const request = { ...base, method };
+    try {
+      const result = asJob
+        ? await km.morphJob(request, { signal: ac.signal, onProgress: (s) => {
+            progress[method] = s.progress;
+            const mean = methods.reduce((sum, m) => sum + progress[m], 0) / methods.length;
+            bar.value = mean;
+            $("#status").textContent = `job ${s.state}: ${Math.floor(mean * 100)}%`;
+          } })
+        : await km.morph(request, { signal: ac.signal });
+      return { method, request, result };
+    } catch (e) {
+      return { method, request, error: e };
+    }
+  });
+  const outcomes = await Promise.all(runs);
+  setBusy(false);
+  bar.hidden = true;
+  state.controller = null;
+  if (ac.signal.aborted) {
+    $("#status").textContent = "cancelled";
+    return;
+  }
+  const failed = outcomes.filter((o) => o.error);
+  /* The same fault in both requests is shown once. */
+  const seen = new Set();
+  for (const o of failed) {
+    const key = o.error instanceof KmorphError ? JSON.stringify(o.error.errors) + o.error.detail : String(o.error);
+    if (seen.has(key)) continue;
+    seen.add(key);
+    showProblem(o.error, failed.length < outcomes.length ? o.method : "");
+  }
+  const ok = outcomes.filter((o) => o.result);
+  if (!ok.length) { $("#status").textContent = "failed"; return; }
+  const ms = Math.round(performance.now() - started);
+  $("#status").textContent = `${ok.map((o) => `${o.method}: ${o.result.frames.length} frames`).join(", ")} in ${ms} ms` +
+                             (asJob ? " (jobs)" : "");
+  showResults(ok);
+}
+
+// ---------------------------------------------------------------- results
+
+function showResults(outcomes) {
+  stop();
+  state.results = outcomes;
+  $("#results").hidden = false;
+  const panels = $("#panels");
+  panels.replaceChildren();
+  state.panels = [];
+  /* One viewBox for every panel, so shapes compare at the same scale. */
+  let b = [Infinity, Infinity, -Infinity, -Infinity];
+  for (const o of outcomes) {
+    const c = bounds(o.result);
+    b = [Math.min(b[0], c[0]), Math.min(b[1], c[1]), Math.max(b[2], c[2]), Math.max(b[3], c[3])];
+  }
+  const pad = Math.max(b[2] - b[0], b[3] - b[1]) * 0.05 || 1;
+  const viewBox = `${b[0] - pad} ${b[1] - pad} ${b[2] - b[0] + 2 * pad} ${b[3] - b[1] + 2 * pad}`;
+  for (const o of outcomes) state.panels.push(buildPanel(o, viewBox));
+  for (const p of state.panels) panels.appendChild(p.root);
+  const n = outcomes[0].result.frames.length;
+  /* Slider steps land exactly on frames: k steps per frame interval. */
+  const k = Math.max(1, Math.ceil(1000 / Math.max(1, n - 1)));
+  state.steps = Math.max(1, (n - 1) * k);
+  $("#scrub").max = String(state.steps);
+  setT(0);
+  for (const p of state.panels) loadPlot(p);
+}
+
+function fmt(v, digits = 4) {
+  if (typeof v !== "number") return "";
+  if (v !== 0 && (Math.abs(v) >= 1e5 || Math.abs(v) < 1e-3)) return v.toExponential(2);
+  return Number(v.toPrecision(digits + 2)).toString();
+}
+
+function buildPanel(o, viewBox) {
+  const root = $("#panel-template").content.firstElementChild.cloneNode(true);
+  const { method, result } = o;
+  root.id = "panel-" + method;
+  root.dataset.method = method;
+  const paths = result.frames.map((f) => f.curve.svg_d || curveToPath(f.curve));
+  const maxSi = Math.max(0, ...result.frames.map((f) => (f.metrics ? f.metrics.self_intersections : 0)));
+  const badFrames = result.frames.filter((f) => f.metrics && f.metrics.self_intersections > 0).length;
+  $(".method-name", root).textContent = method === "curvature" ? "Curvature blend" : "Linear (control points)";
+  $(".summary", root).textContent = `${result.frames.length} frames · ${badFrames} self-intersecting` +
+                                    (badFrames ? ` (up to ${maxSi})` : "");
+  const stage = $(".stage", root);
+  stage.setAttribute("viewBox", viewBox);
+  stage.dataset.testid = "stage-" + method;
+  $(".ghost.from", stage).setAttribute("d", paths[0]);
+  $(".ghost.to", stage).setAttribute("d", paths[paths.length - 1]);
+  /* Filmstrip: every frame, or FILM_MAX evenly chosen. */
+  const film = $(".filmstrip", root);
+  const n = paths.length, count = Math.min(n, FILM_MAX);
+  const picks = [...new Set(Array.from({ length: count }, (_, i) => Math.round(i * (n - 1) / Math.max(1, count - 1))))];
+  const thumbs = new Map();
+  for (const i of picks) {
+    const f = result.frames[i];
+    const svg = svgEl("svg", { viewBox, preserveAspectRatio: "xMidYMid meet", "data-frame": i,
+                               "data-si": f.metrics ? f.metrics.self_intersections : "" }, film);
+    svgEl("title", {}, svg).textContent = `frame ${i}, t = ${fmt(f.t)}` +
+      (f.metrics ? `, ${f.metrics.self_intersections} self-intersections` : "");
+    svgEl("path", { d: paths[i] }, svg);
+    if (f.metrics && f.metrics.self_intersections > 0) svg.classList.add("bad");
+    svg.addEventListener("click", () => { stop(); setT(f.t); });
+    thumbs.set(i, svg);
+  }
+  /* Metrics of every frame; self-intersecting rows stand out. */
+  const tbody = $("tbody", root), rows = [];
+  const tableFrames = result.frames.length <= 2000 ? result.frames : null;
+  if (tableFrames) {
+    const frag = document.createDocumentFragment();
+    tableFrames.forEach((f, i) => {
+      const m = f.metrics || {};
+      const tr = document.createElement("tr");
+      tr.dataset.frame = i;
+      for (const v of [i, fmt(f.t), fmt(m.length), fmt(m.max_abs_kappa), fmt(m.bending_energy),
+                       m.self_intersections ?? "", fmt(m.closure_gap)]) {
+        const td = document.createElement("td");
+        td.textContent = v;
+        tr.appendChild(td);
+      }
+      if (m.self_intersections > 0) tr.classList.add("bad");
+      tr.addEventListener("click", () => { stop(); setT(f.t); });
+      rows.push(tr);
+      frag.appendChild(tr);
+    });
+    tbody.appendChild(frag);
+  } else {
+    $(".metrics-details summary", root).textContent = `Per-frame metrics (${result.frames.length} frames: download JSON for all)`;
+  }
+  return { root, method, result, paths, stage, thumbs, rows, cache: new Map(), current: -1, request: o.request };
+}
+
+function framePoints(panel, i) {
+  let pts = panel.cache.get(i);
+  if (!pts) {
+    pts = samplePoints(panel.result.frames[i].curve, 240);
+    panel.cache.set(i, pts);
+  }
+  return pts;
+}
+
+/** The path of a panel at time t: the frame's own path at a frame time,
+ * else a blend of the two frames around t at equal arc-length fractions. */
+function pathAt(panel, t) {
+  const frames = panel.result.frames, n = frames.length;
+  let i = 0;
+  while (i < n - 2 && t > frames[i + 1].t) i++;
+  for (const j of [i, Math.min(i + 1, n - 1)])
+    if (Math.abs(frames[j].t - t) < 1e-9) return { d: panel.paths[j], frame: j, exact: true };
+  const a = framePoints(panel, i), b = framePoints(panel, i + 1);
+  const f = (t - frames[i].t) / (frames[i + 1].t - frames[i].t || 1);
+  const closed = frames[i].curve.closed;
+  const end = closed ? a.length - 1 : a.length;
+  let d = "";
+  for (let j = 0; j < end; j++) {
+    const x = a[j][0] + f * (b[j][0] - a[j][0]), y = a[j][1] + f * (b[j][1] - a[j][1]);
+    d += `${j ? "L" : "M"}${x.toFixed(5)},${y.toFixed(5)}`;
+  }
+  return { d: closed ? d + "Z" : d, frame: f < 0.5 ? i : i + 1, exact: false };
+}
+
+function setT(t) {
+  state.t = Math.min(1, Math.max(0, t));
+  $("#scrub").value = String(Math.round(state.t * state.steps));
+  $("#t-value").textContent = `t = ${state.t.toFixed(3)}`;
+  let label = "";
+  for (const p of state.panels) {
+    const at = pathAt(p, state.t);
+    const cur = $(".current", p.stage);
+    cur.setAttribute("d", at.d);
+    cur.dataset.frame = at.exact ? String(at.frame) : "";
+    const f = p.result.frames[at.frame], m = f.metrics || {};
+    const root = p.root;
+    $(".m-length", root).textContent = fmt(m.length);
+    $(".m-kappa", root).textContent = fmt(m.max_abs_kappa);
+    $(".m-energy", root).textContent = fmt(m.bending_energy);
+    const si = $(".m-si", root);
+    si.textContent = m.self_intersections ?? "";
+    si.classList.toggle("bad", m.self_intersections > 0);
+    si.dataset.testid = "si-" + p.method;
+    $(".m-gap", root).textContent = fmt(m.closure_gap);
+    p.stage.classList.toggle("bad", m.self_intersections > 0);
+    if (p.current !== at.frame) {
+      if (p.rows[p.current]) p.rows[p.current].classList.remove("current");
+      if (p.thumbs.get(p.current)) p.thumbs.get(p.current).classList.remove("current");
+      if (p.rows[at.frame]) p.rows[at.frame].classList.add("current");
+      if (p.thumbs.get(at.frame)) p.thumbs.get(at.frame).classList.add("current");
+      p.current = at.frame;
+    }
+    label = at.exact ? `frame #${at.frame} (of ${p.result.frames.length})`
+                     : `between frames (nearest ${at.frame}; metrics of that frame)`;
+  }
+  $("#frame-label").textContent = label;
+}
+
+/** Fetch the paper-style plot of kappa_t(s) for a subset of the frames. */
+async function loadPlot(panel) {
+  const div = $(".plot", panel.root);
+  const frames = panel.result.frames, n = frames.length, count = Math.min(n, PLOT_MAX);
+  const times = [...new Set(Array.from({ length: count }, (_, i) => frames[Math.round(i * (n - 1) / Math.max(1, count - 1))].t))];
+  const { include, metrics, frames: _f, ...rest } = panel.request;
+  try {
+    const svg = await km.morph({ ...rest, times, format: "svg", svg: { layout: "curvature_plot" } });
+    const img = document.createElement("img");
+    img.alt = `curvature of ${times.length} frames (${panel.method})`;
+    img.src = URL.createObjectURL(new Blob([svg], { type: "image/svg+xml" }));
+    div.replaceChildren(img);
+  } catch (e) {
+    div.textContent = "no curvature plot: " + problemText(e);
+  }
+}
+
+// --------------------------------------------------------------- playback
+
+function play() {
+  if (!state.panels.length) return;
+  state.playing = true;
+  $("#play").textContent = "Pause";
+  if (state.t >= 1) setT(0);
+  let last = performance.now();
+  const step = (now) => {
+    if (!state.playing) return;
+    const dt = (now - last) / 1000;
+    last = now;
+    const t = state.t + dt / 3;         /* a whole morph in 3 s */
+    setT(t >= 1 ? 1 : t);
+    if (t >= 1) { stop(); return; }
+    requestAnimationFrame(step);
+  };
+  requestAnimationFrame(step);
+}
+
+function stop() {
+  state.playing = false;
+  $("#play").textContent = "Play";
+}
+
+// -------------------------------------------------------------- downloads
+
+function download(name, blob) {
+  const a = document.createElement("a");
+  a.href = URL.createObjectURL(blob);
+  a.download = name;
+  document.body.appendChild(a);
+  a.click();
+  a.remove();
+  setTimeout(() => URL.revokeObjectURL(a.href), 10000);
+}
+
+function downloadJson() {
+  const data = state.results.length === 1 ? state.results[0].result
+    : Object.fromEntries(state.results.map((o) => [o.method, o.result]));
+  download("kmorph.json", new Blob([JSON.stringify(data)], { type: "application/json" }));
+}
+
+async function downloadSvg() {
+  clearErrors();
+  const layout = $("#svg-layout").value;
+  for (const o of state.results) {
+    const { include, ...rest } = o.request;
+    const req = { ...rest, format: "svg", svg: { layout } };
+    try {
+      const svg = Number(req.frames) > JOB_FRAMES ? await km.morphJob(req) : await km.morph(req);
+      download(`kmorph-${o.method}-${layout}.svg`, new Blob([svg], { type: "image/svg+xml" }));
+    } catch (e) {
+      showProblem(e, o.method);
+    }
+  }
+}
+
+// ------------------------------------------------------------------ setup
+
+function fillSelects() {
+  const ex = $("#example");
+  for (const [id, label] of PAIRS) ex.add(new Option(label, id));
+  for (const sel of document.querySelectorAll("select.pick")) {
+    sel.add(new Option("(custom)", ""));
+    for (const [id, c] of Object.entries(CURVES)) sel.add(new Option(c.label, id));
+  }
+}
+
+function chooseCurve(which, id) {
+  const c = CURVES[id];
+  if (!c) return;
+  $(`select.pick[data-testid=pick-${which}]`).value = id;
+  $("#curve-" + which).value = curveText(c.curve);
+  $(`.draw-closed[data-which=${which}]`).checked = c.curve.type === "svg" && /z\s*$/i.test(c.curve.d);
+  updateCurve(which);
+}
+
+function chooseExample(id) {
+  const pair = PAIRS.find((p) => p[0] === id);
+  if (!pair) return;
+  state.matches = [];
+  state.pending = null;
+  if ($("#matches-mode").value === "pairs") $("#matches-mode").value = "none";
+  chooseCurve("from", pair[2]);
+  chooseCurve("to", pair[3]);
+}
+
+function init() {
+  fillSelects();
+  $("#example").addEventListener("change", (e) => chooseExample(e.target.value));
+  for (const which of ["from", "to"]) {
+    $(`select.pick[data-testid=pick-${which}]`).addEventListener("change", (e) => chooseCurve(which, e.target.value));
+    let timer = null;
+    $("#curve-" + which).addEventListener("input", () => {
+      $(`select.pick[data-testid=pick-${which}]`).value = "";
+      clearTimeout(timer);
+      timer = setTimeout(() => updateCurve(which), 300);
+    });
+    $(`.draw[data-which=${which}]`).addEventListener("click", () => toggleDraw(which));
+    $(`.draw-closed[data-which=${which}]`).addEventListener("change", (e) => {
+      const ta = $("#curve-" + which);
+      try {
+        const c = JSON.parse(ta.value);
+        if (c.type === "points") { c.closed = e.target.checked; ta.value = JSON.stringify(c); updateCurve(which); }
+      } catch { /* an SVG path closes with Z instead */ }
+      renderEditor();
+    });
+  }
+  $("#editor").addEventListener("click", onEditorClick);
+  $("#pick-matches").addEventListener("click", () => {
+    if (state.picking) { stopPicking(); renderEditor(); return; }
+    if (state.drawing) toggleDraw(state.drawing);
+    state.picking = true;
+    $("#editor").classList.add("picking");
+    $("#pick-matches").textContent = "Stop picking";
+    $("#editor-hint").textContent = "Click a point on the from curve, then its partner on the to curve.";
+  });
+  $("#clear-matches").addEventListener("click", () => { state.matches = []; state.pending = null; renderEditor(); });
+  $("#morph").addEventListener("click", runMorph);
+  $("#cancel").addEventListener("click", () => state.controller && state.controller.abort());
+  $("#scrub").addEventListener("input", (e) => { stop(); setT(Number(e.target.value) / state.steps); });
+  $("#play").addEventListener("click", () => (state.playing ? stop() : play()));
+  $("#download-json").addEventListener("click", downloadJson);
+  $("#download-svg").addEventListener("click", downloadSvg);
+  chooseExample(PAIRS[0][0]);
+  document.body.dataset.ready = "1";
+}
+
+init();
