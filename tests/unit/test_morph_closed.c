@@ -651,10 +651,11 @@ static void closed_frames_respect_the_curvature_bound(void **state) {
         frame f;
         frame_get(m, i / 4.0, &f);
         if (!(f.mt.max_abs_kappa <= kmax * (1 + 1e-9))) {
-          print_error("%s, %zu matches, t = %g: max |kappa| %.9g, inputs' "
-                      "%.9g, closure gap before %.3g\n",
+          print_error("%s, %zu matches (first %.4f, %.4f), t = %g: max "
+                      "|kappa| %.9g, inputs' %.9g, closure gap before %.3g\n",
                       pr ? "rounded square to star" : "circle to ellipse", n,
-                      i / 4.0, f.mt.max_abs_kappa, kmax, f.mt.closure_gap);
+                      n ? pairs[0] : 0.0, n ? pairs[1] : 0.0, i / 4.0,
+                      f.mt.max_abs_kappa, kmax, f.mt.closure_gap);
           failures++;
         }
         frame_free(&f);
