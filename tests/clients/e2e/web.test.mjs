@@ -213,3 +213,70 @@ test("drawing by clicking control points makes a points curve the service fits",
   assert.deepEqual(errors, []);
   await page.close();
 });
+
+/** Screen coordinates of the point at arc-length fraction f of an editor curve. */
+function screenPoint(page, which, f) {
+  return page.$eval(`#editor path.${which}`, (p, f) => {
+    const q = p.getPointAtLength(f * p.getTotalLength());
+    const m = p.ownerSVGElement.getScreenCTM();
+    return { x: q.x * m.a + q.y * m.c + m.e, y: q.x * m.b + q.y * m.d + m.f };
+  }, f);
+}
+
+test("picked match pairs and the options reach the service, and the result honours the matches", async () => {
+  const { page, errors, morphs } = await openPage();
+  await page.selectOption("#example", "open-spirals");
+  await waitForEditor(page);
+  await page.click("#pick-matches");
+  for (const [which, f] of [["from", 0.3], ["to", 0.6]]) {
+    const pt = await screenPoint(page, which, f);
+    await page.mouse.click(pt.x, pt.y);
+  }
+  await page.click("#pick-matches");
+  assert.equal(await page.$$eval("#match-list li", (l) => l.length), 1);
+  assert.equal(await page.inputValue("#matches-mode"), "pairs");
+  await page.selectOption("#method", "curvature");
+  await page.selectOption("#anchor", "centroid");
+  await page.selectOption("#blend", "paper");
+  await page.fill("#tolerance", "1e-3");
+  await page.fill("#frames", "7");
+  await morphAndWait(page, 1);
+  const { request, result } = answerFor(morphs, "curvature", 7);
+  assert.equal(request.anchor, "centroid");
+  assert.equal(request.blend, "paper");
+  assert.equal(request.tolerance, 1e-3);
+  assert.equal(request.matches.length, 1);
+  /* The clicked points are the nearest of 400 samples: within 1/400 of the aim. */
+  assert.ok(Math.abs(request.matches[0][0] - 0.3) <= 0.0026, String(request.matches[0]));
+  assert.ok(Math.abs(request.matches[0][1] - 0.6) <= 0.0026, String(request.matches[0]));
+  assert.ok(result.matches_used.some(([a, b]) => Math.abs(a - request.matches[0][0]) < 1e-9 &&
+                                                 Math.abs(b - request.matches[0][1]) < 1e-9));
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test("play advances t to 1; downloads give the JSON results and an SVG document", async () => {
+  const { page, errors, morphs } = await openPage();
+  await page.selectOption("#example", "circle-star");
+  await waitForEditor(page);
+  await page.fill("#frames", "9");
+  await morphAndWait(page, 2);
+  await page.click("#play");
+  await page.waitForFunction(() => document.querySelector("#t-value").textContent === "t = 1.000", null, { timeout: 10000 });
+  assert.equal(await page.textContent("#play"), "Play");
+  const cur = answerFor(morphs, "curvature", 9).result;
+  assert.equal(await page.getAttribute("#panel-curvature .stage path.current", "d"), cur.frames[8].curve.svg_d);
+
+  const [json] = await Promise.all([page.waitForEvent("download"), page.click("#download-json")]);
+  const saved = JSON.parse(fs.readFileSync(await json.path(), "utf8"));
+  assert.deepEqual(saved.curvature, cur);
+  assert.equal(saved.linear.method, "linear");
+  await page.selectOption("#svg-layout", "overlay");
+  const download = page.waitForEvent("download");
+  await page.click("#download-svg");
+  const svg = await download;
+  assert.match(svg.suggestedFilename(), /^kmorph-curvature-overlay\.svg$/);
+  assert.match(fs.readFileSync(await svg.path(), "utf8").slice(0, 300), /<svg[\s>]/);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
