@@ -574,7 +574,7 @@ bool api__parse_signature(api_ctx *ctx, const cJSON *v, const char *ptr,
     api__invalid(ctx, p, "must be an object, not %s", type_name(jkappa));
     goto done;
   }
-  if (!api__member_int(ctx, jkappa, p, "degree", true, 0, KM_MAX_DEGREE + 1,
+  if (!api__member_int(ctx, jkappa, p, "degree", true, 0, KM_MAX_FN_DEGREE,
                        &degree, NULL))
     goto done;
   if ((jc = api__require(ctx, jkappa, p, "coefficients")) == NULL)

@@ -9,7 +9,7 @@
 #include "internal.h"
 #include "km/limits.h"
 
-#define FN_MAX_DEGREE (KM_MAX_DEGREE + 1)
+#define FN_MAX_DEGREE KM_MAX_FN_DEGREE
 
 void km_fn_init(km_fn *f) {
   if (f) memset(f, 0, sizeof *f);

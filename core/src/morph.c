@@ -682,6 +682,284 @@ static int cmp_corner(const void *x, const void *y) {
   return (a > b) - (a < b);
 }
 
+/* ---- smooth correspondence ---------------------------------------------
+ * With matches, a piecewise-linear correspondence makes ds_a/ds_t jump at
+ * every match, and with it the blended curvature: the join would be G1
+ * only. Here ds_a/ds_t = alpha(x) is piecewise linear in the frame's arc
+ * length x - continuous at the matches (the mean of the neighbouring
+ * segments' ratios), with a middle node per segment chosen so the segment
+ * still covers exactly its part of a - so s_a(x) is a C1 piecewise
+ * quadratic and s_b(x) = (x - (1-t) s_a(x)) / t follows. Then
+ *   kappa_t(x) = (1-t) kappa_a(s_a(x)) alpha(x) + t kappa_b(s_b(x)) beta(x)
+ * (turning blend; beta = ds_b/ds_t, (1-t) alpha + t beta = 1, a convex
+ * combination still) is continuous at matches and exactly a polynomial of
+ * degree 2d+1 on each piece (kappa of degree d composed with a quadratic),
+ * which is computed by interpolation at Chebyshev points. */
+
+typedef struct quad_map {
+  double x0, h;      /* frame interval [x0, x0 + h] */
+  double a0, al0, al1; /* s_a(x0), alpha at both ends */
+} quad_map;
+
+static double qm_sa(const quad_map *q, double x) {
+  double u = x - q->x0;
+  return q->a0 + q->al0 * u + (q->al1 - q->al0) * u * u / (2 * q->h);
+}
+
+/* x in [x0, x0+h] with s_a(x) = y (s_a increasing there) */
+static double qm_inv_a(const quad_map *q, double y) {
+  double lo = q->x0, hi = q->x0 + q->h;
+  for (int it = 0; it < 200 && hi - lo > 1e-15 * (fabs(lo) + q->h); it++) {
+    double mid = 0.5 * (lo + hi);
+    if (qm_sa(q, mid) < y)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+static double sb_of(const quad_map *q, double x, double t) {
+  return (x - (1 - t) * qm_sa(q, x)) / t;
+}
+
+static double qm_inv_b(const quad_map *q, double y, double t) {
+  double lo = q->x0, hi = q->x0 + q->h;
+  for (int it = 0; it < 200 && hi - lo > 1e-15 * (fabs(lo) + q->h); it++) {
+    double mid = 0.5 * (lo + hi);
+    if (sb_of(q, mid, t) < y)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+static int cmp_dbl(const void *x, const void *y) {
+  double a = *(const double *)x, b = *(const double *)y;
+  return (a > b) - (a < b);
+}
+
+/* Solve the Bernstein interpolation system (n+1 points) in place. */
+static bool bern_interp(const double *u, double *val, int n) {
+  double A[(KM_MAX_FN_DEGREE + 1) * (KM_MAX_FN_DEGREE + 1)];
+  for (int j = 0; j <= n; j++) {
+    double v = 1 - u[j], *row = A + j * (n + 1);
+    row[0] = 1.0;
+    for (int q = 1; q <= n; q++) {
+      double saved = 0.0;
+      for (int k = 0; k < q; k++) {
+        double tmp = row[k];
+        row[k] = saved + v * tmp;
+        saved = u[j] * tmp;
+      }
+      row[q] = saved;
+    }
+  }
+  for (int c = 0; c <= n; c++) {
+    int piv = c;
+    for (int r = c + 1; r <= n; r++)
+      if (fabs(A[r * (n + 1) + c]) > fabs(A[piv * (n + 1) + c])) piv = r;
+    if (!(fabs(A[piv * (n + 1) + c]) > 1e-300)) return false;
+    if (piv != c) {
+      for (int k = 0; k <= n; k++) {
+        double tmp = A[c * (n + 1) + k];
+        A[c * (n + 1) + k] = A[piv * (n + 1) + k];
+        A[piv * (n + 1) + k] = tmp;
+      }
+      double tmp = val[c];
+      val[c] = val[piv];
+      val[piv] = tmp;
+    }
+    for (int r = c + 1; r <= n; r++) {
+      double f = A[r * (n + 1) + c] / A[c * (n + 1) + c];
+      for (int k = c; k <= n; k++) A[r * (n + 1) + k] -= f * A[c * (n + 1) + k];
+      val[r] -= f * val[c];
+    }
+  }
+  for (int r = n; r >= 0; r--) {
+    double v = val[r];
+    for (int k = r + 1; k <= n; k++) v -= A[r * (n + 1) + k] * val[k];
+    val[r] = v / A[r * (n + 1) + r];
+  }
+  return true;
+}
+
+/* Returns KM_EINVAL when the smooth map is not monotone for these matches
+ * (the caller then keeps the piecewise-linear correspondence). */
+static km_status blend_smooth(const km_morph *m, double t, km_pp *out,
+                              corner_list *cl) {
+  const input *a = &m->in[0], *b = &m->in[1];
+  double La = a->sig.length, Lb = b->sig.length;
+  size_t K = m->nk - 1; /* segments */
+  double *buf = malloc((5 * K + 3) * sizeof(double));
+  if (!buf) return KM_ENOMEM;
+  double *rho = buf, *len = buf + K, *S = buf + 2 * K, *node = buf + 3 * K + 1,
+         *mid = buf + 4 * K + 2;
+  S[0] = 0.0;
+  for (size_t k = 0; k < K; k++) {
+    double la = (m->ra[k + 1] - m->ra[k]) * La, lb = (m->rb[k + 1] - m->rb[k]) * Lb;
+    len[k] = (1 - t) * la + t * lb;
+    rho[k] = la / len[k];
+    S[k + 1] = S[k] + len[k];
+  }
+  for (size_t k = 1; k < K; k++) node[k] = 0.5 * (rho[k - 1] + rho[k]);
+  if (m->closed) {
+    node[0] = node[K] = 0.5 * (rho[0] + rho[K - 1]);
+  } else {
+    node[0] = rho[0];
+    node[K] = rho[K - 1];
+  }
+  double amax = 1.0 / (1 - t);
+  km_status st = KM_EINVAL;
+  /* alpha and beta must stay positive at the middle nodes too: where a
+   * segment's ratio differs much from its neighbours', pull its end nodes
+   * toward its own ratio (at the ratio itself the segment is feasible) */
+  for (int round = 0; round < 64 && st; round++) {
+    st = KM_OK;
+    for (size_t k = 0; k < K; k++) {
+      mid[k] = 2 * rho[k] - 0.5 * (node[k] + node[k + 1]);
+      double lo = 0.02 * fmin(rho[k], amax - rho[k]);
+      if (mid[k] > lo && mid[k] < amax - lo) continue;
+      st = KM_EINVAL;
+      node[k] = rho[k] + 0.5 * (node[k] - rho[k]);
+      node[k + 1] = rho[k] + 0.5 * (node[k + 1] - rho[k]);
+      if (m->closed && k == 0) node[K] = node[0];
+      if (m->closed && k == K - 1) node[0] = node[K];
+    }
+  }
+  if (st) {
+    free(buf);
+    return st;
+  }
+  /* frame breaks: segment ends, middles, and the images of both inputs'
+   * breaks and corners */
+  size_t cap = 2 * K + 1 + a->kappa.m + b->kappa.m + 2, nb = 0;
+  double *br = malloc(cap * sizeof(double));
+  quad_map *qm = malloc(2 * K * sizeof *qm);
+  km_pp o;
+  km__pp_init(&o);
+  if (!br || !qm) {
+    st = KM_ENOMEM;
+    goto done;
+  }
+  double sa_at = 0.0;
+  for (size_t k = 0; k < K; k++) {
+    double h = 0.5 * len[k];
+    qm[2 * k] = (quad_map){S[k], h, sa_at, node[k], mid[k]};
+    sa_at = qm_sa(&qm[2 * k], S[k] + h);
+    qm[2 * k + 1] = (quad_map){S[k] + h, h, sa_at, mid[k], node[k + 1]};
+    sa_at = m->ra[k + 1] * La; /* exact at the match */
+    br[nb++] = S[k];
+    br[nb++] = S[k] + h;
+  }
+  br[nb++] = S[K];
+  size_t nq = 2 * K;
+  for (size_t i = 1; i < a->kappa.m; i++) {
+    double y = a->kappa.x[i];
+    for (size_t q = 0; q < nq; q++) {
+      double y0 = qm[q].a0, y1 = qm_sa(&qm[q], qm[q].x0 + qm[q].h);
+      if (y > y0 && y < y1) {
+        br[nb++] = qm_inv_a(&qm[q], y);
+        break;
+      }
+    }
+  }
+  for (size_t i = 1; i < b->kappa.m; i++) {
+    double y = b->kappa.x[i];
+    for (size_t q = 0; q < nq; q++) {
+      double y0 = sb_of(&qm[q], qm[q].x0, t), y1 = sb_of(&qm[q], qm[q].x0 + qm[q].h, t);
+      if (y > y0 && y < y1) {
+        br[nb++] = qm_inv_b(&qm[q], y, t);
+        break;
+      }
+    }
+  }
+  qsort(br, nb, sizeof(double), cmp_dbl);
+  size_t mb = 0;
+  for (size_t i = 0; i < nb; i++)
+    if (mb == 0 || br[i] - br[mb - 1] > 1e-13 * S[K]) br[mb++] = br[i];
+  br[mb - 1] = S[K];
+  int da = a->kappa.degree, db = b->kappa.degree;
+  int dd = 2 * (da > db ? da : db) + 1;
+  if (dd > KM_MAX_FN_DEGREE) dd = KM_MAX_FN_DEGREE;
+  st = km__pp_alloc(&o, dd, mb - 1);
+  if (st) goto done;
+  size_t q = 0;
+  for (size_t i = 0; i + 1 < mb; i++) {
+    double x0 = br[i], x1 = br[i + 1], xm = 0.5 * (x0 + x1);
+    while (q + 1 < nq && xm > qm[q].x0 + qm[q].h) q++;
+    const quad_map *Q = &qm[q];
+    double u[KM_MAX_FN_DEGREE + 1], v[KM_MAX_FN_DEGREE + 1];
+    for (int j = 0; j <= dd; j++) {
+      u[j] = 0.5 - 0.5 * cos(KM_PI * (j + 0.5) / (dd + 1));
+      double x = x0 + u[j] * (x1 - x0);
+      double al = Q->al0 + (Q->al1 - Q->al0) * (x - Q->x0) / Q->h;
+      double be = (1 - (1 - t) * al) / t;
+      double sa = qm_sa(Q, x), sb = (x - (1 - t) * sa) / t;
+      double ka = km__pp_eval(&a->kappa, fmin(fmax(sa, 0.0), La));
+      double kb = km__pp_eval(&b->kappa, fmin(fmax(sb, 0.0), Lb));
+      v[j] = m->opt.blend == KM_BLEND_PAPER ? (1 - t) * ka + t * kb
+                                             : (1 - t) * ka * al + t * kb * be;
+    }
+    if (!bern_interp(u, v, dd)) {
+      st = KM_ENOCONVERGE;
+      goto done;
+    }
+    memcpy(o.c + i * (size_t)(dd + 1), v, (size_t)(dd + 1) * sizeof(double));
+    o.x[i] = x0;
+  }
+  o.x[0] = 0.0;
+  o.x[mb - 1] = S[K];
+  /* corners at the images of the inputs' corners */
+  for (int w = 0; w < 2 && !st; w++) {
+    const input *in = w ? b : a;
+    double cw = w ? t : 1 - t;
+    for (size_t i = 0; i < in->sig.ncorners && !st; i++) {
+      double y = in->sig.corners[i].s, x = -1.0;
+      double L = w ? Lb : La;
+      if (y >= L * (1 - 1e-12)) {
+        x = S[K];
+      } else if (y <= 0) {
+        x = 0.0;
+      } else {
+        for (size_t k = 0; k < nq; k++) {
+          double y0 = w ? sb_of(&qm[k], qm[k].x0, t) : qm[k].a0;
+          double y1 = w ? sb_of(&qm[k], qm[k].x0 + qm[k].h, t)
+                        : qm_sa(&qm[k], qm[k].x0 + qm[k].h);
+          if (y >= y0 && y <= y1) {
+            x = w ? qm_inv_b(&qm[k], y, t) : qm_inv_a(&qm[k], y);
+            break;
+          }
+        }
+      }
+      if (x < 0) continue;
+      double turn = cw * in->sig.corners[i].turn;
+      if (m->opt.blend == KM_BLEND_PAPER) {
+        /* the delta scales with dx/ds of that input */
+        size_t k = 0;
+        while (k + 1 < nq && x > qm[k].x0 + qm[k].h) k++;
+        double al = qm[k].al0 + (qm[k].al1 - qm[k].al0) * (x - qm[k].x0) / qm[k].h;
+        double be = (1 - (1 - t) * al) / t;
+        turn /= w ? be : al;
+        if (turn >= KM_PI) turn = KM_PI - 1e-9;
+        if (turn <= -KM_PI) turn = -KM_PI + 1e-9;
+      }
+      st = corner_push(cl, x, turn);
+    }
+  }
+  if (!st) {
+    *out = o;
+    km__pp_init(&o);
+  }
+done:
+  km__pp_free(&o);
+  free(br);
+  free(qm);
+  free(buf);
+  return st;
+}
+
 /* The blended signature of frame t (before closure), placed at the origin
  * with the blended start angle. */
 static km_status blend_signature(const km_morph *m, double t,
@@ -697,7 +975,15 @@ static km_status blend_signature(const km_morph *m, double t,
   double S = 0.0;
   size_t total = 0;
   int deg = 0;
-  for (size_t k = 0; !st && k + 1 < m->nk; k++) {
+  bool smooth = false;
+  if (!st && m->nk > 2 && t > 0 && t < 1) {
+    km_status ss = blend_smooth(m, t, &whole, &cl);
+    if (ss == KM_OK)
+      smooth = true;
+    else if (ss != KM_EINVAL)
+      st = ss;
+  }
+  for (size_t k = 0; !st && !smooth && k + 1 < m->nk; k++) {
     double la = (m->ra[k + 1] - m->ra[k]) * La, lb = (m->rb[k + 1] - m->rb[k]) * Lb;
     double l = (1 - t) * la + t * lb;
     double wa, wb;
@@ -739,8 +1025,8 @@ static km_status blend_signature(const km_morph *m, double t,
     }
     S += l;
   }
-  if (!st) st = km__pp_alloc(&whole, deg, total);
-  if (!st) {
+  if (!st && !smooth) st = km__pp_alloc(&whole, deg, total);
+  if (!st && !smooth) {
     size_t q = 0;
     for (size_t k = 0; k + 1 < m->nk; k++) {
       for (size_t i = 0; i < segs[k].m; i++, q++) {

@@ -34,7 +34,7 @@ km_status km__pp_alloc(km_pp *p, int degree, size_t m) {
 }
 
 double km__bern_eval(const double *c, int d, double u) {
-  double b[KM_MAX_DEGREE + 12];
+  double b[KM_MAX_FN_DEGREE + 2];
   memcpy(b, c, (size_t)(d + 1) * sizeof(double));
   double v = 1.0 - u;
   for (int r = 1; r <= d; r++)
@@ -46,7 +46,7 @@ double km__bern_eval(const double *c, int d, double u) {
  * may be NULL). */
 static void bern_split(const double *c, int d, double u, double *L,
                        double *R) {
-  double b[KM_MAX_DEGREE + 12];
+  double b[KM_MAX_FN_DEGREE + 2];
   memcpy(b, c, (size_t)(d + 1) * sizeof(double));
   double v = 1.0 - u;
   if (L) L[0] = b[0];
@@ -60,7 +60,7 @@ static void bern_split(const double *c, int d, double u, double *L,
 
 void km__bern_restrict(const double *c, int d, double u0, double u1,
                        double *out) {
-  double tmp[KM_MAX_DEGREE + 12];
+  double tmp[KM_MAX_FN_DEGREE + 2];
   if (u0 <= 0.0 && u1 >= 1.0) {
     memcpy(out, c, (size_t)(d + 1) * sizeof(double));
     return;
@@ -78,7 +78,7 @@ void km__bern_restrict(const double *c, int d, double u0, double u1,
 }
 
 void km__bern_elevate(const double *c, int d, int e, double *out) {
-  double a[KM_MAX_DEGREE + 12], b[KM_MAX_DEGREE + 12];
+  double a[KM_MAX_FN_DEGREE + 2], b[KM_MAX_FN_DEGREE + 2];
   memcpy(a, c, (size_t)(d + 1) * sizeof(double));
   for (int k = d; k < e; k++) {
     b[0] = a[0];
@@ -134,7 +134,7 @@ double km__pp_eval(const km_pp *p, double x) {
  * level). */
 static double blossom(const km_fn *f, size_t i, const double *u) {
   int p = f->degree;
-  double d[KM_MAX_DEGREE + 12];
+  double d[KM_MAX_FN_DEGREE + 2];
   const double *U = f->knots;
   for (int j = 0; j <= p; j++) d[j] = f->coef[i - (size_t)p + (size_t)j];
   for (int r = 1; r <= p; r++) {
@@ -181,7 +181,7 @@ km_status km__pp_from_fn(km_pp *out, const km_fn *f) {
   km_pp r;
   if (km__pp_alloc(&r, p, m)) return KM_ENOMEM;
   size_t k = 0;
-  double u[KM_MAX_DEGREE + 12];
+  double u[KM_MAX_FN_DEGREE + 2];
   for (size_t i = (size_t)p; i < f->n; i++) {
     double a = f->knots[i], b = f->knots[i + 1];
     if (!(b > a)) continue;

@@ -27,7 +27,7 @@
 #include "km/limits.h"
 #include "km/reconstruct.h"
 
-#define MAXD (KM_MAX_DEGREE + 12)
+#define MAXD (KM_MAX_FN_DEGREE + 2)
 
 /* theta as pieces: breaks include kappa's and the corners' positions;
  * kappa pieces kept beside for the bounds. */

@@ -17,7 +17,7 @@
 #include "km/status.h"
 
 typedef struct km_fn {
-  int degree;     /* 0..KM_MAX_DEGREE+1 */
+  int degree;     /* 0..KM_MAX_FN_DEGREE */
   size_t n;       /* number of coefficients */
   double *knots;  /* n + degree + 1 */
   double *coef;   /* n */
@@ -26,7 +26,7 @@ typedef struct km_fn {
 void km_fn_init(km_fn *f);
 void km_fn_free(km_fn *f);
 
-/* Validating constructor (copies): degree 0..10 (KM_EDEGREE), counts
+/* Validating constructor (copies): degree 0..KM_MAX_FN_DEGREE (KM_EDEGREE), counts
  * (KM_ECOUNT), finite (KM_ENONFINITE), knots non-decreasing and clamped with
  * interior multiplicity <= degree+1 and a non-empty domain (KM_EKNOTS). */
 km_status km_fn_create(km_fn *out, int degree, size_t n, const double *knots,

@@ -11,6 +11,11 @@
 #define KM_MIN_DEGREE 1
 #define KM_MAX_DEGREE 9
 
+/* Scalar functions (kappa) up to degree 20: a blended frame's curvature
+ * under a smooth correspondence composes degree-6 pieces with quadratic
+ * reparameterisations (degree 13); 20 leaves room for user input. */
+#define KM_MAX_FN_DEGREE 20
+
 /* Coordinates and lengths beyond 1e15 leave fewer than one digit of
  * sub-unit precision in a double; refuse rather than compute noise. */
 #define KM_MAX_COORDINATE 1e15
