@@ -53,7 +53,8 @@ APIT_BIN  := $(APIT_SRC:%.c=$(BUILD)/%)
 SUPPORT_SRC := $(wildcard tests/support/*.c)
 
 .PHONY: all deps build run test test-unit test-asan test-server test-clients check-layers \
-        bench bench-http fuzz fuzz-svg clean format examples
+        bench bench-http fuzz fuzz-svg clean format examples \
+        test-fuzz test-hardening bench-load
 
 all: build
 
@@ -134,6 +135,10 @@ test: deps
 	@$(MAKE) --no-print-directory test-server || true
 	@echo "== clients: curl, JS, Python and the web page in Chromium"
 	@$(MAKE) --no-print-directory test-clients || true
+	@echo "== fuzzing: every tests/fuzz target for $(TEST_FUZZ_SECONDS) s (ASan, UBSan, LSan)"
+	@$(MAKE) --no-print-directory test-fuzz || true
+	@echo "== hardening: bad-input barrage, daemon under ASan, leaks, load, faults"
+	@$(MAKE) --no-print-directory test-hardening || true
 	@tests/summarise.sh
 
 # The daemon over real HTTP (loopback, ephemeral ports); appends its counts
@@ -181,6 +186,13 @@ build/bench/%: bench/%.c $(LIBCORE)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) $(CORE_INC) $< -o $@ $(LIBCORE) -lm $(LDFLAGS)
 
+# The paper's spiral pair (kappa = s and kappa = -s/2 on [0, 4]) as
+# filmstrips and curvature plots for both methods, written to docs/.
+EXAMPLE_SVGS := $(patsubst docs/examples/%.json,docs/%.svg,$(wildcard docs/examples/spirals-*-*.json))
+examples: $(CLI) $(EXAMPLE_SVGS)
+docs/%.svg: docs/examples/%.json $(CLI)
+	$(CLI) morph < $< > $@
+
 format:
 	clang-format -i core/src/*.c core/include/km/*.h api/src/*.c api/include/kmapi/*.h cli/*.c $(wildcard server/src/*.[ch])
 
@@ -197,6 +209,42 @@ fuzz-svg: deps
 	build/fuzz/fuzz_svg_path -max_total_time=$(FUZZ_SECONDS) -timeout=10 \
 	  -dict=tests/fuzz/svg_path/svg_path.dict \
 	  build/fuzz/svg_path-corpus tests/fuzz/svg_path/corpus
+
+# Every libFuzzer target tests/fuzz/<name>/fuzz_<name>.c, linked with the
+# whole api and core layers. `make fuzz` runs each for FUZZ_SECONDS (600
+# unless given), `make test-fuzz` for TEST_FUZZ_SECONDS; both record counts
+# like the other suites (tests/hardening/fuzz.sh).
+FUZZ_NAMES := $(patsubst tests/fuzz/%/,%,$(dir $(wildcard tests/fuzz/*/fuzz_*.c)))
+FUZZ_BINS  := $(FUZZ_NAMES:%=build/fuzz/fuzz_%)
+TEST_FUZZ_SECONDS ?= 60
+FUZZ_CFLAGS := $(CSTD) -g -O1 $(WARN) -D_POSIX_C_SOURCE=200809L \
+  -fsanitize=address,undefined -fno-sanitize-recover=undefined \
+  -Iapi/include -Iapi/src $(CORE_INC) $(CJSON_CFLAGS)
+FUZZ_OBJ := $(CORE_SRC:%.c=build/fuzz/obj/%.o) $(API_SRC:%.c=build/fuzz/obj/%.o)
+build/fuzz/obj/%.o: %.c
+	@mkdir -p $(@D)
+	clang $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link -MMD -MP -c $< -o $@
+-include $(FUZZ_OBJ:.o=.d)
+define FUZZ_RULE
+build/fuzz/fuzz_$(1): tests/fuzz/$(1)/fuzz_$(1).c $(wildcard tests/fuzz/*.h) $(FUZZ_OBJ)
+	clang $(FUZZ_CFLAGS) -fsanitize=fuzzer $$< $(FUZZ_OBJ) $(CJSON_LIBS) -lm -o $$@
+endef
+$(foreach t,$(FUZZ_NAMES),$(eval $(call FUZZ_RULE,$(t))))
+
+fuzz: deps $(FUZZ_BINS)
+	@tests/hardening/fuzz.sh $(if $(filter file undefined,$(origin FUZZ_SECONDS)),600,$(FUZZ_SECONDS)) $(FUZZ_NAMES)
+
+test-fuzz: $(FUZZ_BINS)
+	@tests/hardening/fuzz.sh $(TEST_FUZZ_SECONDS) $(FUZZ_NAMES)
+
+# Bad-input barrage, the daemon under ASan, leak checks of the CLI, load
+# and faults (tests/hardening/run.sh; HARDENING_LONG=1 for the long run).
+test-hardening: build
+	@$(MAKE) --no-print-directory BUILD=build/asan SAN=address OPT=-O1 build >/dev/null
+	@tests/hardening/run.sh
+
+bench-load: build
+	@HARDENING_LONG=1 tests/hardening/run.sh load faults
 
 clean:
 	rm -rf build
