@@ -513,12 +513,25 @@ int api_morph_render_frame(api_morph_plan *plan, size_t i) {
   return 0;
 }
 
-/* Number of cubic pieces in an SVG path (its "C" commands). */
+/* Number of cubic pieces in an SVG path written as "M x y C ..." with the
+ * C command not repeated: six numbers a piece after the two of the moveto. */
 static size_t count_pieces(const char *d) {
-  size_t n = 0;
-  for (; *d != '\0'; d++)
-    n += *d == 'C' || *d == 'c';
-  return n;
+  size_t numbers = 0;
+  while (*d != '\0') {
+    char *end;
+    if ((*d >= '0' && *d <= '9') || *d == '-' || *d == '+' || *d == '.') {
+      strtod(d, &end);
+      if (end == d) {
+        d++;
+        continue;
+      }
+      numbers++;
+      d = end;
+    } else {
+      d++;
+    }
+  }
+  return numbers > 2 ? (numbers - 2) / 6 : 1;
 }
 
 static cJSON *metrics_json(api_ctx *ctx, const km_frame_metrics *m) {
