@@ -332,7 +332,7 @@ static void fn_create_rejects_bad_input(void **state) {
   km_error err;
   km_fn_init(&f);
   const double kn[8] = {0, 0, 0, 0, 1, 1, 1, 1}, c[4] = {1, 2, 3, 4};
-  assert_status(km_fn_create(&f, 11, 4, kn, c, &err), KM_EDEGREE);
+  assert_status(km_fn_create(&f, KM_MAX_FN_DEGREE + 1, 4, kn, c, &err), KM_EDEGREE);
   assert_status(km_fn_create(&f, -1, 4, kn, c, &err), KM_EDEGREE);
   assert_status(km_fn_create(&f, 3, 3, kn, c, &err), KM_ECOUNT);
   const double bad[8] = {0, 0, 0, 0, 1, 1, 1, 0.5};
