@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "km/fn.h"
+#include "km/limits.h"
 #include "testutil.h"
 
 static void make_fn(km_fn *f, int p, size_t n, const double *knots,
