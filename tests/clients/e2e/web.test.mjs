@@ -40,7 +40,10 @@ async function openPage() {
   const errors = [], morphs = [];
   page.on("console", (m) => { if (m.type() === "error") errors.push(m.text()); });
   page.on("pageerror", (e) => errors.push("page error: " + e.message));
-  page.on("response", async (r) => {
+  /* the handlers below read bodies asynchronously: morphAndWait awaits
+   * them, or a test could look at `morphs` before the answer is in */
+  page.kmPending = [];
+  page.on("response", (r) => page.kmPending.push((async () => {
     const u = new URL(r.url());
     const isMorph = u.pathname === "/v1/morph" && r.request().method() === "POST";
     const isResult = /^\/v1\/jobs\/[0-9a-f]+\/result$/.test(u.pathname);
@@ -48,7 +51,7 @@ async function openPage() {
       try { morphs.push({ request: isMorph ? JSON.parse(r.request().postData()) : null, result: await r.json() }); }
       catch { /* page gone */ }
     }
-  });
+  })()));
   await page.goto(daemon.url + "/", { waitUntil: "load" });
   await page.waitForSelector("body[data-ready='1']", { timeout: 10000 });
   return { page, errors, morphs };
@@ -63,6 +66,7 @@ async function morphAndWait(page, count) {
   await page.click("#morph");
   await page.waitForFunction((n) => document.querySelectorAll("#panels .panel").length === n &&
                                     !document.querySelector("#morph").disabled, count, { timeout: 60000 });
+  await Promise.all(page.kmPending);
 }
 
 /** The JSON answer of the page's morph with this method and frame count. */
