@@ -266,7 +266,10 @@ test("play advances t to 1; downloads give the JSON results and an SVG document"
   await page.fill("#frames", "9");
   await morphAndWait(page, 2);
   await page.click("#play");
-  await page.waitForFunction(() => document.querySelector("#t-value").textContent === "t = 1.000", null, { timeout: 10000 });
+  /* playing stops by itself at t = 1 (the label and t change in separate
+   * frames, so wait for both) */
+  await page.waitForFunction(() => document.querySelector("#t-value").textContent === "t = 1.000" &&
+                                    document.querySelector("#play").textContent === "Play", null, { timeout: 10000 });
   assert.equal(await page.textContent("#play"), "Play");
   const cur = answerFor(morphs, "curvature", 9).result;
   assert.equal(await page.getAttribute("#panel-curvature .stage path.current", "d"), cur.frames[8].curve.svg_d);
