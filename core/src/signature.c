@@ -173,6 +173,8 @@ typedef struct builder {
   double pending_start; /* theta the next piece must start from, or NAN */
   size_t span_first;    /* index of the current span's first piece */
   km__bspan span;       /* the current span in Bezier form */
+  double deriv_noise;   /* rounding error of |C'| in this span */
+  long budget;          /* fit_piece calls left: bounds adversarial input */
   km_error *err;
 } builder;
 
@@ -312,7 +314,11 @@ static double span_speed_at(const void *ctx, double t) {
 
 /* arc length inside the current span */
 static double span_length(const builder *b, double ua, double ub) {
-  return km__integrate_adaptive(span_speed_at, &b->span, ua, ub, 1e-15 * b->L);
+  /* relative to the piece, not the curve: near a sharp tip pieces are
+   * many orders of magnitude shorter than the curve and their node
+   * positions need their own digits */
+  return km__integrate_adaptive(span_speed_at, &b->span, ua, ub,
+                                1e-14 * (ub - ua) * b->span_speed);
 }
 
 /* Cumulative integral of f sampled at the Chebyshev-Lobatto points
@@ -360,6 +366,11 @@ static void cheb_cumulative(const double *f, int n, double *F) {
 static km_status fit_piece(builder *b, double ua, double ub, double known_len,
                            double *s_at, double *theta, const double dir_a[2],
                            const double dir_b[2], int depth) {
+  if (--b->budget < 0)
+    return km__fail(b->err, KM_ELIMIT, KM_FIELD_TOLERANCE, -1, ua,
+                    "the curve needs too many pieces at this tolerance (near "
+                    "parameter t = %g): loosen the tolerance",
+                    ua);
   double t[NPTS], th[NPTS], s[NPTS], dir[NPTS][2];
   double mid = 0.5 * (ua + ub), half = 0.5 * (ub - ua);
   for (int k = 0; k < NPTS; k++)
@@ -385,6 +396,14 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
       dir[k][1] = dir[k - 1][1];
     }
   }
+  /* Directions from C' carry rounding error deriv_noise / |C'|: where the
+   * speed nearly vanishes that exceeds any tolerance, and asking for more
+   * would only bisect into noise. */
+  double noise = 0.0;
+  for (int k = 0; k < NPTS; k++)
+    if (speed[k] > 0) noise = fmax(noise, b->deriv_noise / speed[k]);
+  if (noise > 0.1) noise = 0.1;
+  double tol_here = b->tol_theta + 2.0 * noise;
   /* unwrap, watching for steps too large to interpolate */
   bool coarse = false;
   double big_step = 0.0;
@@ -399,15 +418,17 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
   /* arc length at every point: spectral integration of the speed at the
    * nodes, checked against adaptive quadrature of the whole piece */
   cheb_cumulative(speed, NPTS - 1, F);
-  for (int k = 0; k < NPTS; k++) s[k] = *s_at + half * F[k];
+  /* s[] holds arc length from the piece's start: near a sharp tip a piece
+   * can be shorter than the rounding unit of the absolute arc length */
+  for (int k = 0; k < NPTS; k++) s[k] = half * F[k];
   double h = s[NPTS - 1] - s[0];
   double ref = known_len > 0 ? known_len : span_length(b, ua, ub);
-  if (fabs(h - ref) > 1e-14 * b->L + 1e-13 * ref) {
+  if (fabs(h - ref) > 1e-12 * ref + 1e-16 * b->L) {
     /* the speed is not resolved by the nodes (near-degenerate leg) */
     for (int k = 1; k < NPTS; k++)
       s[k] = s[k - 1] + span_length(b, t[k - 1], t[k]);
   }
-  s[NPTS - 1] = s[0] + ref;
+  s[NPTS - 1] = ref;
   h = ref;
   bool tiny_t = (ub - ua) < 1e-13 * b->span_t;
   if (!(h > 1e-15 * b->L)) {
@@ -458,7 +479,7 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
     }
     for (int k = 1; ok && k < NPTS; k += 2) {
       double u = (s[k] - s[0]) / h;
-      if (fabs(km__bern_eval(coef, THETA_DEGREE, u) - th[k]) > b->tol_theta)
+      if (fabs(km__bern_eval(coef, THETA_DEGREE, u) - th[k]) > tol_here)
         ok = false;
     }
   }
@@ -469,7 +490,7 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
       lo = fmin(lo, th[k]);
       hi = fmax(hi, th[k]);
     }
-    if (hi - lo > 4 * b->tol_theta + 1e-12)
+    if (hi - lo > 4 * tol_here + 1e-12)
       return km__fail(b->err, KM_ENOCONVERGE, KM_FIELD_CONTROL_POINTS, -1,
                       mid,
                       "curvature could not be resolved near parameter t = "
@@ -484,9 +505,9 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
       coef[0] = b->pending_start;
       b->pending_start = NAN;
     }
-    km_status st = push_piece(b, s[0], s[NPTS - 1], coef);
+    km_status st = push_piece(b, *s_at, *s_at + h, coef);
     if (st) return st;
-    *s_at = s[NPTS - 1];
+    *s_at += h;
     *theta = th[NPTS - 1];
     return KM_OK;
   }
@@ -522,6 +543,7 @@ km_status km_signature_compute(const km_curve *c, double tol,
   b.c = c;
   b.err = err;
   b.pending_start = NAN;
+  b.budget = 200000 + 2000 * (long)c->n;
   km_status st = KM_OK;
   km_pp kp;
   km__pp_init(&kp);
@@ -569,6 +591,14 @@ km_status km_signature_compute(const km_curve *c, double tol,
     b.span_t = ub - ua;
     km__bspan_make(&b.span, c, i);
     b.span_speed = len / (ub - ua);
+    {
+      /* |C'| is p/h times differences of points of magnitude up to M */
+      double M = 0.0;
+      for (int q = 0; q <= c->degree; q++)
+        M = fmax(M, fmax(fabs(b.span.h[q][0]), fabs(b.span.h[q][1])) /
+                        fmax(b.span.h[q][2], 1e-300));
+      b.deriv_noise = 8.0 * 2.220446049250313e-16 * c->degree * M / (ub - ua);
+    }
     double da[2], db[2];
     if (!tangent_limit(&b, ua, 1, da) || !tangent_limit(&b, ub, -1, db)) {
       st = km__fail(err, KM_EDEGENERATE, KM_FIELD_CONTROL_POINTS, -1, ua,
