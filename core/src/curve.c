@@ -320,9 +320,8 @@ static double integrate_rec(km__scalar_fn f, const void *ctx, double a,
    * integrands (a speed that is rounding noise around zero). */
   double d = fabs(g16 - g8), mag = fabs(g16);
   double est16 = d < 1e-3 * mag ? d * d / mag : d;
-  if (est16 <= fmax(abs_tol, 8e-16 * mag) || depth >= 40 || --*budget <= 0 ||
-      !(b - a > 1e-300))
-    return g16;
+  if (est16 <= fmax(abs_tol, 8e-16 * mag) || !(b - a > 1e-300)) return g16;
+  if (depth >= 40 || --*budget <= 0) return NAN; /* not to the precision */
   double m = 0.5 * (a + b);
   return integrate_rec(f, ctx, a, m, 0.5 * abs_tol, depth + 1, budget) +
          integrate_rec(f, ctx, m, b, 0.5 * abs_tol, depth + 1, budget);
@@ -331,7 +330,7 @@ static double integrate_rec(km__scalar_fn f, const void *ctx, double a,
 double km__integrate_adaptive(km__scalar_fn f, const void *ctx, double a,
                               double b, double abs_tol) {
   if (!(b > a)) return 0.0;
-  long budget = 4096;
+  long budget = 1024;
   return integrate_rec(f, ctx, a, b, abs_tol, 0, &budget);
 }
 
@@ -364,7 +363,14 @@ double km_curve_length_between(const km_curve *c, double ta, double tb) {
   size_t p = (size_t)c->degree;
   for (size_t i = p; i < c->n; i++) {
     double a = fmax(c->knots[i], ta), b = fmin(c->knots[i + 1], tb);
-    if (b > a) L += km__length_adaptive(c, a, b, tol);
+    if (!(b > a)) continue;
+    /* integrate in the span's own variable u in [0, 1]: a span far
+     * narrower than its knot values would lose digits in t */
+    km__bspan sp;
+    km__bspan_make(&sp, c, i);
+    double w = c->knots[i + 1] - c->knots[i];
+    L += km__bspan_length(&sp, (a - c->knots[i]) / w, (b - c->knots[i]) / w,
+                          tol);
   }
   return L;
 }
@@ -444,10 +450,10 @@ void km__bspan_make(km__bspan *sp, const km_curve *c, size_t i) {
   }
 }
 
-void km__bspan_eval(const km__bspan *sp, double t, double pos[2],
-                    double der[2]) {
+void km__bspan_eval_u(const km__bspan *sp, double u, double pos[2],
+                      double der_u[2]) {
   int p = sp->degree;
-  double len = sp->b - sp->a, u = (t - sp->a) / len, v = 1.0 - u;
+  double v = 1.0 - u;
   double d[KM__BSPAN_MAX][3];
   memcpy(d, sp->h, sizeof(double) * 3 * (size_t)(p + 1));
   for (int r = 1; r < p; r++)
@@ -456,11 +462,30 @@ void km__bspan_eval(const km__bspan *sp, double t, double pos[2],
   double H[3], dH[3];
   for (int q = 0; q < 3; q++) {
     H[q] = v * d[0][q] + u * d[1][q];
-    dH[q] = p * (d[1][q] - d[0][q]) / len;
+    dH[q] = p * (d[1][q] - d[0][q]);
   }
   double w = H[2];
   pos[0] = H[0] / w;
   pos[1] = H[1] / w;
-  der[0] = (dH[0] - pos[0] * dH[2]) / w;
-  der[1] = (dH[1] - pos[1] * dH[2]) / w;
+  der_u[0] = (dH[0] - pos[0] * dH[2]) / w;
+  der_u[1] = (dH[1] - pos[1] * dH[2]) / w;
+}
+
+void km__bspan_eval(const km__bspan *sp, double t, double pos[2],
+                    double der[2]) {
+  double len = sp->b - sp->a;
+  km__bspan_eval_u(sp, (t - sp->a) / len, pos, der);
+  der[0] /= len;
+  der[1] /= len;
+}
+
+static double bspan_speed_u(const void *ctx, double u) {
+  double p[2], d[2];
+  km__bspan_eval_u(ctx, u, p, d);
+  return sqrt(d[0] * d[0] + d[1] * d[1]);
+}
+
+double km__bspan_length(const km__bspan *sp, double u0, double u1,
+                        double abs_tol) {
+  return km__integrate_adaptive(bspan_speed_u, sp, u0, u1, abs_tol);
 }

@@ -39,7 +39,10 @@ extern const double km__gl16_x[16], km__gl16_w[16];
 double km__speed(const km_curve *c, double t);
 double km__length_adaptive(const km_curve *c, double a, double b,
                            double abs_tol);
-/* Adaptive Gauss-Legendre (8 vs 16 points, bisection) of f over [a, b]. */
+/* Adaptive Gauss-Legendre (8 vs 16 points, bisection) of f over [a, b];
+ * NaN when the precision cannot be reached within a fixed amount of work
+ * (an integrand that is rounding noise, or nearly singular), so that no
+ * caller reports a length less precise than it promises. */
 typedef double (*km__scalar_fn)(const void *ctx, double t);
 double km__integrate_adaptive(km__scalar_fn f, const void *ctx, double a,
                               double b, double abs_tol);
@@ -57,6 +60,12 @@ void km__bspan_make(km__bspan *sp, const km_curve *c, size_t i);
 /* Position and derivative with respect to t at t in [a, b]. */
 void km__bspan_eval(const km__bspan *sp, double t, double pos[2],
                     double der[2]);
+/* The same in the span's variable u = (t - a) / (b - a) in [0, 1]. */
+void km__bspan_eval_u(const km__bspan *sp, double u, double pos[2],
+                      double der_u[2]);
+/* Arc length between u0 and u1 (adaptive, NaN as km__integrate_adaptive). */
+double km__bspan_length(const km__bspan *sp, double u0, double u1,
+                        double abs_tol);
 
 /* Span index i with knots[i] <= t < knots[i+1] (last non-empty span at the
  * domain end); side < 0 picks knots[i] < t <= knots[i+1]. */

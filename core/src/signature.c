@@ -306,19 +306,14 @@ static void bernstein_row(double u, int d, double *row) {
   }
 }
 
-static double span_speed_at(const void *ctx, double t) {
-  double p[2], d[2];
-  km__bspan_eval(ctx, t, p, d);
-  return sqrt(d[0] * d[0] + d[1] * d[1]);
-}
-
-/* arc length inside the current span */
+/* arc length inside the current span, in its own variable u */
 static double span_length(const builder *b, double ua, double ub) {
   /* relative to the piece, not the curve: near a sharp tip pieces are
    * many orders of magnitude shorter than the curve and their node
    * positions need their own digits */
-  return km__integrate_adaptive(span_speed_at, &b->span, ua, ub,
-                                1e-14 * (ub - ua) * b->span_speed);
+  double a = b->span.a, w = b->span.b - a;
+  return km__bspan_length(&b->span, (ua - a) / w, (ub - a) / w,
+                          1e-14 * (ub - ua) * b->span_speed);
 }
 
 /* Cumulative integral of f sampled at the Chebyshev-Lobatto points
@@ -423,10 +418,20 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
   for (int k = 0; k < NPTS; k++) s[k] = half * F[k];
   double h = s[NPTS - 1] - s[0];
   double ref = known_len > 0 ? known_len : span_length(b, ua, ub);
+  if (isnan(ref))
+    return km__fail(b->err, KM_ENOCONVERGE, KM_FIELD_CONTROL_POINTS, -1, ua,
+                    "the arc length near parameter t = %g cannot be computed "
+                    "to full precision",
+                    ua);
   if (fabs(h - ref) > 1e-12 * ref + 1e-16 * b->L) {
     /* the speed is not resolved by the nodes (near-degenerate leg) */
     for (int k = 1; k < NPTS; k++)
       s[k] = s[k - 1] + span_length(b, t[k - 1], t[k]);
+    if (isnan(s[NPTS - 1]))
+      return km__fail(b->err, KM_ENOCONVERGE, KM_FIELD_CONTROL_POINTS, -1, ua,
+                      "the arc length near parameter t = %g cannot be "
+                      "computed to full precision",
+                      ua);
   }
   s[NPTS - 1] = ref;
   h = ref;
@@ -543,7 +548,7 @@ km_status km_signature_compute(const km_curve *c, double tol,
   b.c = c;
   b.err = err;
   b.pending_start = NAN;
-  b.budget = 200000 + 2000 * (long)c->n;
+  b.budget = 50000 + 100 * (long)c->n;
   km_status st = KM_OK;
   km_pp kp;
   km__pp_init(&kp);
@@ -561,14 +566,19 @@ km_status km_signature_compute(const km_curve *c, double tol,
     if (c->knots[i + 1] > c->knots[i]) {
       km__bspan sp;
       km__bspan_make(&sp, c, i);
-      span_len[i] = km__integrate_adaptive(span_speed_at, &sp, c->knots[i],
-                                           c->knots[i + 1], 1e-15 * poly);
+      span_len[i] = km__bspan_length(&sp, 0.0, 1.0, 1e-15 * poly);
     }
     L += span_len[i];
   }
   km_curve_domain(c, &t0, &t1);
   double extent = 0.0;
   for (size_t i = 0; i < 2 * c->n; i++) extent = fmax(extent, fabs(c->cp[i]));
+  if (isnan(L)) {
+    st = km__fail(err, KM_ENOCONVERGE, KM_FIELD_CONTROL_POINTS, -1, NAN,
+                  "the arc length cannot be computed to full precision (the "
+                  "speed nearly vanishes inside a span)");
+    goto cleanup;
+  }
   if (!(L > 1e-13 * extent) || !(L > 1e-300)) {
     st = km__fail(err, KM_EDEGENERATE, KM_FIELD_CONTROL_POINTS, -1, NAN,
                   "the curve has zero length");
