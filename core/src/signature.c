@@ -482,6 +482,22 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
       coef[0] = th[0];
       coef[THETA_DEGREE] = th[NPTS - 1];
     }
+    /* A strongly varying speed (rational spans with unequal weights)
+     * crowds the nodes' images in s, and the interpolant can swing far
+     * between them while meeting every check point: its coefficient hull,
+     * which bounds it, must stay near the data's range. */
+    if (ok) {
+      double dlo = th[0], dhi = th[0], clo = coef[0], chi = coef[0];
+      for (int k = 1; k < NPTS; k++) {
+        dlo = fmin(dlo, th[k]);
+        dhi = fmax(dhi, th[k]);
+      }
+      for (int j = 1; j <= THETA_DEGREE; j++) {
+        clo = fmin(clo, coef[j]);
+        chi = fmax(chi, coef[j]);
+      }
+      if (chi - clo > 1.001 * (dhi - dlo) + 4 * tol_here) ok = false;
+    }
     for (int k = 1; ok && k < NPTS; k += 2) {
       double u = (s[k] - s[0]) / h;
       if (fabs(km__bern_eval(coef, THETA_DEGREE, u) - th[k]) > tol_here)
