@@ -164,9 +164,13 @@ static double hermite_bound(int degree, const double *k, double h) {
 }
 
 typedef struct out_piece {
-  size_t piece;  /* theta piece */
-  double u0, u1; /* sub-interval of it */
+  size_t piece;     /* theta piece where it starts, at u0 */
+  size_t piece_end; /* theta piece where it ends, at u1 (cubic merging) */
+  double u0, u1;
   double bound;
+  double m4;        /* bound on |C''''| over the piece */
+  double h;         /* arc length */
+  double j2, j3;    /* sums of the jumps of |C''|, |C'''| inside */
 } out_piece;
 
 typedef struct plan {
@@ -198,7 +202,9 @@ static km_status plan_range(plan *pl, const theta_pieces *tp, size_t i,
   kappa_bounds(kc, dk, h, u0, u1, nd, kb);
   double e = hermite_bound(degree, kb, (u1 - u0) * h);
   if (e <= tol || depth > 60) {
-    out_piece op = {i, u0, u1, e};
+    double hh = (u1 - u0) * h;
+    out_piece op = {i, i, u0, u1, e, e / fmax(pow(hh, 4) / 384.0, 1e-300), hh,
+                    0.0, 0.0};
     return plan_push(pl, op);
   }
   /* split into as many equal parts as the bound's order suggests */
@@ -214,6 +220,78 @@ static km_status plan_range(plan *pl, const theta_pieces *tp, size_t i,
     if (st) return st;
   }
   return KM_OK;
+}
+
+/* Sup over the jump position c and s in [0, 1] of |q - Hq| for the cubic
+ * Hermite interpolant H of q = (s - c)_+^2 / 2 and (s - c)_+^3 / 6, rounded
+ * up (0.016151 and 1/192 measured on a fine grid). */
+#define HERMITE_JUMP2 0.0165
+#define HERMITE_JUMP3 0.0053
+
+static double kappa_end(const theta_pieces *tp, size_t i, int right_end,
+                        double *slope) {
+  int dk = tp->kappa.degree;
+  const double *kc = tp->kappa.c + i * (size_t)(dk + 1);
+  double h = tp->kappa.x[i + 1] - tp->kappa.x[i];
+  if (dk == 0) {
+    *slope = 0.0;
+    return kc[0];
+  }
+  if (right_end) {
+    *slope = dk * (kc[dk] - kc[dk - 1]) / h;
+    return kc[dk];
+  }
+  *slope = dk * (kc[1] - kc[0]) / h;
+  return kc[0];
+}
+
+/* Cubic pieces may span breakpoints of kappa where theta is continuous:
+ * C is then C1 with jumps J2 in its second derivative and J3 in its third
+ * there, and writing C = g + sum (J2 q2 + J3 q3) with g three times
+ * continuously differentiable gives
+ *   |C - H| <= h^4/384 max|g''''| + sum (a2 h^2 |J2| + a3 h^3 |J3|).
+ * Neighbours are merged greedily while that bound meets the tolerance. */
+static void merge_cubic(plan *pl, const theta_pieces *tp, double tol) {
+  if (pl->n == 0) return;
+  int dt = tp->theta.degree;
+  size_t w = 0;
+  out_piece cur = pl->p[0];
+  for (size_t j = 1; j < pl->n; j++) {
+    out_piece nx = pl->p[j];
+    double j2 = 0.0, j3 = 0.0;
+    bool ok = true;
+    if (nx.piece != cur.piece_end) {
+      /* a breakpoint of kappa between them: theta must be continuous */
+      double tha = km__bern_eval(tp->theta.c + cur.piece_end * (size_t)(dt + 1), dt, 1.0);
+      double thb = km__bern_eval(tp->theta.c + nx.piece * (size_t)(dt + 1), dt, 0.0);
+      if (fabs(thb - tha) > 1e-13) ok = false;
+      double sa, sb;
+      double ka = kappa_end(tp, cur.piece_end, 1, &sa);
+      double kb = kappa_end(tp, nx.piece, 0, &sb);
+      j2 = fabs(kb - ka);
+      j3 = fabs(sb - sa) + fabs(kb * kb - ka * ka);
+    }
+    if (ok) {
+      double h = cur.h + nx.h, m4 = fmax(cur.m4, nx.m4);
+      double s2 = cur.j2 + nx.j2 + j2, s3 = cur.j3 + nx.j3 + j3;
+      double e = pow(h, 4) / 384.0 * m4 + HERMITE_JUMP2 * h * h * s2 +
+                 HERMITE_JUMP3 * h * h * h * s3;
+      if (e <= tol) {
+        cur.piece_end = nx.piece_end;
+        cur.u1 = nx.u1;
+        cur.h = h;
+        cur.m4 = m4;
+        cur.j2 = s2;
+        cur.j3 = s3;
+        cur.bound = e;
+        continue;
+      }
+    }
+    pl->p[w++] = cur;
+    cur = nx;
+  }
+  pl->p[w++] = cur;
+  pl->n = w;
 }
 
 km_status km_reconstruct(const km_signature *sig, int degree, double tol,
@@ -243,6 +321,7 @@ km_status km_reconstruct(const km_signature *sig, int degree, double tol,
       goto cleanup;
     }
   }
+  if (degree == 3) merge_cubic(&pl, &tp, 0.9 * tol);
   size_t np = pl.n;
   /* positions and tangent data at every piece boundary */
   pos = malloc((np + 1) * 2 * sizeof(double));
@@ -255,16 +334,20 @@ km_status km_reconstruct(const km_signature *sig, int degree, double tol,
   double max_bound = 0.0;
   for (size_t j = 0; j < np; j++) {
     const out_piece *op = &pl.p[j];
-    size_t i = op->piece;
-    double h = tp.theta.x[i + 1] - tp.theta.x[i];
-    double kb[1];
-    kappa_bounds(tp.kappa.c + i * (size_t)(dk + 1), dk, h, op->u0, op->u1, 1,
-                 kb);
-    double d[2];
-    km__integrate_exp(tp.theta.c + i * (size_t)(dt + 1), dt, h, op->u0, op->u1,
-                    kb[0], d);
-    pos[2 * j + 2] = pos[2 * j] + d[0];
-    pos[2 * j + 3] = pos[2 * j + 1] + d[1];
+    double sx = 0.0, sy = 0.0;
+    for (size_t i = op->piece; i <= op->piece_end; i++) {
+      double h = tp.theta.x[i + 1] - tp.theta.x[i];
+      double u0 = i == op->piece ? op->u0 : 0.0;
+      double u1 = i == op->piece_end ? op->u1 : 1.0;
+      double kb[1], d[2];
+      kappa_bounds(tp.kappa.c + i * (size_t)(dk + 1), dk, h, u0, u1, 1, kb);
+      km__integrate_exp(tp.theta.c + i * (size_t)(dt + 1), dt, h, u0, u1,
+                        kb[0], d);
+      sx += d[0];
+      sy += d[1];
+    }
+    pos[2 * j + 2] = pos[2 * j] + sx;
+    pos[2 * j + 3] = pos[2 * j + 1] + sy;
     max_bound = fmax(max_bound, op->bound);
   }
   /* junction continuity: 0 = corner (C0), 1 = kappa jump (C1), 2 = C2 */
@@ -278,9 +361,9 @@ km_status km_reconstruct(const km_signature *sig, int degree, double tol,
   double kscale = km__pp_max_abs(&tp.kappa) + 1.0 / L;
   for (size_t j = 1; j < np; j++) {
     const out_piece *a = &pl.p[j - 1], *b = &pl.p[j];
-    double tha = km__bern_eval(tp.theta.c + a->piece * (size_t)(dt + 1), dt, a->u1);
+    double tha = km__bern_eval(tp.theta.c + a->piece_end * (size_t)(dt + 1), dt, a->u1);
     double thb = km__bern_eval(tp.theta.c + b->piece * (size_t)(dt + 1), dt, b->u0);
-    double ka = km__bern_eval(tp.kappa.c + a->piece * (size_t)(dk + 1), dk, a->u1);
+    double ka = km__bern_eval(tp.kappa.c + a->piece_end * (size_t)(dk + 1), dk, a->u1);
     double kb = km__bern_eval(tp.kappa.c + b->piece * (size_t)(dk + 1), dk, b->u0);
     if (fabs(thb - tha) > 1e-13)
       cont[j] = 0;
@@ -307,12 +390,13 @@ km_status km_reconstruct(const km_signature *sig, int degree, double tol,
   double prev_h = 0.0;
   for (size_t j = 0; j < np; j++) {
     const out_piece *op = &pl.p[j];
-    size_t i = op->piece;
-    double ph = tp.theta.x[i + 1] - tp.theta.x[i];
+    size_t i = op->piece, ie = op->piece_end;
     const double *tc = tp.theta.c + i * (size_t)(dt + 1);
     const double *kc = tp.kappa.c + i * (size_t)(dk + 1);
-    double h = (op->u1 - op->u0) * ph;
-    double t0 = km__bern_eval(tc, dt, op->u0), t1 = km__bern_eval(tc, dt, op->u1);
+    const double *tce = tp.theta.c + ie * (size_t)(dt + 1);
+    const double *kce = tp.kappa.c + ie * (size_t)(dk + 1);
+    double h = op->h;
+    double t0 = km__bern_eval(tc, dt, op->u0), t1 = km__bern_eval(tce, dt, op->u1);
     double T0[2] = {cos(t0), sin(t0)}, T1[2] = {cos(t1), sin(t1)};
     double P0[2] = {pos[2 * j], pos[2 * j + 1]};
     double P1[2] = {pos[2 * j + 2], pos[2 * j + 3]};
@@ -325,7 +409,7 @@ km_status km_reconstruct(const km_signature *sig, int degree, double tol,
         Q[3][a] = P1[a];
       }
     } else {
-      double k0 = km__bern_eval(kc, dk, op->u0), k1 = km__bern_eval(kc, dk, op->u1);
+      double k0 = km__bern_eval(kc, dk, op->u0), k1 = km__bern_eval(kce, dk, op->u1);
       double N0[2] = {-T0[1], T0[0]}, N1[2] = {-T1[1], T1[0]};
       for (int a = 0; a < 2; a++) {
         Q[0][a] = P0[a];
