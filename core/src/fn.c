@@ -304,11 +304,6 @@ double km_fn_integral_sq(const km_fn *f) {
   return v;
 }
 
-static int cmp_double(const void *a, const void *b) {
-  double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
-
 /* Coefficients of the piece of p covering [r0, r1] (normalised r over p's
  * domain), elevated to degree e. */
 static void piece_on(const km_pp *p, double r0, double r1, int e,
@@ -335,7 +330,7 @@ km_status km__pp_blend(km_pp *out, const km_pp *a, double wa, const km_pp *b,
   double La = a->x[a->m] - a->x[0], Lb = b->x[b->m] - b->x[0];
   for (size_t i = 0; i <= a->m; i++) r[k++] = (a->x[i] - a->x[0]) / La;
   for (size_t i = 0; i <= b->m; i++) r[k++] = (b->x[i] - b->x[0]) / Lb;
-  qsort(r, k, sizeof(double), cmp_double);
+  qsort(r, k, sizeof(double), km__cmp_double);
   size_t m = 0;
   for (size_t i = 0; i < k; i++) {
     double v = r[i] < 0 ? 0 : (r[i] > 1 ? 1 : r[i]);

@@ -71,6 +71,14 @@ double km__bspan_length(const km__bspan *sp, double u0, double u1,
  * domain end); side < 0 picks knots[i] < t <= knots[i+1]. */
 size_t km__find_span(const km_curve *c, double t, int side);
 
+/* Solve the dense n x n system A x = y in place (row-major A, x returned
+ * in y) by Gaussian elimination with partial pivoting; false if singular. */
+bool km__solve_dense(double *A, double *y, int n);
+/* The d+1 Bernstein basis values B_k^d(u). */
+void km__bernstein_basis(double u, int d, double *row);
+/* qsort comparison of doubles. */
+int km__cmp_double(const void *a, const void *b);
+
 /* Wrap an angle to (-pi, pi]. */
 double km__wrap_angle(double a);
 

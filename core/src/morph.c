@@ -735,54 +735,11 @@ static double qm_inv_b(const quad_map *q, double y, double t) {
   return 0.5 * (lo + hi);
 }
 
-static int cmp_dbl(const void *x, const void *y) {
-  double a = *(const double *)x, b = *(const double *)y;
-  return (a > b) - (a < b);
-}
-
 /* Solve the Bernstein interpolation system (n+1 points) in place. */
 static bool bern_interp(const double *u, double *val, int n) {
   double A[(KM_MAX_FN_DEGREE + 1) * (KM_MAX_FN_DEGREE + 1)];
-  for (int j = 0; j <= n; j++) {
-    double v = 1 - u[j], *row = A + j * (n + 1);
-    row[0] = 1.0;
-    for (int q = 1; q <= n; q++) {
-      double saved = 0.0;
-      for (int k = 0; k < q; k++) {
-        double tmp = row[k];
-        row[k] = saved + v * tmp;
-        saved = u[j] * tmp;
-      }
-      row[q] = saved;
-    }
-  }
-  for (int c = 0; c <= n; c++) {
-    int piv = c;
-    for (int r = c + 1; r <= n; r++)
-      if (fabs(A[r * (n + 1) + c]) > fabs(A[piv * (n + 1) + c])) piv = r;
-    if (!(fabs(A[piv * (n + 1) + c]) > 1e-300)) return false;
-    if (piv != c) {
-      for (int k = 0; k <= n; k++) {
-        double tmp = A[c * (n + 1) + k];
-        A[c * (n + 1) + k] = A[piv * (n + 1) + k];
-        A[piv * (n + 1) + k] = tmp;
-      }
-      double tmp = val[c];
-      val[c] = val[piv];
-      val[piv] = tmp;
-    }
-    for (int r = c + 1; r <= n; r++) {
-      double f = A[r * (n + 1) + c] / A[c * (n + 1) + c];
-      for (int k = c; k <= n; k++) A[r * (n + 1) + k] -= f * A[c * (n + 1) + k];
-      val[r] -= f * val[c];
-    }
-  }
-  for (int r = n; r >= 0; r--) {
-    double v = val[r];
-    for (int k = r + 1; k <= n; k++) v -= A[r * (n + 1) + k] * val[k];
-    val[r] = v / A[r * (n + 1) + r];
-  }
-  return true;
+  for (int j = 0; j <= n; j++) km__bernstein_basis(u[j], n, A + j * (n + 1));
+  return km__solve_dense(A, val, n + 1);
 }
 
 /* Returns KM_EINVAL when the smooth map is not monotone for these matches
@@ -875,7 +832,7 @@ static km_status blend_smooth(const km_morph *m, double t, km_pp *out,
       }
     }
   }
-  qsort(br, nb, sizeof(double), cmp_dbl);
+  qsort(br, nb, sizeof(double), km__cmp_double);
   size_t mb = 0;
   for (size_t i = 0; i < nb; i++)
     if (mb == 0 || br[i] - br[mb - 1] > 1e-13 * S[K]) br[mb++] = br[i];
@@ -1091,37 +1048,6 @@ static double bspline3_d(double u) {
   return -v * v / 2.0;
 }
 
-/* Solve the small dense system A x = y (n <= 32) with partial pivoting. */
-static bool small_solve(double *A, double *y, int n) {
-  for (int c = 0; c < n; c++) {
-    int piv = c;
-    for (int r = c + 1; r < n; r++)
-      if (fabs(A[r * n + c]) > fabs(A[piv * n + c])) piv = r;
-    if (!(fabs(A[piv * n + c]) > 1e-300)) return false;
-    if (piv != c) {
-      for (int k = 0; k < n; k++) {
-        double tmp = A[c * n + k];
-        A[c * n + k] = A[piv * n + k];
-        A[piv * n + k] = tmp;
-      }
-      double tmp = y[c];
-      y[c] = y[piv];
-      y[piv] = tmp;
-    }
-    for (int r = c + 1; r < n; r++) {
-      double f = A[r * n + c] / A[c * n + c];
-      for (int k = c; k < n; k++) A[r * n + k] -= f * A[c * n + k];
-      y[r] -= f * y[c];
-    }
-  }
-  for (int r = n - 1; r >= 0; r--) {
-    double v = y[r];
-    for (int k = r + 1; k < n; k++) v -= A[r * n + k] * y[k];
-    y[r] = v / A[r * n + r];
-  }
-  return true;
-}
-
 typedef struct qnode {
   double s, w, theta;
 } qnode;
@@ -1241,7 +1167,7 @@ static km_status close_lsq(const km_signature *sig, km_signature *out,
       double A[NF * NF];
       memcpy(A, M, sizeof A);
       memcpy(Y[r], J[r], sizeof Y[r]);
-      if (!small_solve(A, Y[r], NF)) {
+      if (!km__solve_dense(A, Y[r], NF)) {
         st = KM_ENOCONVERGE;
         goto done;
       }
@@ -1255,7 +1181,7 @@ static km_status close_lsq(const km_signature *sig, km_signature *out,
       rhs[r] = -G[r];
       for (int i = 0; i < NF; i++) rhs[r] += J[r][i] * c[i];
     }
-    if (!small_solve(S, rhs, 2)) {
+    if (!km__solve_dense(S, rhs, 2)) {
       st = KM_ENOCONVERGE;
       goto done;
     }

@@ -41,11 +41,6 @@ static void theta_pieces_free(theta_pieces *tp) {
   km__pp_free(&tp->theta);
 }
 
-static int cmp_double(const void *a, const void *b) {
-  double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
-
 km_status km__build_theta(const km_signature *sig, km_pp *kappa, km_pp *theta) {
   theta_pieces tps, *tp = &tps;
   km_pp k0;
@@ -64,7 +59,7 @@ km_status km__build_theta(const km_signature *sig, km_pp *kappa, km_pp *theta) {
   size_t n = 0;
   for (size_t i = 0; i <= k0.m; i++) br[n++] = k0.x[i];
   for (size_t i = 0; i < sig->ncorners; i++) br[n++] = sig->corners[i].s;
-  qsort(br, n, sizeof(double), cmp_double);
+  qsort(br, n, sizeof(double), km__cmp_double);
   size_t m = 0;
   for (size_t i = 0; i < n; i++) {
     double v = br[i] < 0 ? 0 : (br[i] > L ? L : br[i]);

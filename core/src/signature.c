@@ -258,54 +258,6 @@ static bool tangent_limit(const builder *b, double t, int side,
   return true;
 }
 
-
-/* Solve the (n x n) system A x = y in place by Gaussian elimination with
- * partial pivoting. Returns false if singular. */
-static bool solve(double A[][THETA_DEGREE + 1], double *y, int n) {
-  for (int col = 0; col < n; col++) {
-    int piv = col;
-    for (int r = col + 1; r < n; r++)
-      if (fabs(A[r][col]) > fabs(A[piv][col])) piv = r;
-    if (!(fabs(A[piv][col]) > 1e-300)) return false;
-    if (piv != col) {
-      for (int k = 0; k < n; k++) {
-        double tmp = A[col][k];
-        A[col][k] = A[piv][k];
-        A[piv][k] = tmp;
-      }
-      double tmp = y[col];
-      y[col] = y[piv];
-      y[piv] = tmp;
-    }
-    for (int r = col + 1; r < n; r++) {
-      double f = A[r][col] / A[col][col];
-      for (int k = col; k < n; k++) A[r][k] -= f * A[col][k];
-      y[r] -= f * y[col];
-    }
-  }
-  for (int r = n - 1; r >= 0; r--) {
-    double v = y[r];
-    for (int k = r + 1; k < n; k++) v -= A[r][k] * y[k];
-    y[r] = v / A[r][r];
-  }
-  return true;
-}
-
-static void bernstein_row(double u, int d, double *row) {
-  /* B_k^d(u) for k = 0..d */
-  double v = 1.0 - u;
-  row[0] = 1.0;
-  for (int j = 1; j <= d; j++) {
-    double saved = 0.0;
-    for (int k = 0; k < j; k++) {
-      double tmp = row[k];
-      row[k] = saved + v * tmp;
-      saved = u * tmp;
-    }
-    row[j] = saved;
-  }
-}
-
 /* arc length inside the current span, in its own variable u */
 static double span_length(const builder *b, double ua, double ub) {
   /* relative to the piece, not the curve: near a sharp tip pieces are
@@ -470,13 +422,13 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
   double coef[THETA_DEGREE + 1];
   bool ok = !coarse;
   if (ok) {
-    double A[THETA_DEGREE + 1][THETA_DEGREE + 1];
+    double A[(THETA_DEGREE + 1) * (THETA_DEGREE + 1)];
     for (int j = 0; j <= THETA_DEGREE; j++) {
       double u = (s[2 * j] - s[0]) / h;
-      bernstein_row(u, THETA_DEGREE, A[j]);
+      km__bernstein_basis(u, THETA_DEGREE, A + j * (THETA_DEGREE + 1));
       coef[j] = th[2 * j];
     }
-    ok = solve(A, coef, THETA_DEGREE + 1);
+    ok = km__solve_dense(A, coef, THETA_DEGREE + 1);
     /* pin the ends exactly so theta is continuous across pieces */
     if (ok) {
       coef[0] = th[0];
