@@ -326,11 +326,20 @@ km_status km__pp_blend(km_pp *out, const km_pp *a, double wa, const km_pp *b,
   size_t nr = a->m + b->m + 2;
   double *r = malloc(nr * sizeof(double));
   if (!r) return KM_ENOMEM;
-  size_t k = 0;
+  size_t k = 0, ia = 0, ib = 0;
   double La = a->x[a->m] - a->x[0], Lb = b->x[b->m] - b->x[0];
-  for (size_t i = 0; i <= a->m; i++) r[k++] = (a->x[i] - a->x[0]) / La;
-  for (size_t i = 0; i <= b->m; i++) r[k++] = (b->x[i] - b->x[0]) / Lb;
-  qsort(r, k, sizeof(double), km__cmp_double);
+  /* both break sequences are sorted: merge them */
+  while (ia <= a->m || ib <= b->m) {
+    double ra = ia <= a->m ? (a->x[ia] - a->x[0]) / La : INFINITY;
+    double rb = ib <= b->m ? (b->x[ib] - b->x[0]) / Lb : INFINITY;
+    if (ra <= rb) {
+      r[k++] = ra;
+      ia++;
+    } else {
+      r[k++] = rb;
+      ib++;
+    }
+  }
   size_t m = 0;
   for (size_t i = 0; i < k; i++) {
     double v = r[i] < 0 ? 0 : (r[i] > 1 ? 1 : r[i]);
