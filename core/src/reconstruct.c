@@ -56,10 +56,19 @@ km_status km__build_theta(const km_signature *sig, km_pp *kappa, km_pp *theta) {
     km__pp_free(&k0);
     return KM_ENOMEM;
   }
-  size_t n = 0;
-  for (size_t i = 0; i <= k0.m; i++) br[n++] = k0.x[i];
-  for (size_t i = 0; i < sig->ncorners; i++) br[n++] = sig->corners[i].s;
-  qsort(br, n, sizeof(double), km__cmp_double);
+  /* kappa's breaks and the corners are both sorted: merge them */
+  size_t n = 0, ik = 0, ic = 0;
+  while (ik <= k0.m || ic < sig->ncorners) {
+    double xk = ik <= k0.m ? k0.x[ik] : INFINITY;
+    double xc = ic < sig->ncorners ? sig->corners[ic].s : INFINITY;
+    if (xk <= xc) {
+      br[n++] = xk;
+      ik++;
+    } else {
+      br[n++] = xc;
+      ic++;
+    }
+  }
   size_t m = 0;
   for (size_t i = 0; i < n; i++) {
     double v = br[i] < 0 ? 0 : (br[i] > L ? L : br[i]);
