@@ -478,8 +478,10 @@ def part_faults(ck):
                  "request time limit")
         ck.check(fds1 <= fds0 + 2, "descriptors back to baseline (%d -> "
                  "%d)" % (fds0, fds1))
-        ck.check(rss1 <= rss0 + 32 * 1024, "memory back near baseline (%d "
-                 "-> %d kB, bound +32 MiB)" % (rss0, rss1))
+        # the abandoned 400-frame answers (MBs each) leave glibc arenas
+        # of a few tens of MiB behind; a leak would grow without bound
+        ck.check(rss1 <= rss0 + 64 * 1024, "memory back near baseline (%d "
+                 "-> %d kB, bound +64 MiB)" % (rss0, rss1))
         ck.check(h.status == 200, "/healthz fine afterwards")
         rc, dt = d.terminate(timeout=30)
         ck.check(rc == 0, "SIGTERM afterwards: exit 0 (%s in %.1f s)" %
