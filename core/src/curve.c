@@ -92,6 +92,18 @@ km_status km_curve_create(km_curve *out, int degree, size_t n,
   if (!(knots[n] > knots[degree]))
     return km__fail(err, KM_EKNOTS, KM_FIELD_KNOTS, (long)n, NAN,
                     "knot vector has an empty domain");
+  /* an end knot repeated more than degree + 1 times leaves a control point
+   * with no influence: not a clamped B-spline */
+  if (!(knots[degree + 1] > knots[degree]))
+    return km__fail(err, KM_EKNOTS, KM_FIELD_KNOTS, (long)degree + 1, NAN,
+                    "knot vector is not clamped: the first knot repeats more "
+                    "than degree + 1 = %d times",
+                    degree + 1);
+  if (!(knots[n] > knots[n - 1]))
+    return km__fail(err, KM_EKNOTS, KM_FIELD_KNOTS, (long)n - 1, NAN,
+                    "knot vector is not clamped: the last knot repeats more "
+                    "than degree + 1 = %d times",
+                    degree + 1);
   /* interior multiplicity <= degree */
   size_t run = 1;
   for (size_t i = (size_t)degree + 1; i <= n; i++) {
