@@ -8,7 +8,8 @@
 # build/fuzz/NAME-corpus), with its dictionary, in fork mode so that a slow
 # input is recorded and fuzzing goes on: any crash, sanitizer report, leak,
 # input slower than 1 s (-timeout=1) or above 2 GiB is a failure. Artifacts
-# land in build/fuzz/NAME-artifacts/. Appends "fuzz/NAME 1 0" or
+# land in build/fuzz/artifacts-<pid>/NAME/ (one folder per run, so that two
+# runs in one tree do not remove each other's). Appends "fuzz/NAME 1 0" or
 # "fuzz/NAME 0 1" per target to the results file summarise.sh totals.
 set -u
 cd "$(dirname "$0")/../.."
@@ -21,11 +22,10 @@ for name in "$@"; do
   bin=build/fuzz/fuzz_$name
   seeds=tests/fuzz/$name/corpus
   work=build/fuzz/$name-corpus
-  arts=build/fuzz/$name-artifacts
-  rm -rf "$arts"
+  arts=build/fuzz/artifacts-$$/$name
   mkdir -p "$work" "$arts"
   dict=$(ls tests/fuzz/"$name"/*.dict 2>/dev/null | head -n 1)
-  log=build/fuzz/$name.log
+  log=$arts.log
   t0=$(date +%s)
   # The JSON targets take requests up to 16 KiB (the largest seeds are a
   # few KiB); the others keep libFuzzer's default from their seeds.
