@@ -247,6 +247,8 @@ typedef struct scan {
   size_t depth, max_depth;
   const char *error; /* static message, NULL while fine */
   bool too_deep;
+  size_t max_array;  /* no array in a valid request is longer */
+  bool too_long;
 } scan;
 
 static bool scan_fail(scan *s, const char *msg) {
@@ -413,7 +415,14 @@ static bool scan_container(scan *s, unsigned char close, bool object) {
     s->depth--;
     return true;
   }
+  size_t count = 0;
   for (;;) {
+    /* refuse an overlong array before any tree is built: a million-point
+     * array costs hundreds of megabytes as cJSON items */
+    if (!object && ++count > s->max_array) {
+      s->too_long = true;
+      return scan_fail(s, "array too long");
+    }
     if (object) {
       scan_ws(s);
       if (s->p >= s->end || *s->p != '"')
@@ -647,6 +656,15 @@ cJSON *api__parse_body(api_ctx *ctx, const char *body, size_t length) {
   s.max_depth = ctx->cfg->max_json_depth;
   s.error = NULL;
   s.too_deep = false;
+  s.too_long = false;
+  {
+    /* the longest array any field may hold: control points, knots
+     * (points + degree + 1), weights, samples, times */
+    size_t m = ctx->cfg->max_control_points + 32;
+    if (ctx->cfg->max_samples > m) m = ctx->cfg->max_samples;
+    if (ctx->cfg->max_frames_job > m) m = ctx->cfg->max_frames_job;
+    s.max_array = m;
+  }
   /* A UTF-8 byte order mark is tolerated, as cJSON does. */
   if (length >= 3 && memcmp(s.p, "\xef\xbb\xbf", 3) == 0)
     s.p += 3;
@@ -656,7 +674,11 @@ cJSON *api__parse_body(api_ctx *ctx, const char *body, size_t length) {
       scan_fail(&s, "unexpected data after the JSON value");
   }
   if (s.error != NULL) {
-    if (s.too_deep)
+    if (s.too_long)
+      api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded", NULL,
+                 "an array holds more than %zu elements (at byte %zu)",
+                 s.max_array, (size_t)(s.p - s.start));
+    else if (s.too_deep)
       api__failf(ctx, 400, API_P_MALFORMED, "Malformed JSON", NULL,
                  "JSON nested deeper than %zu levels (at byte %zu)",
                  s.max_depth, (size_t)(s.p - s.start));

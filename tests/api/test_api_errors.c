@@ -101,6 +101,28 @@ static void nesting_deeper_than_the_limit_is_400(void **state) {
   free(huge);
 }
 
+/* An array longer than any field may hold is refused by the scanner,
+ * before a tree of a million items is built. */
+static void overlong_array_is_refused_before_parsing(void **state) {
+  (void)state;
+  api_config cfg;
+  api_config_default(&cfg);
+  cfg.max_control_points = 10;
+  cfg.max_samples = 10;
+  cfg.max_frames_job = 10;
+  const char *head = "{\"curve\":{\"type\":\"points\",\"points\":[";
+  size_t n = 1000, cap = strlen(head) + n * 6 + 8;
+  char *body = malloc(cap), *p = body;
+  p += sprintf(p, "%s", head);
+  for (size_t i = 0; i < n; i++) p += sprintf(p, "%s[0,1]", i ? "," : "");
+  sprintf(p, "]}}");
+  cJSON *j = at_expect_problem_cfg(&cfg, SIG, body, 422, NULL);
+  assert_string_equal(cJSON_GetObjectItem(j, "type")->valuestring,
+                      "/problems/limit-exceeded");
+  cJSON_Delete(j);
+  free(body);
+}
+
 static void non_object_body_is_422_at_root(void **state) {
   (void)state;
   at_problem(SIG, "[1,2]", 422, "");
@@ -403,6 +425,7 @@ int main(void) {
       cmocka_unit_test(string_escapes_are_decoded),
       cmocka_unit_test(body_without_nul_is_read_to_its_length),
       cmocka_unit_test(nesting_deeper_than_the_limit_is_400),
+      cmocka_unit_test(overlong_array_is_refused_before_parsing),
       cmocka_unit_test(non_object_body_is_422_at_root),
       cmocka_unit_test(body_over_the_limit_is_413),
       cmocka_unit_test(unknown_route_is_404),
