@@ -260,8 +260,12 @@ void srv_jobs_cancel_all(srv_jobs *j)
   job *next;
   for (job *p = j->first; p; p = next) {
     next = p->next;
-    if (p->done < p->total)
+    if (p->done < p->total && !p->cancelled && !p->failed && !p->finishing) {
+      /* one line per job, so every accepted job is accounted for */
+      fprintf(stderr, "kmorphd: job %s cancelled by shutdown (%zu/%zu frames)\n",
+              p->id, p->done, p->total);
       cancel_locked(j, p, now);
+    }
     if (take_if_over(j, p)) {
       p->next = done_list;
       done_list = p;

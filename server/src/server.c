@@ -17,6 +17,7 @@
 #include "server.h"
 
 #include <arpa/inet.h>
+#include <errno.h>
 #include <microhttpd.h>
 #include <netinet/in.h>
 #include <stdarg.h>
@@ -387,12 +388,32 @@ static void create_job(srv_req *r, const api_request *req)
   srv_pool_kick(s->pool);
 }
 
+/* True if the client has closed or reset its connection while its
+ * request waited: its answer could not be delivered, so no work is done
+ * for it (a FIN counts too, as it does for common proxies). */
+static bool client_gone(srv_req *r)
+{
+  const union MHD_ConnectionInfo *ci =
+      MHD_get_connection_info(r->conn, MHD_CONNECTION_INFO_CONNECTION_FD);
+  if (ci == NULL)
+    return false;
+  char b;
+  ssize_t n = recv(ci->connect_fd, &b, 1, MSG_PEEK | MSG_DONTWAIT);
+  if (n == 0)
+    return true;
+  return n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR;
+}
+
 static void compute_task(void *arg, bool cancelled)
 {
   srv_req *r = arg;
   srv_server *s = r->srv;
   api_response_init(&r->resp);
-  if (cancelled) {
+  if (!cancelled && client_gone(r)) {
+    api_problem(&r->resp, 503, "/problems/client-gone", "Client gone",
+                "the client closed the connection before the work started",
+                NULL, NULL, r->rid);
+  } else if (cancelled) {
     api_problem(&r->resp, 503, "/problems/shutting-down", "Shutting down",
                 "the service is stopping; retry on another instance",
                 NULL, NULL, r->rid);
@@ -406,11 +427,32 @@ static void compute_task(void *arg, bool cancelled)
     if (r->route == SRV_R_JOBS) {
       req.route = API_ROUTE_MORPH;
       create_job(r, &req);
-    } else {
-      req.route = r->route == SRV_R_SIGNATURE     ? API_ROUTE_SIGNATURE
-                  : r->route == SRV_R_RECONSTRUCT ? API_ROUTE_RECONSTRUCT
-                                                  : API_ROUTE_MORPH;
+    } else if (r->route == SRV_R_SIGNATURE || r->route == SRV_R_RECONSTRUCT) {
+      req.route = r->route == SRV_R_SIGNATURE ? API_ROUTE_SIGNATURE
+                                              : API_ROUTE_RECONSTRUCT;
       api_handle(&s->api, &req, &r->resp);
+    } else {
+      /* A synchronous morph frame by frame, the way api_handle does it, so
+       * that a client who leaves stops the work between frames. */
+      api_morph_plan *plan = NULL;
+      req.route = API_ROUTE_MORPH;
+      if (api_morph_prepare(&s->api, &req, s->api.max_frames_sync, &plan,
+                            &r->resp) == 0) {
+        size_t n = api_morph_frame_count(plan);
+        bool gone = false;
+        for (size_t i = 0; i < n && !gone; i++) {
+          api_morph_render_frame(plan, i);
+          if (i % 8 == 7)
+            gone = client_gone(r);
+        }
+        if (gone)
+          api_problem(&r->resp, 503, "/problems/client-gone", "Client gone",
+                      "the client closed the connection during the work",
+                      NULL, NULL, r->rid);
+        else
+          api_morph_result(plan, &r->resp);
+        api_morph_plan_free(plan);
+      }
     }
   }
   atomic_store(&r->phase, PH_READY);

@@ -469,8 +469,13 @@ def part_faults(ck):
         ck.check(not probe.fail, "a well-behaved client was served "
                  "throughout (%d failures: %s)" % (len(probe.fail),
                                                    probe.fail[:5]))
-        ck.check(max(probe.lat or [0]) < 2.0, "and never waited 2 s "
-                 "(max %.2f s)" % max(probe.lat or [0]))
+        # While a batch of idle connections fills the connection limit a
+        # new client waits for the oldest to reach the idle timeout (3 s
+        # here), so that plus half a second of compute is the bound; work
+        # for clients that left (up to 5 s before it was skipped) breaks it.
+        ck.check(max(probe.lat or [0]) < 3.5, "and never waited longer than "
+                 "the idle timeout (max %.2f s, bound 3.5 s)"
+                 % max(probe.lat or [0]))
         ck.check(opened >= IDLE_CONNECTIONS and served_during > 0,
                  "%d idle connections opened and dropped while serving "
                  "others" % opened)
