@@ -358,6 +358,41 @@ void api__input_free(api_input *in) {
 /* The knot checks the contract names explicitly are made here too, so the
  * pointer of the first bad knot or weight never depends on how the core
  * happens to order its own checks. */
+/* The "knots" member of obj (at base): present, numbers, as many as
+ * ncoef + degree + 1 (what names the counted member in the message), never
+ * decreasing. On failure the problem names the knot at fault. */
+static bool read_knots(api_ctx *ctx, const cJSON *obj, const char *base,
+                       size_t ncoef, long degree, const char *what,
+                       const char *type, const char *title, double **knots,
+                       size_t *nk) {
+  char p[API_POINTER_MAX];
+  const cJSON *jk = api__require(ctx, obj, base, "knots");
+  if (jk == NULL)
+    return false;
+  api__ptr_key(p, base, "knots");
+  if (!api__num_array(ctx, jk, p, ctx->cfg->max_control_points + 64, knots,
+                      nk))
+    return false;
+  if (*nk != ncoef + (size_t)degree + 1) {
+    api__failf(ctx, 422, type, title, p,
+               "must have len(%s) + degree + 1 = %zu knots, not %zu", what,
+               ncoef + (size_t)degree + 1, *nk);
+    return false;
+  }
+  for (size_t i = 1; i < *nk; i++) {
+    if ((*knots)[i] < (*knots)[i - 1]) {
+      char q[API_POINTER_MAX];
+      api__ptr_idx(q, p, i);
+      api__failf(ctx, 422, type, title, q,
+                 "must be >= previous knot (knot vector decreases at index "
+                 "%zu)",
+                 i);
+      return false;
+    }
+  }
+  return true;
+}
+
 static bool parse_bspline(api_ctx *ctx, const cJSON *v, const char *ptr,
                           km_curve *out) {
   char p[API_POINTER_MAX];
@@ -366,7 +401,7 @@ static bool parse_bspline(api_ctx *ctx, const cJSON *v, const char *ptr,
   size_t n = 0, nk = 0, nw = 0;
   bool closed = false;
   bool ok = false, has_w = false;
-  const cJSON *jcp, *jk, *jw;
+  const cJSON *jcp, *jw;
   km_error err;
   km_status st;
 
@@ -385,30 +420,9 @@ static bool parse_bspline(api_ctx *ctx, const cJSON *v, const char *ptr,
                degree, degree + 1, n);
     goto done;
   }
-  if ((jk = api__require(ctx, v, ptr, "knots")) == NULL)
+  if (!read_knots(ctx, v, ptr, n, degree, "control_points",
+                  API_P_INVALID_CURVE, "Invalid curve", &knots, &nk))
     goto done;
-  api__ptr_key(p, ptr, "knots");
-  if (!api__num_array(ctx, jk, p, ctx->cfg->max_control_points + 64, &knots,
-                      &nk))
-    goto done;
-  if (nk != n + (size_t)degree + 1) {
-    api__failf(ctx, 422, API_P_INVALID_CURVE, "Invalid curve", p,
-               "must have len(control_points) + degree + 1 = %zu knots, not "
-               "%zu",
-               n + (size_t)degree + 1, nk);
-    goto done;
-  }
-  for (size_t i = 1; i < nk; i++) {
-    if (knots[i] < knots[i - 1]) {
-      char q[API_POINTER_MAX];
-      api__ptr_idx(q, p, i);
-      api__failf(ctx, 422, API_P_INVALID_CURVE, "Invalid curve", q,
-                 "must be >= previous knot (knot vector decreases at index "
-                 "%zu)",
-                 i);
-      goto done;
-    }
-  }
   jw = cJSON_GetObjectItemCaseSensitive(v, "weights");
   if (jw != NULL && !cJSON_IsNull(jw)) {
     api__ptr_key(p, ptr, "weights");
@@ -535,7 +549,7 @@ bool api__parse_signature(api_ctx *ctx, const cJSON *v, const char *ptr,
   size_t nk = 0, nc = 0, ncorners = 0;
   km_corner *corners = NULL;
   bool closed = false, ok = false;
-  const cJSON *js, *jkappa, *jk, *jc, *jcorners;
+  const cJSON *js, *jkappa, *jc, *jcorners;
   km_fn kappa;
   km_error err;
   km_status st;
@@ -588,30 +602,9 @@ bool api__parse_signature(api_ctx *ctx, const cJSON *v, const char *ptr,
                degree + 1);
     goto done;
   }
-  if ((jk = api__require(ctx, jkappa, p, "knots")) == NULL)
+  if (!read_knots(ctx, jkappa, p, nc, degree, "coefficients",
+                  API_P_INVALID_SIGNATURE, "Invalid signature", &knots, &nk))
     goto done;
-  api__ptr_key(q, p, "knots");
-  if (!api__num_array(ctx, jk, q, ctx->cfg->max_control_points + 64, &knots,
-                      &nk))
-    goto done;
-  if (nk != nc + (size_t)degree + 1) {
-    api__failf(ctx, 422, API_P_INVALID_SIGNATURE, "Invalid signature", q,
-               "must have len(coefficients) + degree + 1 = %zu knots, not "
-               "%zu",
-               nc + (size_t)degree + 1, nk);
-    goto done;
-  }
-  for (size_t i = 1; i < nk; i++) {
-    if (knots[i] < knots[i - 1]) {
-      char r[API_POINTER_MAX];
-      api__ptr_idx(r, q, i);
-      api__failf(ctx, 422, API_P_INVALID_SIGNATURE, "Invalid signature", r,
-                 "must be >= previous knot (knot vector decreases at index "
-                 "%zu)",
-                 i);
-      goto done;
-    }
-  }
   jcorners = cJSON_GetObjectItemCaseSensitive(v, "corners");
   if (jcorners != NULL && !cJSON_IsNull(jcorners)) {
     const cJSON *e;
