@@ -477,7 +477,7 @@ done:
 }
 
 static bool parse_points(api_ctx *ctx, const cJSON *v, const char *ptr,
-                         km_curve *out) {
+                         double tol, km_curve *out) {
   char p[API_POINTER_MAX];
   double *pts = NULL;
   size_t n = 0;
@@ -496,7 +496,15 @@ static bool parse_points(api_ctx *ctx, const cJSON *v, const char *ptr,
   }
   if (!api__member_bool(ctx, v, ptr, "closed", false, &closed, NULL))
     goto done;
-  st = km_curve_interpolate(out, pts, n, closed, &err);
+  {
+    /* fitted within half the tolerance (the request's, else the default
+     * 1e-5 of the length) so the rest of the work keeps the other half */
+    double len = 0.0;
+    for (size_t i = 1; i < n; i++)
+      len += hypot(pts[2 * i] - pts[2 * i - 2], pts[2 * i + 1] - pts[2 * i - 1]);
+    double fit_tol = 0.5 * (tol > 0 ? tol : 1e-5 * len);
+    st = km_curve_fit_points(out, pts, n, closed, fit_tol, &err);
+  }
   if (st != KM_OK) {
     api__core_fail(ctx, st, &err, ptr, API_KIND_POINTS);
     goto done;
@@ -695,7 +703,7 @@ bool api__parse_curve(api_ctx *ctx, const cJSON *v, const char *ptr,
     out->kind = API_KIND_CURVE;
     break;
   case 1:
-    if (!parse_points(ctx, v, ptr, &out->curve))
+    if (!parse_points(ctx, v, ptr, tol, &out->curve))
       return false;
     out->kind = API_KIND_POINTS;
     break;

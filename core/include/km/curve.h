@@ -107,6 +107,14 @@ double km_curve_param_at_length(const km_curve *c, double s);
 km_status km_curve_interpolate(km_curve *out, const double *pts, size_t n,
                                bool closed, km_error *err);
 
+/* A cubic B-spline through the first and last point that passes within
+ * tol of every point, with few control points (knots added where points
+ * miss; see core/src/fit.c). Closed curves, fewer than 8 points, or input
+ * that would need about as many control points as points get the exact
+ * interpolant of km_curve_interpolate. */
+km_status km_curve_fit_points(km_curve *out, const double *pts, size_t n,
+                              bool closed, double tol, km_error *err);
+
 /* Apply x' = R x + t with R the rotation by angle `rot`. */
 km_status km_curve_transform(km_curve *out, const km_curve *c, double rot,
                              double tx, double ty, km_error *err);
