@@ -54,19 +54,39 @@ static size_t span_of(const double *U, size_t ncp, double u) {
 
 km_status km_curve_fit_points(km_curve *out, const double *pts, size_t n,
                               bool closed, double tol, km_error *err) {
-  if (closed || n < 8 || !(tol > 0) || !isfinite(tol))
+  if (n < 8 || !(tol > 0) || !isfinite(tol))
     return km_curve_interpolate(out, pts, n, closed, err);
+  const double *orig = pts;
+  size_t norig = n;
+  double *ext = NULL;
+  if (closed) {
+    /* the loop as an open run back to its first point; the control
+     * points beside the seam are tied (P[m-2] = 2 P0 - P1) so the tangent
+     * is continuous there */
+    ext = malloc(2 * (n + 1) * sizeof(double));
+    if (!ext) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+    memcpy(ext, pts, 2 * n * sizeof(double));
+    ext[2 * n] = pts[0];
+    ext[2 * n + 1] = pts[1];
+    pts = ext;
+    n++;
+  }
+  const bool seam = closed;
   km_status st = KM_OK;
   double *u = malloc(n * sizeof(double));
   double *U = NULL, *A = NULL, *rhs = NULL, *cp = NULL, *newk = NULL;
-  if (!u) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  if (!u) {
+    free(ext);
+    return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  }
   u[0] = 0.0;
   for (size_t i = 1; i < n; i++)
     u[i] = u[i - 1] + hypot(pts[2 * i] - pts[2 * i - 2], pts[2 * i + 1] - pts[2 * i - 1]);
   double total = u[n - 1];
   if (!(total > 0)) {
     free(u);
-    return km_curve_interpolate(out, pts, n, closed, err);
+    free(ext);
+    return km_curve_interpolate(out, orig, norig, closed, err);
   }
   for (size_t i = 0; i < n; i++) u[i] /= total;
   size_t nint = 1; /* interior knots */
@@ -82,7 +102,8 @@ km_status km_curve_fit_points(km_curve *out, const double *pts, size_t n,
   double interior[FIT_MAX_CP];
   interior[0] = u[n / 2];
   for (;;) {
-    size_t ncp = nint + 4, nu = ncp - 2; /* unknowns: inner points */
+    size_t ncp = nint + 4; /* unknowns: inner points, less a tied one */
+    size_t nu = ncp - 2 - (seam ? 1 : 0);
     if (ncp >= n || ncp > FIT_MAX_CP) break; /* interpolation is as small */
     for (int k = 0; k < 4; k++) {
       U[k] = 0.0;
@@ -121,6 +142,9 @@ km_status km_curve_fit_points(km_curve *out, const double *pts, size_t n,
       double N[4];
       basis4(U, s, u[i], N);
       double px = pts[2 * i], py = pts[2 * i + 1];
+      size_t idx[4];
+      double val[4];
+      int cnt = 0;
       for (int a = 0; a < 4; a++) {
         size_t g = s - 3 + (size_t)a;
         if (g == 0) {
@@ -129,18 +153,20 @@ km_status km_curve_fit_points(km_curve *out, const double *pts, size_t n,
         } else if (g == ncp - 1) {
           px -= N[a] * pts[2 * n - 2];
           py -= N[a] * pts[2 * n - 1];
+        } else if (seam && g == ncp - 2) {
+          px -= N[a] * 2 * pts[0];
+          py -= N[a] * 2 * pts[1];
+          idx[cnt] = 0;
+          val[cnt++] = -N[a];
+        } else {
+          idx[cnt] = g - 1;
+          val[cnt++] = N[a];
         }
       }
-      for (int a = 0; a < 4; a++) {
-        size_t ga = s - 3 + (size_t)a;
-        if (ga == 0 || ga == ncp - 1) continue;
-        rhs[ga - 1] += N[a] * px;
-        rhs[nu + ga - 1] += N[a] * py;
-        for (int b = 0; b < 4; b++) {
-          size_t gb = s - 3 + (size_t)b;
-          if (gb == 0 || gb == ncp - 1) continue;
-          A[(ga - 1) * nu + (gb - 1)] += N[a] * N[b];
-        }
+      for (int a = 0; a < cnt; a++) {
+        rhs[idx[a]] += val[a] * px;
+        rhs[nu + idx[a]] += val[a] * py;
+        for (int b = 0; b < cnt; b++) A[idx[a] * nu + idx[b]] += val[a] * val[b];
       }
     }
     /* two right-hand sides: solve twice on copies */
@@ -159,6 +185,10 @@ km_status km_curve_fit_points(km_curve *out, const double *pts, size_t n,
     for (size_t k = 0; k < nu; k++) {
       cp[2 * (k + 1)] = rhs[k];
       cp[2 * (k + 1) + 1] = rhs[nu + k];
+    }
+    if (seam) {
+      cp[2 * (ncp - 2)] = 2 * pts[0] - cp[2];
+      cp[2 * (ncp - 2) + 1] = 2 * pts[1] - cp[3];
     }
     cp[2 * (ncp - 1)] = pts[2 * n - 2];
     cp[2 * (ncp - 1) + 1] = pts[2 * n - 1];
@@ -196,7 +226,7 @@ km_status km_curve_fit_points(km_curve *out, const double *pts, size_t n,
     if (nnew == (size_t)-1) break;
     if (nnew == 0) {
       /* every point within tol: the fit */
-      st = km_curve_create(out, 3, ncp, U, cp, NULL, false, err);
+      st = km_curve_create(out, 3, ncp, U, cp, NULL, closed, err);
       goto done;
     }
     if (nint + nnew + 4 > FIT_MAX_CP) break;
@@ -212,8 +242,9 @@ km_status km_curve_fit_points(km_curve *out, const double *pts, size_t n,
     memcpy(interior, merged, m * sizeof(double));
     nint = m;
   }
-  st = km_curve_interpolate(out, pts, n, closed, err);
+  st = km_curve_interpolate(out, orig, norig, closed, err);
 done:
+  free(ext);
   free(u);
   free(U);
   free(newk);

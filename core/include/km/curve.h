@@ -107,11 +107,12 @@ double km_curve_param_at_length(const km_curve *c, double s);
 km_status km_curve_interpolate(km_curve *out, const double *pts, size_t n,
                                bool closed, km_error *err);
 
-/* A cubic B-spline through the first and last point that passes within
- * tol of every point, with few control points (knots added where points
- * miss; see core/src/fit.c). Closed curves, fewer than 8 points, or input
- * that would need about as many control points as points get the exact
- * interpolant of km_curve_interpolate. */
+/* A cubic B-spline through the first and last point (closed: through the
+ * first point, tangent continuous at the seam) that passes within tol of
+ * every point, with few control points (knots added where points miss;
+ * see core/src/fit.c). Fewer than 8 points, or input that would need
+ * about as many control points as points, get the exact interpolant of
+ * km_curve_interpolate. */
 km_status km_curve_fit_points(km_curve *out, const double *pts, size_t n,
                               bool closed, double tol, km_error *err);
 
