@@ -235,7 +235,7 @@ fuzz: deps $(FUZZ_BINS)
 	@tests/hardening/fuzz.sh $(if $(filter file undefined,$(origin FUZZ_SECONDS)),600,$(FUZZ_SECONDS)) $(FUZZ_NAMES)
 
 test-fuzz: $(FUZZ_BINS)
-	@tests/hardening/fuzz.sh $(TEST_FUZZ_SECONDS) $(FUZZ_NAMES)
+	@FUZZ_SEED=1 tests/hardening/fuzz.sh $(TEST_FUZZ_SECONDS) $(FUZZ_NAMES)
 
 # Bad-input barrage, the daemon under ASan, leak checks of the CLI, load
 # and faults (tests/hardening/run.sh; HARDENING_LONG=1 for the long run).

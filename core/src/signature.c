@@ -350,7 +350,7 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
   for (int k = 0; k < NPTS; k++)
     if (speed[k] > 0) noise = fmax(noise, b->deriv_noise / speed[k]);
   if (noise > 0.1) noise = 0.1;
-  double tol_here = b->tol_theta + 2.0 * noise;
+  double tol_here = b->tol_theta; /* widened for noise once h is known */
   /* unwrap, watching for steps too large to interpolate */
   bool coarse = false;
   double big_step = 0.0;
@@ -387,6 +387,9 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
   }
   s[NPTS - 1] = ref;
   h = ref;
+  /* the noise allowance may not cost more than a twentieth of the
+   * tolerance in position (|dC| <= h |d theta|) */
+  tol_here += fmin(2.0 * noise, 0.05 * 4.0 * b->tol_theta * b->L / fmax(h, 1e-300));
   bool tiny_t = (ub - ua) < 1e-13 * b->span_t;
   if (!(h > 1e-15 * b->L)) {
     /* a piece of (numerically) zero length: whatever turn it hides acts
@@ -399,17 +402,24 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
                       mid);
     /* Bisection toward a degenerate end ends in such pieces: the turning
      * they carry is real (kappa ~ 1/sqrt(s) there) but concentrated in a
-     * length below resolution. A small turn is handed to the neighbouring
+     * length below resolution. A small turn is handed to a neighbouring
      * piece, whose end value absorbs it, so a smooth curve reports no
-     * corner; a large one is a corner. */
+     * corner - but absorbing tilts the neighbour's theta by up to |turn|
+     * over its length, so only where that stays far inside the tolerance;
+     * otherwise the turn is a (tiny) corner, which is exact. */
+    double tol = 4.0 * b->tol_theta * b->L;
     double prev_end = b->m > 0 ? b->s[b->m] : -1.0;
-    if (fabs(turn) < 1e-3 && b->m > b->span_first && prev_end == *s_at) {
+    double prev_h = b->m > 0 ? b->s[b->m] - b->s[b->m - 1] : INFINITY;
+    if (fabs(turn) < 1e-3 && b->m > b->span_first && prev_end == *s_at &&
+        fabs(turn) * prev_h <= 0.05 * tol) {
       b->th[(b->m - 1) * (THETA_DEGREE + 1) + THETA_DEGREE] += turn;
-    } else if (fabs(turn) < 1e-3) {
+    } else if (fabs(turn) * (b->L - *s_at) <= 0.05 * tol) {
       if (isnan(b->pending_start)) b->pending_start = th[0];
-    } else {
+    } else if (fabs(turn) > CORNER_NOISE) {
       km_status st = push_corner(b, *s_at, km__wrap_angle(turn));
       if (st) return st;
+    } else if (isnan(b->pending_start)) {
+      b->pending_start = th[0];
     }
     *theta = th[NPTS - 1];
     return KM_OK;
@@ -463,7 +473,7 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
       lo = fmin(lo, th[k]);
       hi = fmax(hi, th[k]);
     }
-    if (hi - lo > 4 * tol_here + 1e-12)
+    if (hi - lo > 4 * tol_here)
       return km__fail(b->err, KM_ENOCONVERGE, KM_FIELD_CONTROL_POINTS, -1,
                       mid,
                       "curvature could not be resolved near parameter t = "

@@ -11,6 +11,8 @@
 # land in build/fuzz/artifacts-<pid>/NAME/ (one folder per run, so that two
 # runs in one tree do not remove each other's). Appends "fuzz/NAME 1 0" or
 # "fuzz/NAME 0 1" per target to the results file summarise.sh totals.
+# FUZZ_SEED fixes libFuzzer's seed (make test does, so that a run explores
+# the same inputs each time; make fuzz does not, to explore new ones).
 set -u
 cd "$(dirname "$0")/../.."
 results=${KM_RESULTS:-build/test-results.txt}
@@ -36,6 +38,7 @@ for name in "$@"; do
     timeout $((seconds + 120)) "$bin" -fork=1 -ignore_timeouts=1 \
       -ignore_ooms=0 -ignore_crashes=0 -max_total_time="$seconds" \
       -timeout=1 -rss_limit_mb=2048 -malloc_limit_mb=2048 $maxlen \
+      ${FUZZ_SEED:+-seed="$FUZZ_SEED"} \
       ${dict:+-dict="$dict"} -artifact_prefix="$arts/" \
       "$work" "$seeds" >"$log" 2>&1
   rc=$?
