@@ -342,7 +342,7 @@ static double integrate_rec(km__scalar_fn f, const void *ctx, double a,
 double km__integrate_adaptive(km__scalar_fn f, const void *ctx, double a,
                               double b, double abs_tol) {
   if (!(b > a)) return 0.0;
-  long budget = 1024;
+  long budget = 256;
   return integrate_rec(f, ctx, a, b, abs_tol, 0, &budget);
 }
 

@@ -547,6 +547,7 @@ km_status km_signature_compute(const km_curve *c, double tol,
       span_len[i] = km__bspan_length(&sp, 0.0, 1.0, 1e-15 * poly);
     }
     L += span_len[i];
+    if (isnan(L)) break; /* reported below; no more work for this curve */
   }
   km_curve_domain(c, &t0, &t1);
   double extent = 0.0;
