@@ -22,6 +22,7 @@
 #include "km/signature.h"
 #include "curvedist.h"
 #include "testutil.h"
+#include "morphutil.h"
 
 /* ---- inputs ------------------------------------------------------------- */
 
@@ -102,39 +103,6 @@ static const char *const PAIRS[6] = {"circle_to_star", "square_to_circle",
                                      "U_to_S",         "spiral_open",
                                      "arrow_rot90",    "crescent_to_heart"};
 
-/* ---- running a morph ---------------------------------------------------- */
-
-static km_morph *morph_new(const km_morph_input *a, const km_morph_input *b,
-                           const km_morph_options *o) {
-  km_morph *m = NULL;
-  km_error err;
-  km_status st = km_morph_create(&m, a, b, o, &err);
-  if (st != KM_OK) print_error("km_morph_create: %s\n", err.message);
-  assert_status(st, KM_OK);
-  assert_non_null(m);
-  return m;
-}
-
-typedef struct frame {
-  km_curve c;
-  km_frame_metrics mt;
-  km_signature sig;
-} frame;
-
-static void frame_get(const km_morph *m, double t, frame *f) {
-  km_error err;
-  km_curve_init(&f->c);
-  km_signature_init(&f->sig);
-  memset(&f->mt, 0, sizeof f->mt);
-  km_status st = km_morph_frame(m, t, &f->c, &f->mt, &f->sig, &err);
-  if (st != KM_OK) print_error("km_morph_frame(t = %g): %s\n", t, err.message);
-  assert_status(st, KM_OK);
-}
-
-static void frame_free(frame *f) {
-  km_curve_free(&f->c);
-  km_signature_free(&f->sig);
-}
 
 /* ---- geometry ------------------------------------------------------------ */
 
