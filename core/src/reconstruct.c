@@ -138,8 +138,8 @@ void km__integrate_exp(const double *tc, int d, double h, double u0,
 }
 
 /* Bounds on |kappa^(j)| for j = 0..nd-1 over [u0,u1] of kappa piece kc. */
-static void kappa_bounds(const double *kc, int dk, double h, double u0,
-                         double u1, int nd, double *bnd) {
+void km__kappa_bounds(const double *kc, int dk, double h, double u0,
+                      double u1, int nd, double *bnd) {
   double c[MAXD], dc[MAXD];
   km__bern_restrict(kc, dk, u0, u1, c);
   int d = dk;
@@ -203,7 +203,7 @@ static km_status plan_range(plan *pl, const theta_pieces *tp, size_t i,
   const double *kc = tp->kappa.c + i * (size_t)(dk + 1);
   double kb[5];
   int nd = degree == 3 ? 3 : 5;
-  kappa_bounds(kc, dk, h, u0, u1, nd, kb);
+  km__kappa_bounds(kc, dk, h, u0, u1, nd, kb);
   double e = hermite_bound(degree, kb, (u1 - u0) * h);
   if (e <= tol || depth > 60) {
     double hh = (u1 - u0) * h;
@@ -226,11 +226,6 @@ static km_status plan_range(plan *pl, const theta_pieces *tp, size_t i,
   return KM_OK;
 }
 
-/* Sup over the jump position c and s in [0, 1] of |q - Hq| for the cubic
- * Hermite interpolant H of q = (s - c)_+^2 / 2 and (s - c)_+^3 / 6, rounded
- * up (0.016151 and 1/192 measured on a fine grid). */
-#define HERMITE_JUMP2 0.0165
-#define HERMITE_JUMP3 0.0053
 
 static double kappa_end(const theta_pieces *tp, size_t i, int right_end,
                         double *slope) {
@@ -278,8 +273,8 @@ static void merge_cubic(plan *pl, const theta_pieces *tp, double tol) {
     if (ok) {
       double h = cur.h + nx.h, m4 = fmax(cur.m4, nx.m4);
       double s2 = cur.j2 + nx.j2 + j2, s3 = cur.j3 + nx.j3 + j3;
-      double e = pow(h, 4) / 384.0 * m4 + HERMITE_JUMP2 * h * h * s2 +
-                 HERMITE_JUMP3 * h * h * h * s3;
+      double e = pow(h, 4) / 384.0 * m4 + KM__HERMITE_JUMP2 * h * h * s2 +
+                 KM__HERMITE_JUMP3 * h * h * h * s3;
       if (e <= tol) {
         cur.piece_end = nx.piece_end;
         cur.u1 = nx.u1;
@@ -344,7 +339,7 @@ km_status km_reconstruct(const km_signature *sig, int degree, double tol,
       double u0 = i == op->piece ? op->u0 : 0.0;
       double u1 = i == op->piece_end ? op->u1 : 1.0;
       double kb[1], d[2];
-      kappa_bounds(tp.kappa.c + i * (size_t)(dk + 1), dk, h, u0, u1, 1, kb);
+      km__kappa_bounds(tp.kappa.c + i * (size_t)(dk + 1), dk, h, u0, u1, 1, kb);
       km__integrate_exp(tp.theta.c + i * (size_t)(dt + 1), dt, h, u0, u1,
                         kb[0], d);
       sx += d[0];
@@ -525,7 +520,7 @@ km_status km_signature_point(const km_signature *sig, double s, double pos[2],
     if (a >= s && i > 0) break;
     double u1 = s >= b ? 1.0 : (s - a) / h;
     double kb[1], d[2];
-    kappa_bounds(tp.kappa.c + i * (size_t)(dk + 1), dk, h, 0.0, u1, 1, kb);
+    km__kappa_bounds(tp.kappa.c + i * (size_t)(dk + 1), dk, h, 0.0, u1, 1, kb);
     const double *tc = tp.theta.c + i * (size_t)(dt + 1);
     km__integrate_exp(tc, dt, h, 0.0, u1, kb[0], d);
     x += d[0];
