@@ -44,11 +44,12 @@
 #include "km/limits.h"
 #include "km/morph.h"
 #include "km/reconstruct.h"
+#include "morph_plan.h"
 
 #define TABLE_N 512   /* samples per input for placement targets */
 #define FIT_N 256     /* frame samples for the Procrustes fit */
 #define ALIGN_N 512   /* samples of theta for start alignment */
-#define LSQ_INTERVALS 16
+#define LSQ_INTERVALS KM__CLOSURE_INTERVALS
 
 void km_morph_options_default(km_morph_options *o) {
   memset(o, 0, sizeof *o);
@@ -79,6 +80,7 @@ struct km_morph {
   size_t nk;
   size_t nuser;    /* match pairs reported */
   km_curve lin[2]; /* compatible curves (linear method) */
+  km__frame_plan *plan; /* frames planned once (morph_plan.c), or NULL */
 };
 
 static void input_free(input *in) {
@@ -96,6 +98,7 @@ void km_morph_free(km_morph *m) {
   }
   free(m->ra);
   free(m->rb);
+  km__frame_plan_free(m->plan);
   free(m);
 }
 
@@ -568,6 +571,17 @@ static km_status create_impl(km_morph **out, const km_morph_input *from,
     if (!st)
       st = km_curve_make_compatible(&a->curve, &b->curve, &m->lin[0],
                                     &m->lin[1], err);
+    if (st) goto fail;
+  }
+  /* Frames of the default morph (turning blend, no matches, cubic output)
+   * are planned once: see morph_plan.c. Others are blended piece by piece
+   * and reconstructed frame by frame. */
+  if (opt->method == KM_METHOD_CURVATURE && m->opt.blend == KM_BLEND_TURNING &&
+      m->nk == 2 && m->opt.degree == 3) {
+    const km_pp kp[2] = {a->kappa, b->kappa}, tp[2] = {a->theta, b->theta};
+    double len[2] = {a->sig.length, b->sig.length};
+    double ang[2] = {a->sig.angle, b->sig.angle};
+    st = km__frame_plan_build(&m->plan, kp, tp, len, ang, m->closed, m->tol, err);
     if (st) goto fail;
   }
   *out = m;
@@ -1423,6 +1437,31 @@ static km_status linear_frame(const km_morph *m, double t, km_curve *out,
   return KM_OK;
 }
 
+/* A frame from the plan: the curve only (metrics and signatures take the
+ * general path, which yields them exactly). */
+static km_status planned_frame(const km_morph *m, double t, km_closure how,
+                               km_curve *out, km_error *err) {
+  const input *a = &m->in[0], *b = &m->in[1];
+  double phia = a->sig.angle, phib = phia + km__wrap_angle(b->sig.angle - phia);
+  km_curve f, placed;
+  km_curve_init(&f);
+  km_curve_init(&placed);
+  km_status st = km__frame_plan_curve(m->plan, t, (1 - t) * phia + t * phib,
+                                      how == KM_CLOSURE_LSQ, &f, NULL, err);
+  if (st) return st;
+  if (m->closed && !f.closed && how != KM_CLOSURE_NONE)
+    close_polygon(&f, how == KM_CLOSURE_LSQ ? KM_CLOSURE_C0 : how);
+  double Lt = (1 - t) * a->sig.length + t * b->sig.length, rot, T[2];
+  placement(m, t, &f, Lt, &rot, T);
+  st = km_curve_transform(&placed, &f, rot, T[0], T[1], err);
+  if (!st) {
+    placed.closed = f.closed;
+    *out = placed;
+  }
+  km_curve_free(&f);
+  return st;
+}
+
 km_status km_morph_frame(const km_morph *m, double t, km_curve *out,
                          km_frame_metrics *metrics, km_signature *sig_out,
                          km_error *err) {
@@ -1431,6 +1470,8 @@ km_status km_morph_frame(const km_morph *m, double t, km_curve *out,
                     "time %g is outside [0, 1]", t);
   if (m->opt.method == KM_METHOD_LINEAR)
     return linear_frame(m, t, out, metrics, sig_out, err);
+  km_closure how = m->opt.closure == KM_CLOSURE_AUTO ? KM_CLOSURE_LSQ : m->opt.closure;
+  if (m->plan && !metrics && !sig_out) return planned_frame(m, t, how, out, err);
   km_signature blended, closed;
   km_signature_init(&blended);
   km_signature_init(&closed);
@@ -1439,7 +1480,6 @@ km_status km_morph_frame(const km_morph *m, double t, km_curve *out,
   km_curve_init(&placed);
   const km_signature *use = &blended;
   double gap = 0.0, bound = 0.0;
-  km_closure how = m->opt.closure == KM_CLOSURE_AUTO ? KM_CLOSURE_LSQ : m->opt.closure;
   km_status st = blend_signature(m, t, &blended, err);
   if (st) goto done;
   if (m->closed && how == KM_CLOSURE_LSQ) {

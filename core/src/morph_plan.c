@@ -1,0 +1,649 @@
+/* morph_plan.c - curvature frames planned once per morph.
+ *
+ * DESIGN. Without matches, a frame of the turning blend is
+ *     theta_t(r) = theta0(t) + (1 - t) Ta(r) + t Tb(r),   r in [0, 1],
+ *     C_t(r)     = integral from 0 to r of L_t e^(i theta_t),
+ * with Ta, Tb the inputs' tangent angles less their start angles over the
+ * normalised arc length r, and L_t = (1 - t) La + t Lb. Everything a frame
+ * needs that does not depend on t is computed here once per morph:
+ *   - The output pieces: cubic Hermite pieces in r. The derivatives of
+ *     theta_t are convex combinations of the inputs', so the larger of the
+ *     two inputs' bounds holds for every t (and L_t <= max(La, Lb)); the
+ *     pieces are sized with the remainder bound of reconstruct.c
+ *     (h^4 / 384 * B_3, plus jump terms where a piece spans a breakpoint of
+ *     either input's curvature), so every frame meets the tolerance.
+ *   - Gauss-Legendre nodes on every piece with Ta, Tb and the closure basis
+ *     evaluated there. Each chunk gets the lowest rule order whose error
+ *     bound, K_n h^(2n+1) max|f^(2n)| with |d^m e^(i theta)| <= B_m(|theta'|,
+ *     ..., |theta^(m)|) (complete Bell polynomial), meets its share of the
+ *     tolerance: smooth inputs need two or three nodes a piece, not eight.
+ * A frame is then one pass of sin/cos over the nodes per Gauss-Newton step
+ * of the lsq closure (two or three steps) and the Hermite control points:
+ * no piecewise-polynomial blending, no planning, no allocation but the
+ * output. The closure is the one of morph.c (close_lsq): interior uniform
+ * cubic B-splines psi added to theta, minimum-norm steps in the metric
+ * integral psi'^2 (the Gram matrix of their derivatives is Toeplitz with
+ * entries 2/3, -1/8, -1/5, -1/120), so the seam stays G2.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+#include "km/limits.h"
+#include "morph_plan.h"
+
+#define NB KM__CLOSURE_INTERVALS
+#define NF (KM__CLOSURE_INTERVALS - 3)
+#define MAX_RULE 8      /* highest Gauss-Legendre order used */
+#define NDER (2 * MAX_RULE)
+
+typedef struct gnode {
+  double w;      /* weight in r */
+  double ta, tb; /* Ta(r), Tb(r) at the node */
+  int bi;        /* first closure basis function that may be nonzero */
+  double bv[4];  /* basis values bi .. bi+3 (0 where outside 0..NF-1) */
+} gnode;
+
+struct km__frame_plan {
+  double La, Lb, tol;
+  bool closed;
+  size_t np;            /* output pieces */
+  double *x;            /* np + 1 breaks in r */
+  unsigned char *corner; /* np + 1: theta jumps there (C0 junction) */
+  double *ta_l, *ta_r;  /* Ta left / right of each break */
+  double *tb_l, *tb_r;
+  size_t *first;        /* nodes of piece k: first[k] .. first[k+1] - 1 */
+  gnode *node;
+  size_t nn;
+  double chol[NF * NF]; /* Cholesky factor of the closure metric */
+};
+
+/* ---- small numerics ---------------------------------------------------- */
+
+/* Gauss-Legendre rules of order 1..MAX_RULE on [-1, 1], by Newton on the
+ * Legendre recurrence. */
+typedef struct gl_rules {
+  double x[MAX_RULE + 1][MAX_RULE], w[MAX_RULE + 1][MAX_RULE];
+  double K[MAX_RULE + 1]; /* error constant (n!)^4 / ((2n+1) ((2n)!)^3) */
+} gl_rules;
+
+static void gl_make(gl_rules *g) {
+  for (int n = 1; n <= MAX_RULE; n++) {
+    for (int i = 0; i < n; i++) {
+      double z = cos(KM_PI * (i + 0.75) / (n + 0.5)), dp = 1.0;
+      for (int it = 0; it < 100; it++) {
+        double p0 = 1.0, p1 = z;
+        for (int k = 2; k <= n; k++) {
+          double p2 = ((2 * k - 1) * z * p1 - (k - 1) * p0) / k;
+          p0 = p1;
+          p1 = p2;
+        }
+        if (n == 1) p0 = 1.0;
+        dp = n * (z * p1 - p0) / (z * z - 1);
+        double dz = p1 / dp;
+        z -= dz;
+        if (fabs(dz) < 1e-16) break;
+      }
+      g->x[n][i] = z;
+      g->w[n][i] = 2.0 / ((1 - z * z) * dp * dp);
+    }
+    double f = 1.0, f2 = 1.0;
+    for (int k = 2; k <= n; k++) f *= k;
+    for (int k = 2; k <= 2 * n; k++) f2 *= k;
+    g->K[n] = f * f * f * f / ((2 * n + 1) * f2 * f2 * f2);
+  }
+}
+
+/* Complete Bell polynomial B_m(x[1], ..., x[m]) for m = 0..mmax. */
+static void bell(const double *x, int mmax, double *B) {
+  B[0] = 1.0;
+  for (int m = 0; m < mmax; m++) {
+    double s = 0.0, binom = 1.0;
+    for (int i = 0; i <= m; i++) {
+      s += binom * B[m - i] * x[i + 1];
+      binom = binom * (m - i) / (i + 1);
+    }
+    B[m + 1] = s;
+  }
+}
+
+static double bspline3(double u) {
+  if (u <= 0 || u >= 4) return 0.0;
+  if (u < 1) return u * u * u / 6.0;
+  if (u < 2) return (-3 * u * u * u + 12 * u * u - 12 * u + 4) / 6.0;
+  if (u < 3) return (3 * u * u * u - 24 * u * u + 60 * u - 44) / 6.0;
+  double v = 4 - u;
+  return v * v * v / 6.0;
+}
+
+/* The closure basis at r: first index and four values. */
+static void basis_at(double r, int *bi, double bv[4]) {
+  double u = r * NB;
+  int iv = (int)floor(u);
+  if (iv < 0) iv = 0;
+  if (iv > NB - 1) iv = NB - 1;
+  int i0 = iv - 3;
+  for (int k = 0; k < 4; k++) {
+    int i = i0 + k;
+    bv[k] = (i >= 0 && i < NF) ? bspline3(u - i) : 0.0;
+  }
+  *bi = i0;
+}
+
+static double psi_at(const double *c, double r) {
+  int bi;
+  double bv[4], v = 0.0;
+  basis_at(r, &bi, bv);
+  for (int k = 0; k < 4; k++)
+    if (bi + k >= 0 && bi + k < NF) v += c[bi + k] * bv[k];
+  return v;
+}
+
+/* Cholesky of the Toeplitz metric (exact entries, see DESIGN). */
+static bool metric_factor(double *Lc) {
+  static const double band[4] = {2.0 / 3.0, -1.0 / 8.0, -1.0 / 5.0, -1.0 / 120.0};
+  memset(Lc, 0, NF * NF * sizeof(double));
+  for (int i = 0; i < NF; i++)
+    for (int j = 0; j <= i; j++) {
+      double v = i - j < 4 ? band[i - j] : 0.0;
+      for (int k = 0; k < j; k++) v -= Lc[i * NF + k] * Lc[j * NF + k];
+      if (i == j) {
+        if (!(v > 0)) return false;
+        Lc[i * NF + i] = sqrt(v);
+      } else {
+        Lc[i * NF + j] = v / Lc[j * NF + j];
+      }
+    }
+  return true;
+}
+
+static void chol_solve(const double *Lc, double *y) {
+  for (int i = 0; i < NF; i++) {
+    double v = y[i];
+    for (int k = 0; k < i; k++) v -= Lc[i * NF + k] * y[k];
+    y[i] = v / Lc[i * NF + i];
+  }
+  for (int i = NF - 1; i >= 0; i--) {
+    double v = y[i];
+    for (int k = i + 1; k < NF; k++) v -= Lc[k * NF + i] * y[k];
+    y[i] = v / Lc[i * NF + i];
+  }
+}
+
+/* ---- one input over an interval of r --------------------------------- */
+
+typedef struct side {
+  const km_pp *kappa, *theta;
+  double L, angle;
+} side;
+
+/* Piece of the input containing [r0, r1] and the local range there. */
+static size_t side_piece(const side *sd, double r0, double r1, double *u0,
+                         double *u1) {
+  size_t i = km__pp_find(sd->theta, 0.5 * (r0 + r1) * sd->L);
+  double a = sd->theta->x[i], h = sd->theta->x[i + 1] - a;
+  *u0 = fmin(fmax((r0 * sd->L - a) / h, 0.0), 1.0);
+  *u1 = fmin(fmax((r1 * sd->L - a) / h, 0.0), 1.0);
+  return i;
+}
+
+/* D[j] >= |d^j theta / dr^j| on [r0, r1] for j = 1..nd. */
+static void side_bounds(const side *sd, double r0, double r1, int nd,
+                        double *D) {
+  double u0, u1, kb[NDER];
+  size_t i = side_piece(sd, r0, r1, &u0, &u1);
+  int dk = sd->kappa->degree;
+  double h = sd->kappa->x[i + 1] - sd->kappa->x[i];
+  km__kappa_bounds(sd->kappa->c + i * (size_t)(dk + 1), dk, h, u0, u1, nd, kb);
+  double Lj = sd->L;
+  for (int j = 1; j <= nd; j++) {
+    D[j] = Lj * kb[j - 1];
+    Lj *= sd->L;
+  }
+}
+
+/* theta (less the start angle), d theta/dr and d2 theta/dr2 at r, from the
+ * piece on the left (side < 0) or the right of r. */
+static void side_eval(const side *sd, double r, int side_dir, double v[3]) {
+  size_t i = km__pp_find(sd->theta, r * sd->L);
+  if (side_dir < 0 && i > 0 && sd->theta->x[i] >= r * sd->L) i--;
+  double a = sd->theta->x[i], h = sd->theta->x[i + 1] - a;
+  double u = fmin(fmax((r * sd->L - a) / h, 0.0), 1.0);
+  int dt = sd->theta->degree, dk = sd->kappa->degree;
+  const double *kc = sd->kappa->c + i * (size_t)(dk + 1);
+  v[0] = km__bern_eval(sd->theta->c + i * (size_t)(dt + 1), dt, u) - sd->angle;
+  v[1] = sd->L * km__bern_eval(kc, dk, u);
+  double dc[KM_MAX_FN_DEGREE + 1];
+  if (dk > 0) {
+    km__bern_derivative(kc, dk, h, dc);
+    v[2] = sd->L * sd->L * km__bern_eval(dc, dk - 1, u);
+  } else {
+    v[2] = 0.0;
+  }
+}
+
+static double side_theta(const side *sd, double r) {
+  size_t i = km__pp_find(sd->theta, r * sd->L);
+  double a = sd->theta->x[i], h = sd->theta->x[i + 1] - a;
+  double u = fmin(fmax((r * sd->L - a) / h, 0.0), 1.0);
+  int dt = sd->theta->degree;
+  return km__bern_eval(sd->theta->c + i * (size_t)(dt + 1), dt, u) - sd->angle;
+}
+
+/* ---- planning ---------------------------------------------------------- */
+
+/* An atom: a stretch of r inside one piece of each input. */
+typedef struct atom {
+  double x0, x1;
+  double m4;    /* max |C''''(r)| / L over the atom */
+  double j2, j3; /* jumps of C'', C''' (over L) at x0, bounds for every t */
+  bool corner;  /* theta jumps at x0 */
+} atom;
+
+typedef struct vec {
+  void *p;
+  size_t n, cap, size;
+} vec;
+
+static km_status vec_push(vec *v, const void *item) {
+  if (v->n == v->cap) {
+    size_t cap = v->cap ? 2 * v->cap : 256;
+    if (cap > 64 * (size_t)KM_MAX_PIECES) return KM_ELIMIT;
+    void *q = realloc(v->p, cap * v->size);
+    if (!q) return KM_ENOMEM;
+    v->p = q;
+    v->cap = cap;
+  }
+  memcpy((char *)v->p + v->n * v->size, item, v->size);
+  v->n++;
+  return KM_OK;
+}
+
+static double m4_of(const double *D) {
+  return D[1] * D[1] * D[1] + 3 * D[1] * D[2] + D[3];
+}
+
+static void both_bounds(const side sd[2], double r0, double r1, int nd,
+                        double *D) {
+  double Da[NDER + 1], Db[NDER + 1];
+  side_bounds(&sd[0], r0, r1, nd, Da);
+  side_bounds(&sd[1], r0, r1, nd, Db);
+  for (int j = 1; j <= nd; j++) D[j] = fmax(Da[j], Db[j]);
+}
+
+/* Atoms of the merged interval [r0, r1], split until each meets tolp
+ * (relative to L: tolerances here are over max(La, Lb)). */
+static km_status plan_interval(vec *atoms, const side sd[2], double r0,
+                               double r1, double tolp, double j2, double j3,
+                               bool corner) {
+  double D[4];
+  both_bounds(sd, r0, r1, 3, D);
+  double h = r1 - r0, e = pow(h, 4) / 384.0 * m4_of(D);
+  int parts = 1;
+  if (e > tolp) {
+    double p = ceil(pow(e / tolp, 0.25) * 1.05);
+    parts = p > 1e6 ? 1000000 : (int)p;
+  }
+  for (int k = 0; k < parts; k++) {
+    double a = r0 + h * k / parts, b = k + 1 == parts ? r1 : r0 + h * (k + 1) / parts;
+    atom at = {a, b, 0.0, k ? 0.0 : j2, k ? 0.0 : j3, k ? false : corner};
+    double Dk[4];
+    if (parts > 1)
+      both_bounds(sd, a, b, 3, Dk);
+    else
+      memcpy(Dk, D, sizeof Dk);
+    at.m4 = m4_of(Dk);
+    km_status st = vec_push(atoms, &at);
+    if (st) return st;
+  }
+  return KM_OK;
+}
+
+void km__frame_plan_free(km__frame_plan *p) {
+  if (!p) return;
+  free(p->x);
+  free(p->corner);
+  free(p->ta_l);
+  free(p->ta_r);
+  free(p->tb_l);
+  free(p->tb_r);
+  free(p->first);
+  free(p->node);
+  free(p);
+}
+
+static int cmp_dbl(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+km_status km__frame_plan_build(km__frame_plan **out, const km_pp kappa[2],
+                               const km_pp theta[2], const double length[2],
+                               const double angle[2], bool closed, double tol,
+                               km_error *err) {
+  km_status st = KM_OK;
+  double *br = NULL;
+  vec atoms = {NULL, 0, 0, sizeof(atom)}, nodes = {NULL, 0, 0, sizeof(gnode)};
+  gl_rules *g = malloc(sizeof *g);
+  km__frame_plan *p = calloc(1, sizeof *p);
+  if (!p || !g) {
+    st = KM_ENOMEM;
+    goto fail;
+  }
+  gl_make(g);
+  side sd[2];
+  for (int w = 0; w < 2; w++) {
+    sd[w].kappa = &kappa[w];
+    sd[w].theta = &theta[w];
+    sd[w].L = length[w];
+    sd[w].angle = angle[w];
+  }
+  double Lmax = fmax(length[0], length[1]);
+  p->La = length[0];
+  p->Lb = length[1];
+  p->tol = tol;
+  p->closed = closed;
+  if (!metric_factor(p->chol)) {
+    st = KM_ENOCONVERGE;
+    goto fail;
+  }
+  /* merged breaks of both inputs in r */
+  size_t nbr = theta[0].m + theta[1].m + 2;
+  br = malloc(nbr * sizeof(double));
+  if (!br) {
+    st = KM_ENOMEM;
+    goto fail;
+  }
+  size_t q = 0;
+  for (int w = 0; w < 2; w++)
+    for (size_t i = 0; i <= theta[w].m; i++) br[q++] = theta[w].x[i] / length[w];
+  qsort(br, q, sizeof(double), cmp_dbl);
+  size_t m = 0;
+  for (size_t i = 0; i < q; i++) {
+    double v = fmin(fmax(br[i], 0.0), 1.0);
+    if (m == 0 || v > br[m - 1] + 1e-14) br[m++] = v;
+  }
+  br[0] = 0.0;
+  if (br[m - 1] < 1.0 - 1e-14)
+    br[m++] = 1.0;
+  else
+    br[m - 1] = 1.0;
+  if (m < 2) {
+    st = KM_EDEGENERATE;
+    goto fail;
+  }
+  /* atoms; jumps and corners at the merged breaks */
+  double tolp = 0.5 * tol / Lmax;
+  for (size_t i = 0; i + 1 < m; i++) {
+    double j2 = 0.0, j3 = 0.0;
+    bool corner = false;
+    if (i > 0) {
+      double D[2];
+      both_bounds(sd, br[i - 1], br[i + 1], 1, D);
+      for (int w = 0; w < 2; w++) {
+        double vl[3], vr[3];
+        side_eval(&sd[w], br[i], -1, vl);
+        side_eval(&sd[w], br[i], 1, vr);
+        if (fabs(vr[0] - vl[0]) > 1e-12) corner = true;
+        double d1 = fabs(vr[1] - vl[1]), d2 = fabs(vr[2] - vl[2]);
+        j2 = fmax(j2, d1);
+        j3 = fmax(j3, d2 + d1 * 2 * D[1]);
+      }
+    }
+    st = plan_interval(&atoms, sd, br[i], br[i + 1], tolp, j2, j3, corner);
+    if (st) goto fail;
+  }
+  /* merge atoms greedily into output pieces while the bound holds */
+  atom *A = atoms.p;
+  size_t na = atoms.n;
+  size_t *start = malloc((na + 1) * sizeof(size_t));
+  if (!start) {
+    st = KM_ENOMEM;
+    goto fail;
+  }
+  size_t np = 0;
+  {
+    size_t k = 0;
+    while (k < na) {
+      start[np++] = k;
+      double m4 = A[k].m4, s2 = 0.0, s3 = 0.0;
+      size_t e = k + 1;
+      while (e < na && !A[e].corner) {
+        double h = A[e].x1 - A[k].x0;
+        double m4n = fmax(m4, A[e].m4), s2n = s2 + A[e].j2, s3n = s3 + A[e].j3;
+        double e_h = pow(h, 4) / 384.0 * m4n + KM__HERMITE_JUMP2 * h * h * s2n +
+                     KM__HERMITE_JUMP3 * h * h * h * s3n;
+        if (e_h > tolp) break;
+        m4 = m4n;
+        s2 = s2n;
+        s3 = s3n;
+        e++;
+      }
+      k = e;
+    }
+    start[np] = na;
+  }
+  p->np = np;
+  p->x = malloc((np + 1) * sizeof(double));
+  p->corner = calloc(np + 1, 1);
+  p->ta_l = malloc((np + 1) * sizeof(double));
+  p->ta_r = malloc((np + 1) * sizeof(double));
+  p->tb_l = malloc((np + 1) * sizeof(double));
+  p->tb_r = malloc((np + 1) * sizeof(double));
+  p->first = malloc((np + 1) * sizeof(size_t));
+  if (!p->x || !p->corner || !p->ta_l || !p->ta_r || !p->tb_l || !p->tb_r ||
+      !p->first) {
+    free(start);
+    st = KM_ENOMEM;
+    goto fail;
+  }
+  /* quadrature share of the tolerance, per unit of r */
+  double tolq = 0.1 * tol / Lmax;
+  for (size_t k = 0; k < np && !st; k++) {
+    p->x[k] = A[start[k]].x0;
+    p->corner[k] = A[start[k]].corner;
+    p->first[k] = nodes.n;
+    for (size_t ai = start[k]; ai < start[k + 1] && !st; ai++) {
+      double a = A[ai].x0, b = A[ai].x1;
+      double D[NDER + 1], B[NDER + 1], Dh[NDER + 1];
+      both_bounds(sd, a, b, NDER, D);
+      /* lowest order, then halving, whose bound meets tolq per unit r */
+      int chunks = 1, n = 2;
+      for (;;) {
+        double h = (b - a) / chunks, hj = h;
+        for (int j = 1; j <= NDER; j++) {
+          Dh[j] = D[j] * hj;
+          hj *= h;
+        }
+        bell(Dh, NDER, B);
+        bool ok = false;
+        for (n = 2; n <= MAX_RULE; n++)
+          if (g->K[n] * B[2 * n] <= tolq) {
+            ok = true;
+            break;
+          }
+        if (ok || chunks >= (1 << 20)) {
+          if (!ok) n = MAX_RULE;
+          break;
+        }
+        chunks *= 2;
+      }
+      double hc = (b - a) / chunks;
+      for (int c = 0; c < chunks && !st; c++) {
+        double mid = a + hc * (c + 0.5);
+        for (int j = 0; j < n && !st; j++) {
+          gnode nd;
+          double r = mid + 0.5 * hc * g->x[n][j];
+          nd.w = 0.5 * hc * g->w[n][j];
+          nd.ta = side_theta(&sd[0], r);
+          nd.tb = side_theta(&sd[1], r);
+          basis_at(r, &nd.bi, nd.bv);
+          st = vec_push(&nodes, &nd);
+        }
+      }
+    }
+  }
+  free(start);
+  if (st) goto fail;
+  p->x[np] = 1.0;
+  p->first[np] = nodes.n;
+  for (size_t k = 0; k <= np; k++) {
+    double v[3];
+    side_eval(&sd[0], p->x[k], k == 0 ? 1 : -1, v);
+    p->ta_l[k] = v[0];
+    side_eval(&sd[0], p->x[k], k == np ? -1 : 1, v);
+    p->ta_r[k] = v[0];
+    side_eval(&sd[1], p->x[k], k == 0 ? 1 : -1, v);
+    p->tb_l[k] = v[0];
+    side_eval(&sd[1], p->x[k], k == np ? -1 : 1, v);
+    p->tb_r[k] = v[0];
+  }
+  p->node = nodes.p;
+  p->nn = nodes.n;
+  nodes.p = NULL;
+  free(atoms.p);
+  free(br);
+  free(g);
+  *out = p;
+  return KM_OK;
+fail:
+  free(atoms.p);
+  free(nodes.p);
+  free(br);
+  free(g);
+  km__frame_plan_free(p);
+  return km__fail(err, st, KM_FIELD_TOLERANCE, -1, NAN,
+                  st == KM_ELIMIT ? "the frames need too many pieces at this "
+                                    "tolerance: loosen it"
+                                  : NULL);
+}
+
+size_t km__frame_plan_pieces(const km__frame_plan *p) { return p->np; }
+size_t km__frame_plan_nodes(const km__frame_plan *p) { return p->nn; }
+
+/* ---- frames ------------------------------------------------------------ */
+
+km_status km__frame_plan_curve(const km__frame_plan *p, double t,
+                               double theta0, bool close_lsq, km_curve *out,
+                               double *gap_before, km_error *err) {
+  double Lt = (1 - t) * p->La + t * p->Lb, al = 1 - t, be = t;
+  size_t np = p->np;
+  double c[NF] = {0};
+  double *sum = malloc(2 * np * sizeof(double));
+  if (!sum) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  double gap = 0.0;
+  for (int it = 0;; it++) {
+    double G[2] = {0, 0}, J[2][NF];
+    memset(J, 0, sizeof J);
+    for (size_t k = 0; k < np; k++) {
+      double sx = 0.0, sy = 0.0;
+      for (size_t j = p->first[k]; j < p->first[k + 1]; j++) {
+        const gnode *nd = &p->node[j];
+        double th = theta0 + al * nd->ta + be * nd->tb;
+        if (it > 0)
+          for (int q = 0; q < 4; q++)
+            if (nd->bv[q] != 0.0) th += c[nd->bi + q] * nd->bv[q];
+        double cs = cos(th), sn = sin(th);
+        sx += nd->w * cs;
+        sy += nd->w * sn;
+        if (close_lsq)
+          for (int q = 0; q < 4; q++)
+            if (nd->bv[q] != 0.0) {
+              J[0][nd->bi + q] -= nd->w * sn * nd->bv[q];
+              J[1][nd->bi + q] += nd->w * cs * nd->bv[q];
+            }
+      }
+      sum[2 * k] = sx;
+      sum[2 * k + 1] = sy;
+      G[0] += sx;
+      G[1] += sy;
+    }
+    gap = Lt * hypot(G[0], G[1]);
+    if (it == 0 && gap_before) *gap_before = gap;
+    if (!close_lsq || !p->closed || gap <= 1e-12 * Lt) break;
+    if (it == 40) {
+      free(sum);
+      return km__fail(err, KM_ENOCONVERGE, KM_FIELD_NONE, -1, NAN,
+                      "closing the frame did not converge");
+    }
+    /* minimum-norm Newton step in the metric: c = M^-1 J^T lambda with
+     * J c = J c_old - G */
+    double Y[2][NF];
+    for (int r = 0; r < 2; r++) {
+      memcpy(Y[r], J[r], sizeof Y[r]);
+      chol_solve(p->chol, Y[r]);
+    }
+    double S[4] = {0, 0, 0, 0}, rhs[2];
+    for (int r = 0; r < 2; r++) {
+      for (int k = 0; k < 2; k++)
+        for (int i = 0; i < NF; i++) S[r * 2 + k] += J[r][i] * Y[k][i];
+      rhs[r] = -G[r];
+      for (int i = 0; i < NF; i++) rhs[r] += J[r][i] * c[i];
+    }
+    if (!km__solve_dense(S, rhs, 2)) {
+      free(sum);
+      return km__fail(err, KM_ENOCONVERGE, KM_FIELD_NONE, -1, NAN,
+                      "closing the frame did not converge");
+    }
+    for (int i = 0; i < NF; i++) c[i] = Y[0][i] * rhs[0] + Y[1][i] * rhs[1];
+  }
+  /* Hermite control points: P0, then Q1 Q2 of every piece, with the
+   * junction point itself at corners (triple knots; double elsewhere) */
+  size_t ncorner = 0;
+  for (size_t k = 1; k < np; k++) ncorner += p->corner[k];
+  size_t ncp = 2 * np + 2 + ncorner, nknots = ncp + 4;
+  km_curve f;
+  km_curve_init(&f);
+  km_status st = km__curve_alloc(&f, 3, ncp, false);
+  if (st) {
+    free(sum);
+    return km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
+  }
+  size_t cc = 0, kk = 0;
+  double P[2] = {0.0, 0.0};
+  for (int r = 0; r < 4; r++) f.knots[kk++] = 0.0;
+  f.cp[cc++] = 0.0;
+  f.cp[cc++] = 0.0;
+  for (size_t k = 0; k < np; k++) {
+    double h = Lt * (p->x[k + 1] - p->x[k]);
+    double th0 = theta0 + al * p->ta_r[k] + be * p->tb_r[k] + psi_at(c, p->x[k]);
+    double th1 = theta0 + al * p->ta_l[k + 1] + be * p->tb_l[k + 1] +
+                 psi_at(c, p->x[k + 1]);
+    double Pn[2] = {P[0] + Lt * sum[2 * k], P[1] + Lt * sum[2 * k + 1]};
+    if (k > 0 && p->corner[k]) {
+      f.cp[cc++] = P[0];
+      f.cp[cc++] = P[1];
+    }
+    f.cp[cc++] = P[0] + h / 3.0 * cos(th0);
+    f.cp[cc++] = P[1] + h / 3.0 * sin(th0);
+    f.cp[cc++] = Pn[0] - h / 3.0 * cos(th1);
+    f.cp[cc++] = Pn[1] - h / 3.0 * sin(th1);
+    if (k + 1 < np) {
+      int mult = p->corner[k + 1] ? 3 : 2;
+      for (int r = 0; r < mult; r++) f.knots[kk++] = Lt * p->x[k + 1];
+    }
+    P[0] = Pn[0];
+    P[1] = Pn[1];
+  }
+  f.cp[cc++] = P[0];
+  f.cp[cc++] = P[1];
+  for (int r = 0; r < 4; r++) f.knots[kk++] = Lt;
+  free(sum);
+  if (cc != 2 * ncp || kk != nknots) {
+    km_curve_free(&f);
+    return km__fail(err, KM_EINVAL, KM_FIELD_NONE, -1, NAN,
+                    "internal inconsistency building a frame");
+  }
+  f.closed = false;
+  if (p->closed) {
+    double g = hypot(P[0], P[1]);
+    if (g <= p->tol) {
+      f.cp[2 * (ncp - 1)] = f.cp[0];
+      f.cp[2 * (ncp - 1) + 1] = f.cp[1];
+      f.closed = true;
+    }
+  }
+  *out = f;
+  return KM_OK;
+}

@@ -1,0 +1,44 @@
+/* morph_plan.h - curvature frames planned once per morph (morph_plan.c):
+ * the output pieces and quadrature nodes of every frame of a turning-blend
+ * morph without matches, so that a frame costs one pass of sin/cos per
+ * closure step. Internal to the core. */
+#ifndef KM_MORPH_PLAN_H
+#define KM_MORPH_PLAN_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "internal.h"
+#include "km/curve.h"
+#include "km/status.h"
+
+/* Uniform intervals of the lsq closure's basis over the whole curve: its
+ * interior cubic B-splines (KM__CLOSURE_INTERVALS - 3 of them) vanish with
+ * two derivatives at the seam. */
+#define KM__CLOSURE_INTERVALS 16
+
+typedef struct km__frame_plan km__frame_plan;
+
+/* Plans frames between two inputs given as kappa and theta pieces in their
+ * own arc length (km__build_theta), with lengths and start angles. Every
+ * frame built from the plan is within tol of the exact frame (tol: the
+ * frame tolerance; a half goes to the Hermite pieces, a tenth to the
+ * quadrature). */
+km_status km__frame_plan_build(km__frame_plan **out, const km_pp kappa[2],
+                               const km_pp theta[2], const double length[2],
+                               const double angle[2], bool closed, double tol,
+                               km_error *err);
+void km__frame_plan_free(km__frame_plan *p);
+size_t km__frame_plan_pieces(const km__frame_plan *p);
+size_t km__frame_plan_nodes(const km__frame_plan *p);
+
+/* The frame at t as a cubic B-spline in its arc length, starting at the
+ * origin with tangent angle theta0. close_lsq: closes a closed pair by the
+ * lsq correction of theta; *gap_before (optional) is the end gap before
+ * any correction. The result is marked closed (end snapped to start) when
+ * its gap is within the tolerance. */
+km_status km__frame_plan_curve(const km__frame_plan *p, double t,
+                               double theta0, bool close_lsq, km_curve *out,
+                               double *gap_before, km_error *err);
+
+#endif
