@@ -184,11 +184,64 @@ static km_status recompute_sig(input *in, double tol, km_error *err) {
   return input_tables(in);
 }
 
-/* Closed curve starting at arc length s0 instead of 0. */
-static km_status rotate_start(input *in, double s0, double tol,
-                              km_error *err) {
-  km_status st = ensure_curve(in, tol, err);
-  if (st) return st;
+static km_status pp_slice(km_pp *out, const km_pp *p, double x0, double x1);
+static int cmp_corner(const void *x, const void *y);
+
+/* The signature of the same closed curve started at arc length s0: kappa
+ * and the corners shifted cyclically (the seam's corner becomes an interior
+ * one, a corner at s0 the seam's), the start point and angle those at s0.
+ * Exact, so no new signature has to be computed. */
+static km_status rotate_signature(const input *in, double s0,
+                                  km_signature *out, km_error *err) {
+  const km_signature *sig = &in->sig;
+  double L = sig->length, start[2];
+  km_pp k1, k2, kr;
+  km__pp_init(&k1);
+  km__pp_init(&k2);
+  km__pp_init(&kr);
+  km_corner *cs = malloc((sig->ncorners + 1) * sizeof *cs);
+  km_fn kf;
+  km_fn_init(&kf);
+  km_status st = cs ? km_signature_point(sig, s0, start, NULL) : KM_ENOMEM;
+  if (!st) st = pp_slice(&k1, &in->kappa, s0, L);
+  if (!st) st = pp_slice(&k2, &in->kappa, 0.0, s0);
+  if (!st) st = km__pp_alloc(&kr, k1.degree, k1.m + k2.m);
+  if (st) goto done;
+  size_t nc1 = (size_t)k1.degree + 1;
+  for (size_t i = 0; i < k1.m; i++) kr.x[i] = k1.x[i] - s0;
+  for (size_t i = 0; i < k2.m; i++) kr.x[k1.m + i] = k2.x[i] + (L - s0);
+  kr.x[0] = 0.0;
+  kr.x[kr.m] = L;
+  memcpy(kr.c, k1.c, k1.m * nc1 * sizeof(double));
+  memcpy(kr.c + k1.m * nc1, k2.c, k2.m * nc1 * sizeof(double));
+  size_t n = 0;
+  double eps = 1e-12 * L;
+  for (size_t i = 0; i < sig->ncorners; i++) {
+    double cs0 = sig->corners[i].s;
+    if (fabs(cs0 - s0) <= eps)
+      cs[n].s = L;
+    else
+      cs[n].s = cs0 > s0 ? cs0 - s0 : cs0 + (L - s0);
+    cs[n++].turn = sig->corners[i].turn;
+  }
+  if (n > 1) qsort(cs, n, sizeof *cs, cmp_corner);
+  st = km__pp_to_fn(&kf, &kr);
+  if (st) goto done;
+  st = km_signature_create(out, L, start, theta_at(in, s0), &kf, cs, n, true,
+                           err);
+done:
+  if (st == KM_ENOMEM) km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
+  km_fn_free(&kf);
+  free(cs);
+  km__pp_free(&k1);
+  km__pp_free(&k2);
+  km__pp_free(&kr);
+  return st;
+}
+
+/* The curve (if the input has one) split at s0 and joined the other way
+ * round: the same closed curve started there. */
+static km_status rotate_curve(input *in, double s0, km_error *err) {
   const km_curve *c = &in->curve;
   double t = km_curve_param_at_length(c, s0);
   double t0, t1;
@@ -199,7 +252,7 @@ static km_status rotate_start(input *in, double s0, double tol,
   km_curve_init(&left);
   km_curve_init(&right);
   km_curve_init(&joined);
-  st = km_curve_split(c, t, &left, &right, err);
+  km_status st = km_curve_split(c, t, &left, &right, err);
   if (st) goto done;
   /* joined = right then left: knots of left shifted past right's end */
   int p = c->degree;
@@ -234,12 +287,24 @@ static km_status rotate_start(input *in, double s0, double tol,
   km_curve_free(&in->curve);
   in->curve = joined;
   km_curve_init(&joined);
-  st = recompute_sig(in, tol, err);
 done:
   km_curve_free(&left);
   km_curve_free(&right);
   km_curve_free(&joined);
   return st;
+}
+
+/* Closed input starting at arc length s0 instead of 0. */
+static km_status rotate_start(input *in, double s0, km_error *err) {
+  double L = in->sig.length;
+  if (!(s0 > 1e-12 * L) || !(s0 < L - 1e-12 * L)) return KM_OK;
+  km_status st = in->has_curve ? rotate_curve(in, s0, err) : KM_OK;
+  km_signature r;
+  if (!st) st = rotate_signature(in, s0, &r, err);
+  if (st) return st;
+  km_signature_free(&in->sig);
+  in->sig = r;
+  return input_tables(in);
 }
 
 static km_status reverse_input(input *in, double tol, km_error *err) {
@@ -529,7 +594,7 @@ static km_status create_impl(km_morph **out, const km_morph_input *from,
         shift = cand[0];
       }
       if (shift > 0) {
-        st = rotate_start(b, shift * b->sig.length, 0.1 * tol, err);
+        st = rotate_start(b, shift * b->sig.length, err);
         if (st) goto fail;
       }
     }
@@ -1322,60 +1387,85 @@ static void corresponding(const km_morph *m, double t, double s, double *ra,
 }
 
 /* Rigid motion (rotation about the origin by *rot, then translation) that
- * places a frame whose parameter is arc length. */
-static void placement(const km_morph *m, double t, const km_curve *f,
-                      double Lt, double *rot, double T[2]) {
+ * places a frame given by samples F at frame arc lengths s[j] (weights w,
+ * arc length the samples stand for): "fit" maps them in the least-squares
+ * sense onto the linear blend Q of the inputs at corresponding points. */
+static void place_samples(const km_morph *m, double t, const double (*F)[2],
+                          const double *s, const double *w, size_t n,
+                          double *rot, double T[2]) {
   const input *a = &m->in[0], *b = &m->in[1];
   *rot = 0.0;
-  if (t == 0.0 || t == 1.0 || m->opt.anchor == KM_ANCHOR_START) {
-    T[0] = (1 - t) * a->sig.start[0] + t * b->sig.start[0];
-    T[1] = (1 - t) * a->sig.start[1] + t * b->sig.start[1];
+  T[0] = (1 - t) * a->sig.start[0] + t * b->sig.start[0];
+  T[1] = (1 - t) * a->sig.start[1] + t * b->sig.start[1];
+  if (t == 0.0 || t == 1.0 || m->opt.anchor == KM_ANCHOR_START || n == 0)
     return;
-  }
-  double fc[2] = {0, 0}, qc[2] = {0, 0};
-  static const int N = FIT_N;
-  double (*F)[2] = malloc(2 * (size_t)N * sizeof *F);
-  if (!F) {
-    T[0] = (1 - t) * a->sig.start[0] + t * b->sig.start[0];
-    T[1] = (1 - t) * a->sig.start[1] + t * b->sig.start[1];
-    return;
-  }
-  double (*Q)[2] = F + N;
-  for (int j = 0; j < N; j++) {
-    double s = Lt * (j + 0.5) / N, d[1][2], ra, rb, pa[2], pb[2];
-    km_curve_eval(f, s, 0, d);
-    F[j][0] = d[0][0];
-    F[j][1] = d[0][1];
-    corresponding(m, t, s, &ra, &rb);
+  double fc[2] = {0, 0}, qc[2] = {0, 0}, W = 0.0;
+  double (*Q)[2] = malloc(n * sizeof *Q);
+  if (!Q) return;
+  for (size_t j = 0; j < n; j++) {
+    double ra, rb, pa[2], pb[2];
+    corresponding(m, t, s[j], &ra, &rb);
     table_at(a, ra, pa);
     table_at(b, rb, pb);
     Q[j][0] = (1 - t) * pa[0] + t * pb[0];
     Q[j][1] = (1 - t) * pa[1] + t * pb[1];
-    fc[0] += F[j][0] / N;
-    fc[1] += F[j][1] / N;
-    qc[0] += Q[j][0] / N;
-    qc[1] += Q[j][1] / N;
+    for (int k = 0; k < 2; k++) {
+      fc[k] += w[j] * F[j][k];
+      qc[k] += w[j] * Q[j][k];
+    }
+    W += w[j];
+  }
+  for (int k = 0; k < 2; k++) {
+    fc[k] /= W;
+    qc[k] /= W;
   }
   if (m->opt.anchor == KM_ANCHOR_CENTROID) {
     /* the blended start angle is kept; the wire centroid follows the
      * line between the inputs' centroids */
     T[0] = (1 - t) * a->centroid[0] + t * b->centroid[0] - fc[0];
     T[1] = (1 - t) * a->centroid[1] + t * b->centroid[1] - fc[1];
-    free(F);
+    free(Q);
     return;
   }
   double sx = 0.0, sy = 0.0;
-  for (int j = 0; j < N; j++) {
+  for (size_t j = 0; j < n; j++) {
     double fx = F[j][0] - fc[0], fy = F[j][1] - fc[1];
     double qx = Q[j][0] - qc[0], qy = Q[j][1] - qc[1];
-    sx += fx * qx + fy * qy;
-    sy += fx * qy - fy * qx;
+    sx += w[j] * (fx * qx + fy * qy);
+    sy += w[j] * (fx * qy - fy * qx);
   }
   *rot = atan2(sy, sx);
   double cr = cos(*rot), sr = sin(*rot);
   T[0] = qc[0] - (cr * fc[0] - sr * fc[1]);
   T[1] = qc[1] - (sr * fc[0] + cr * fc[1]);
+  free(Q);
+}
+
+/* Placement of a frame curve whose parameter is arc length: samples at the
+ * midpoints of FIT_N equal parts. */
+static void placement(const km_morph *m, double t, const km_curve *f,
+                      double Lt, double *rot, double T[2]) {
+  static const size_t N = FIT_N;
+  double (*F)[2] = malloc(N * sizeof *F);
+  double *s = malloc(2 * N * sizeof(double));
+  if (!F || !s) {
+    free(F);
+    free(s);
+    place_samples(m, t, NULL, NULL, NULL, 0, rot, T); /* by the start */
+    return;
+  }
+  double *w = s + N;
+  for (size_t j = 0; j < N; j++) {
+    double d[1][2];
+    s[j] = Lt * ((double)j + 0.5) / (double)N;
+    w[j] = 1.0;
+    km_curve_eval(f, s[j], 0, d);
+    F[j][0] = d[0][0];
+    F[j][1] = d[0][1];
+  }
+  place_samples(m, t, (const double (*)[2])F, s, w, N, rot, T);
   free(F);
+  free(s);
 }
 
 static double curve_kappa(const km_curve *c, double t, double *speed) {
@@ -1443,22 +1533,34 @@ static km_status planned_frame(const km_morph *m, double t, km_closure how,
                                km_curve *out, km_error *err) {
   const input *a = &m->in[0], *b = &m->in[1];
   double phia = a->sig.angle, phib = phia + km__wrap_angle(b->sig.angle - phia);
+  double Lt = (1 - t) * a->sig.length + t * b->sig.length, rot, T[2];
+  size_t nb = km__frame_plan_pieces(m->plan) + 1;
+  const double *x = km__frame_plan_breaks(m->plan);
+  double *buf = malloc(4 * nb * sizeof(double));
+  if (!buf) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  double (*P)[2] = (double (*)[2])buf, *s = buf + 2 * nb, *w = buf + 3 * nb;
   km_curve f, placed;
   km_curve_init(&f);
   km_curve_init(&placed);
   km_status st = km__frame_plan_curve(m->plan, t, (1 - t) * phia + t * phib,
-                                      how == KM_CLOSURE_LSQ, &f, NULL, err);
-  if (st) return st;
+                                      how == KM_CLOSURE_LSQ, &f, NULL, buf, err);
+  if (st) goto done;
   if (m->closed && !f.closed && how != KM_CLOSURE_NONE)
     close_polygon(&f, how == KM_CLOSURE_LSQ ? KM_CLOSURE_C0 : how);
-  double Lt = (1 - t) * a->sig.length + t * b->sig.length, rot, T[2];
-  placement(m, t, &f, Lt, &rot, T);
+  /* placed by the piece ends (trapezoid weights in arc length) */
+  for (size_t k = 0; k < nb; k++) {
+    s[k] = Lt * x[k];
+    w[k] = 0.5 * ((k + 1 < nb ? x[k + 1] : x[k]) - (k > 0 ? x[k - 1] : x[k]));
+  }
+  place_samples(m, t, (const double (*)[2])P, s, w, nb, &rot, T);
   st = km_curve_transform(&placed, &f, rot, T[0], T[1], err);
   if (!st) {
     placed.closed = f.closed;
     *out = placed;
   }
+done:
   km_curve_free(&f);
+  free(buf);
   return st;
 }
 

@@ -521,12 +521,14 @@ fail:
 
 size_t km__frame_plan_pieces(const km__frame_plan *p) { return p->np; }
 size_t km__frame_plan_nodes(const km__frame_plan *p) { return p->nn; }
+const double *km__frame_plan_breaks(const km__frame_plan *p) { return p->x; }
 
 /* ---- frames ------------------------------------------------------------ */
 
 km_status km__frame_plan_curve(const km__frame_plan *p, double t,
                                double theta0, bool close_lsq, km_curve *out,
-                               double *gap_before, km_error *err) {
+                               double *gap_before, double *ends,
+                               km_error *err) {
   double Lt = (1 - t) * p->La + t * p->Lb, al = 1 - t, be = t;
   size_t np = p->np;
   double c[NF] = {0};
@@ -605,6 +607,7 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t,
   for (int r = 0; r < 4; r++) f.knots[kk++] = 0.0;
   f.cp[cc++] = 0.0;
   f.cp[cc++] = 0.0;
+  if (ends) ends[0] = ends[1] = 0.0;
   for (size_t k = 0; k < np; k++) {
     double h = Lt * (p->x[k + 1] - p->x[k]);
     double th0 = theta0 + al * p->ta_r[k] + be * p->tb_r[k] + psi_at(c, p->x[k]);
@@ -625,6 +628,10 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t,
     }
     P[0] = Pn[0];
     P[1] = Pn[1];
+    if (ends) {
+      ends[2 * k + 2] = P[0];
+      ends[2 * k + 3] = P[1];
+    }
   }
   f.cp[cc++] = P[0];
   f.cp[cc++] = P[1];
