@@ -531,12 +531,85 @@ static km_status prepare_input(input *in, const km_morph_input *src,
   return input_tables(in);
 }
 
-/* forced_shift: NULL to choose the start of a closed `to` by the alignment
- * cost (the candidates are returned in cand/ncand), else that shift. */
+/* Frames of the default morph (turning blend, no matches, cubic output)
+ * are planned once: see morph_plan.c. Others are blended piece by piece
+ * and reconstructed frame by frame. */
+static km_status plan_frames(km_morph *m, km_error *err) {
+  const input *a = &m->in[0], *b = &m->in[1];
+  if (m->opt.method != KM_METHOD_CURVATURE || m->opt.blend != KM_BLEND_TURNING ||
+      m->nk != 2 || m->opt.degree != 3)
+    return KM_OK;
+  const km_pp kp[2] = {a->kappa, b->kappa}, tp[2] = {a->theta, b->theta};
+  double len[2] = {a->sig.length, b->sig.length};
+  double ang[2] = {a->sig.angle, b->sig.angle};
+  return km__frame_plan_build(&m->plan, kp, tp, len, ang, m->closed, m->tol,
+                              err);
+}
+
+static km_status pp_copy(km_pp *out, const km_pp *p) {
+  km_status st = km__pp_alloc(out, p->degree, p->m);
+  if (st) return st;
+  memcpy(out->x, p->x, (p->m + 1) * sizeof(double));
+  memcpy(out->c, p->c, p->m * (size_t)(p->degree + 1) * sizeof(double));
+  return KM_OK;
+}
+
+static km_status input_copy(input *out, const input *in, km_error *err) {
+  memcpy(out->table, in->table, sizeof out->table);
+  memcpy(out->centroid, in->centroid, sizeof out->centroid);
+  out->has_curve = in->has_curve;
+  km_status st = in->has_curve ? km_curve_copy(&out->curve, &in->curve, err) : KM_OK;
+  if (!st) st = km_signature_copy(&out->sig, &in->sig, err);
+  if (!st) st = pp_copy(&out->kappa, &in->kappa);
+  if (!st) st = pp_copy(&out->theta, &in->theta);
+  if (st == KM_ENOMEM) km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
+  return st;
+}
+
+/* The morph of a closed pair without matches with `to` started a further
+ * fraction dshift of its length along: its inputs are copied, not
+ * computed again. */
+static km_status morph_shifted(const km_morph *base, double dshift,
+                               km_morph **out, km_error *err) {
+  km_morph *m = calloc(1, sizeof *m);
+  if (!m) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  for (int i = 0; i < 2; i++) {
+    km_curve_init(&m->in[i].curve);
+    km_signature_init(&m->in[i].sig);
+    km__pp_init(&m->in[i].kappa);
+    km__pp_init(&m->in[i].theta);
+    km_curve_init(&m->lin[i]);
+  }
+  m->opt = base->opt;
+  m->tol = base->tol;
+  m->closed = base->closed;
+  m->ra = malloc(2 * sizeof(double));
+  m->rb = malloc(2 * sizeof(double));
+  km_status st = m->ra && m->rb ? KM_OK
+                                : km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  if (!st) {
+    m->ra[0] = m->rb[0] = 0.0;
+    m->ra[1] = m->rb[1] = 1.0;
+    m->nk = 2;
+    st = input_copy(&m->in[0], &base->in[0], err);
+  }
+  if (!st) st = input_copy(&m->in[1], &base->in[1], err);
+  if (!st) st = rotate_start(&m->in[1], dshift * m->in[1].sig.length, err);
+  if (!st) st = plan_frames(m, err);
+  if (st) {
+    km_morph_free(m);
+    return st;
+  }
+  *out = m;
+  return KM_OK;
+}
+
+/* The start of a closed `to` is chosen by the alignment cost; the
+ * candidates are returned in cand/ncand, best first. */
 static km_status create_impl(km_morph **out, const km_morph_input *from,
                              const km_morph_input *to,
                              const km_morph_options *opt,
-                             const double *forced_shift, double *cand,
+                             double *cand,
                              size_t *ncand, km_error *err) {
   km_morph *m = calloc(1, sizeof *m);
   if (!m) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
@@ -587,12 +660,8 @@ static km_status create_impl(km_morph **out, const km_morph_input *from,
     }
     if (opt->nmatches == 0) {
       double shift = 0.0;
-      if (forced_shift) {
-        shift = *forced_shift;
-      } else {
-        *ncand = best_shifts(a, b, cand);
-        shift = cand[0];
-      }
+      *ncand = best_shifts(a, b, cand);
+      shift = cand[0];
       if (shift > 0) {
         st = rotate_start(b, shift * b->sig.length, err);
         if (st) goto fail;
@@ -641,14 +710,8 @@ static km_status create_impl(km_morph **out, const km_morph_input *from,
   /* Frames of the default morph (turning blend, no matches, cubic output)
    * are planned once: see morph_plan.c. Others are blended piece by piece
    * and reconstructed frame by frame. */
-  if (opt->method == KM_METHOD_CURVATURE && m->opt.blend == KM_BLEND_TURNING &&
-      m->nk == 2 && m->opt.degree == 3) {
-    const km_pp kp[2] = {a->kappa, b->kappa}, tp[2] = {a->theta, b->theta};
-    double len[2] = {a->sig.length, b->sig.length};
-    double ang[2] = {a->sig.angle, b->sig.angle};
-    st = km__frame_plan_build(&m->plan, kp, tp, len, ang, m->closed, m->tol, err);
-    if (st) goto fail;
-  }
+  st = plan_frames(m, err);
+  if (st) goto fail;
   *out = m;
   return KM_OK;
 fail:
@@ -660,10 +723,10 @@ static long preview_crossings(const km_morph *m) {
   long total = 0;
   for (int k = 1; k <= 5; k++) {
     km_curve c;
-    km_frame_metrics mt;
-    if (km_morph_frame(m, k / 6.0, &c, &mt, NULL, NULL) != KM_OK) return LONG_MAX;
+    if (km_morph_frame(m, k / 6.0, &c, NULL, NULL, NULL) != KM_OK) return LONG_MAX;
+    long x = km_curve_self_intersections(&c, m->tol);
     km_curve_free(&c);
-    if (mt.self_intersections > 0) total += mt.self_intersections;
+    if (x > 0) total += x;
   }
   return total;
 }
@@ -674,7 +737,7 @@ km_status km_morph_create(km_morph **out, const km_morph_input *from,
   double cand[SHIFT_CANDIDATES];
   size_t ncand = 0;
   km_morph *m = NULL;
-  km_status st = create_impl(&m, from, to, opt, NULL, cand, &ncand, err);
+  km_status st = create_impl(&m, from, to, opt, cand, &ncand, err);
   if (st) return st;
   /* Among starts that align about as well, prefer one whose frames do not
    * cross themselves: preview five frames of the best and, only if they
@@ -683,8 +746,8 @@ km_status km_morph_create(km_morph **out, const km_morph_input *from,
     long best = preview_crossings(m);
     for (size_t i = 1; i < ncand && best > 0; i++) {
       km_morph *alt = NULL;
-      if (create_impl(&alt, from, to, opt, &cand[i], NULL, NULL, NULL) != KM_OK)
-        continue;
+      double d = cand[i] - cand[0];
+      if (morph_shifted(m, d < 0 ? d + 1.0 : d, &alt, NULL) != KM_OK) continue;
       long x = preview_crossings(alt);
       if (x < best) {
         km_morph_free(m);
