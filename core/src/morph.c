@@ -1606,7 +1606,7 @@ static km_status planned_frame(const km_morph *m, double t, km_closure how,
   km_curve_init(&f);
   km_curve_init(&placed);
   km_status st = km__frame_plan_curve(m->plan, t, (1 - t) * phia + t * phib,
-                                      how == KM_CLOSURE_LSQ, &f, NULL, buf, err);
+                                      how == KM_CLOSURE_LSQ, &f, buf, err);
   if (st) goto done;
   if (m->closed && !f.closed && how != KM_CLOSURE_NONE)
     close_polygon(&f, how == KM_CLOSURE_LSQ ? KM_CLOSURE_C0 : how);

@@ -57,6 +57,7 @@ struct km__frame_plan {
   gnode *node;
   size_t nn;
   double chol[NF * NF]; /* Cholesky factor of the closure metric */
+  double c_half[NF];    /* the closure correction at t = 1/2 */
 };
 
 /* ---- small numerics ---------------------------------------------------- */
@@ -318,6 +319,9 @@ static int cmp_dbl(const void *a, const void *b) {
   return (x > y) - (x < y);
 }
 
+static km_status close_frame(const km__frame_plan *p, double t, double theta0,
+                             bool close_lsq, double *c, double *sum);
+
 km_status km__frame_plan_build(km__frame_plan **out, const km_pp kappa[2],
                                const km_pp theta[2], const double length[2],
                                const double angle[2], bool closed, double tol,
@@ -502,6 +506,16 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp kappa[2],
   p->node = nodes.p;
   p->nn = nodes.n;
   nodes.p = NULL;
+  if (closed) {
+    double *sum = malloc(2 * np * sizeof(double));
+    st = sum ? close_frame(p, 0.5, 0.0, true, p->c_half, sum) : KM_ENOMEM;
+    free(sum);
+    if (st == KM_ENOCONVERGE) {
+      memset(p->c_half, 0, sizeof p->c_half);
+      st = KM_OK;
+    }
+    if (st) goto fail;
+  }
   free(atoms.p);
   free(br);
   free(g);
@@ -525,16 +539,13 @@ const double *km__frame_plan_breaks(const km__frame_plan *p) { return p->x; }
 
 /* ---- frames ------------------------------------------------------------ */
 
-km_status km__frame_plan_curve(const km__frame_plan *p, double t,
-                               double theta0, bool close_lsq, km_curve *out,
-                               double *gap_before, double *ends,
-                               km_error *err) {
+/* theta_t plus the closure correction psi (coefficients c, started from
+ * c), integrated over every piece: sum[2k], sum[2k+1] = integral of
+ * e^(i theta) dr over piece k. */
+static km_status close_frame(const km__frame_plan *p, double t, double theta0,
+                             bool close_lsq, double *c, double *sum) {
   double Lt = (1 - t) * p->La + t * p->Lb, al = 1 - t, be = t;
   size_t np = p->np;
-  double c[NF] = {0};
-  double *sum = malloc(2 * np * sizeof(double));
-  if (!sum) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
-  double gap = 0.0;
   for (int it = 0;; it++) {
     double G[2] = {0, 0}, J[2][NF];
     memset(J, 0, sizeof J);
@@ -543,9 +554,8 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t,
       for (size_t j = p->first[k]; j < p->first[k + 1]; j++) {
         const gnode *nd = &p->node[j];
         double th = theta0 + al * nd->ta + be * nd->tb;
-        if (it > 0)
-          for (int q = 0; q < 4; q++)
-            if (nd->bv[q] != 0.0) th += c[nd->bi + q] * nd->bv[q];
+        for (int q = 0; q < 4; q++)
+          if (nd->bv[q] != 0.0) th += c[nd->bi + q] * nd->bv[q];
         double cs = cos(th), sn = sin(th);
         sx += nd->w * cs;
         sy += nd->w * sn;
@@ -561,16 +571,17 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t,
       G[0] += sx;
       G[1] += sy;
     }
-    gap = Lt * hypot(G[0], G[1]);
-    if (it == 0 && gap_before) *gap_before = gap;
-    if (!close_lsq || !p->closed || gap <= 1e-12 * Lt) break;
-    if (it == 40) {
-      free(sum);
-      return km__fail(err, KM_ENOCONVERGE, KM_FIELD_NONE, -1, NAN,
-                      "closing the frame did not converge");
-    }
-    /* minimum-norm Newton step in the metric: c = M^-1 J^T lambda with
-     * J c = J c_old - G */
+    double gap = Lt * hypot(G[0], G[1]);
+    if (!close_lsq || !p->closed || gap <= 1e-11 * Lt) return KM_OK;
+    if (it == 40) return KM_ENOCONVERGE;
+    /* Gauss-Newton in the metric: the first steps project, c = M^-1 J^T
+     * lambda with J c = J c_old - G (the minimum-norm point of the
+     * linearised constraints: the least change of curvature), which also
+     * moves c along the constraints and so converges only linearly; the
+     * later ones take the minimum-norm step dc = M^-1 J^T lambda with
+     * J dc = -G, which converges quadratically and leaves c within the
+     * square of the remaining step of that least change. */
+    bool project = it == 0;
     double Y[2][NF];
     for (int r = 0; r < 2; r++) {
       memcpy(Y[r], J[r], sizeof Y[r]);
@@ -581,14 +592,32 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t,
       for (int k = 0; k < 2; k++)
         for (int i = 0; i < NF; i++) S[r * 2 + k] += J[r][i] * Y[k][i];
       rhs[r] = -G[r];
-      for (int i = 0; i < NF; i++) rhs[r] += J[r][i] * c[i];
+      if (project)
+        for (int i = 0; i < NF; i++) rhs[r] += J[r][i] * c[i];
     }
-    if (!km__solve_dense(S, rhs, 2)) {
-      free(sum);
-      return km__fail(err, KM_ENOCONVERGE, KM_FIELD_NONE, -1, NAN,
-                      "closing the frame did not converge");
-    }
-    for (int i = 0; i < NF; i++) c[i] = Y[0][i] * rhs[0] + Y[1][i] * rhs[1];
+    if (!km__solve_dense(S, rhs, 2)) return KM_ENOCONVERGE;
+    for (int i = 0; i < NF; i++)
+      c[i] = (project ? 0.0 : c[i]) + Y[0][i] * rhs[0] + Y[1][i] * rhs[1];
+  }
+}
+
+km_status km__frame_plan_curve(const km__frame_plan *p, double t,
+                               double theta0, bool close_lsq, km_curve *out,
+                               double *ends, km_error *err) {
+  double Lt = (1 - t) * p->La + t * p->Lb, al = 1 - t, be = t;
+  size_t np = p->np;
+  /* start from the correction at t = 1/2 scaled by 4 t (1 - t): frames
+   * near each other need nearly the same correction, and the ends none */
+  double c[NF] = {0};
+  if (close_lsq && p->closed)
+    for (int i = 0; i < NF; i++) c[i] = 4 * t * (1 - t) * p->c_half[i];
+  double *sum = malloc(2 * np * sizeof(double));
+  if (!sum) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  km_status st = close_frame(p, t, theta0, close_lsq, c, sum);
+  if (st) {
+    free(sum);
+    return km__fail(err, st, KM_FIELD_NONE, -1, NAN,
+                    "closing the frame did not converge");
   }
   /* Hermite control points: P0, then Q1 Q2 of every piece, with the
    * junction point itself at corners (triple knots; double elsewhere) */
@@ -597,7 +626,7 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t,
   size_t ncp = 2 * np + 2 + ncorner, nknots = ncp + 4;
   km_curve f;
   km_curve_init(&f);
-  km_status st = km__curve_alloc(&f, 3, ncp, false);
+  st = km__curve_alloc(&f, 3, ncp, false);
   if (st) {
     free(sum);
     return km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);

@@ -36,13 +36,11 @@ const double *km__frame_plan_breaks(const km__frame_plan *p);
 
 /* The frame at t as a cubic B-spline in its arc length, starting at the
  * origin with tangent angle theta0. close_lsq: closes a closed pair by the
- * lsq correction of theta; *gap_before (optional) is the end gap before
- * any correction. The result is marked closed (end snapped to start) when
+ * lsq correction of theta. The result is marked closed (end snapped to start) when
  * its gap is within the tolerance. ends (optional, 2 (pieces + 1) values)
  * receives the pieces' end points. */
 km_status km__frame_plan_curve(const km__frame_plan *p, double t,
                                double theta0, bool close_lsq, km_curve *out,
-                               double *gap_before, double *ends,
-                               km_error *err);
+                               double *ends, km_error *err);
 
 #endif
