@@ -320,7 +320,8 @@ static int cmp_dbl(const void *a, const void *b) {
 }
 
 static km_status close_frame(const km__frame_plan *p, double t, double theta0,
-                             bool close_lsq, double *c, double *sum);
+                             bool close_lsq, double *c, double *sum,
+                             double *e);
 
 km_status km__frame_plan_build(km__frame_plan **out, const km_pp kappa[2],
                                const km_pp theta[2], const double length[2],
@@ -507,8 +508,9 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp kappa[2],
   p->nn = nodes.n;
   nodes.p = NULL;
   if (closed) {
-    double *sum = malloc(2 * np * sizeof(double));
-    st = sum ? close_frame(p, 0.5, 0.0, true, p->c_half, sum) : KM_ENOMEM;
+    double *sum = malloc(2 * (np + p->nn) * sizeof(double));
+    st = sum ? close_frame(p, 0.5, 0.0, true, p->c_half, sum, sum + 2 * np)
+             : KM_ENOMEM;
     free(sum);
     if (st == KM_ENOCONVERGE) {
       memset(p->c_half, 0, sizeof p->c_half);
@@ -539,13 +541,30 @@ const double *km__frame_plan_breaks(const km__frame_plan *p) { return p->x; }
 
 /* ---- frames ------------------------------------------------------------ */
 
+/* e^(i d) for |d| <= 0.1 by its Taylor series (the remainder is below
+ * 0.1^10 / 10! < 3e-17), beyond that by sin and cos. */
+static void exp_i_small(double d, double *cs, double *sn) {
+  if (fabs(d) > 0.1) {
+    *cs = cos(d);
+    *sn = sin(d);
+    return;
+  }
+  double d2 = d * d;
+  *cs = 1 - d2 / 2 * (1 - d2 / 12 * (1 - d2 / 30 * (1 - d2 / 56 * (1 - d2 / 90))));
+  *sn = d * (1 - d2 / 6 * (1 - d2 / 20 * (1 - d2 / 42 * (1 - d2 / 72))));
+}
+
 /* theta_t plus the closure correction psi (coefficients c, started from
  * c), integrated over every piece: sum[2k], sum[2k+1] = integral of
- * e^(i theta) dr over piece k. */
+ * e^(i theta) dr over piece k. e (2 per node) is scratch: e^(i theta) at
+ * the nodes, computed by sin and cos once and then turned by the change
+ * of psi at every step, which is small. */
 static km_status close_frame(const km__frame_plan *p, double t, double theta0,
-                             bool close_lsq, double *c, double *sum) {
+                             bool close_lsq, double *c, double *sum,
+                             double *e) {
   double Lt = (1 - t) * p->La + t * p->Lb, al = 1 - t, be = t;
   size_t np = p->np;
+  double dc[NF];
   for (int it = 0;; it++) {
     double G[2] = {0, 0}, J[2][NF];
     memset(J, 0, sizeof J);
@@ -553,10 +572,23 @@ static km_status close_frame(const km__frame_plan *p, double t, double theta0,
       double sx = 0.0, sy = 0.0;
       for (size_t j = p->first[k]; j < p->first[k + 1]; j++) {
         const gnode *nd = &p->node[j];
-        double th = theta0 + al * nd->ta + be * nd->tb;
-        for (int q = 0; q < 4; q++)
-          if (nd->bv[q] != 0.0) th += c[nd->bi + q] * nd->bv[q];
-        double cs = cos(th), sn = sin(th);
+        double cs, sn;
+        if (it == 0) {
+          double th = theta0 + al * nd->ta + be * nd->tb;
+          for (int q = 0; q < 4; q++)
+            if (nd->bv[q] != 0.0) th += c[nd->bi + q] * nd->bv[q];
+          cs = cos(th);
+          sn = sin(th);
+        } else {
+          double d = 0.0, dx, dy;
+          for (int q = 0; q < 4; q++)
+            if (nd->bv[q] != 0.0) d += dc[nd->bi + q] * nd->bv[q];
+          exp_i_small(d, &dx, &dy);
+          cs = e[2 * j] * dx - e[2 * j + 1] * dy;
+          sn = e[2 * j] * dy + e[2 * j + 1] * dx;
+        }
+        e[2 * j] = cs;
+        e[2 * j + 1] = sn;
         sx += nd->w * cs;
         sy += nd->w * sn;
         if (close_lsq)
@@ -596,8 +628,11 @@ static km_status close_frame(const km__frame_plan *p, double t, double theta0,
         for (int i = 0; i < NF; i++) rhs[r] += J[r][i] * c[i];
     }
     if (!km__solve_dense(S, rhs, 2)) return KM_ENOCONVERGE;
-    for (int i = 0; i < NF; i++)
-      c[i] = (project ? 0.0 : c[i]) + Y[0][i] * rhs[0] + Y[1][i] * rhs[1];
+    for (int i = 0; i < NF; i++) {
+      double ci = (project ? 0.0 : c[i]) + Y[0][i] * rhs[0] + Y[1][i] * rhs[1];
+      dc[i] = ci - c[i];
+      c[i] = ci;
+    }
   }
 }
 
@@ -611,9 +646,9 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t,
   double c[NF] = {0};
   if (close_lsq && p->closed)
     for (int i = 0; i < NF; i++) c[i] = 4 * t * (1 - t) * p->c_half[i];
-  double *sum = malloc(2 * np * sizeof(double));
+  double *sum = malloc(2 * (np + p->nn) * sizeof(double));
   if (!sum) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
-  km_status st = close_frame(p, t, theta0, close_lsq, c, sum);
+  km_status st = close_frame(p, t, theta0, close_lsq, c, sum, sum + 2 * np);
   if (st) {
     free(sum);
     return km__fail(err, st, KM_FIELD_NONE, -1, NAN,
