@@ -336,6 +336,41 @@ static void pair(ctx *x, const seg *A, const seg *B, int depth) {
   }
 }
 
+/* Sign of a sub-curve's travel in x and in y (from its first control
+ * point to its last; 0 if none). */
+static void travel(const seg *s, int p, int sg[2]) {
+  double a[2], b[2];
+  cart(s->h[0], a);
+  cart(s->h[p], b);
+  for (int k = 0; k < 2; k++) sg[k] = (b[k] > a[k]) - (b[k] < a[k]);
+}
+
+/* Two sub-curves that follow each other along the curve (A's end is B's
+ * start) and travel the same way in x and in y cannot meet anywhere else:
+ * A lies in the box from its start to the shared point, B in the box from
+ * there on, and the boxes touch only at that point. Subdividing toward the
+ * shared end would otherwise cost some forty levels a pair. */
+static bool consecutive_same_way(const ctx *x, const seg *A, const seg *B) {
+  size_t last = (x->bz->n - 1) / (size_t)x->p - 1;
+  const seg *f = NULL, *g = NULL;
+  for (int k = 0; k < 2 && !f; k++) {
+    const seg *u = k ? B : A, *v = k ? A : B;
+    bool same = u->piece == v->piece && u->u1 == v->u0;
+    bool next = u->u1 == 1.0 && v->u0 == 0.0 &&
+                (v->piece == u->piece + 1 ||
+                 (x->closed && u->piece == last && v->piece == 0));
+    if (same || next) {
+      f = u;
+      g = v;
+    }
+  }
+  if (!f) return false;
+  int sf[2], sg[2];
+  travel(f, x->p, sf);
+  travel(g, x->p, sg);
+  return sf[0] != 0 && sf[1] != 0 && sf[0] == sg[0] && sf[1] == sg[1];
+}
+
 static int by_xmin(const void *a, const void *b) {
   double u = ((const seg *)a)->xmin, v = ((const seg *)b)->xmin;
   return (u > v) - (u < v);
@@ -396,6 +431,7 @@ long km_curve_self_intersections(const km_curve *c, double tol) {
   for (size_t i = 0; i < x.nseg && !x.oom; i++)
     for (size_t j = i + 1; j < x.nseg && !x.oom; j++) {
       if (x.segs[j].xmin > x.segs[i].xmax + x.tol) break;
+      if (consecutive_same_way(&x, &x.segs[i], &x.segs[j])) continue;
       pair(&x, &x.segs[i], &x.segs[j], 0);
     }
   if (x.oom) goto cleanup;

@@ -240,6 +240,8 @@ typedef struct atom {
   double m4;    /* max |C''''(r)| / L over the atom */
   double j2, j3; /* jumps of C'', C''' (over L) at x0, bounds for every t */
   bool corner;  /* theta jumps at x0 */
+  size_t iv;    /* merged interval it lies in */
+  bool whole;   /* it is the whole interval */
 } atom;
 
 typedef struct vec {
@@ -273,13 +275,13 @@ static void both_bounds(const side sd[2], double r0, double r1, int nd,
   for (int j = 1; j <= nd; j++) D[j] = fmax(Da[j], Db[j]);
 }
 
-/* Atoms of the merged interval [r0, r1], split until each meets tolp
- * (relative to L: tolerances here are over max(La, Lb)). */
+/* Atoms of merged interval iv = [r0, r1] (derivative bounds D), split
+ * until each meets tolp (relative to L: tolerances here are over
+ * max(La, Lb)). */
 static km_status plan_interval(vec *atoms, const side sd[2], double r0,
-                               double r1, double tolp, double j2, double j3,
+                               double r1, size_t iv, const double *D,
+                               double tolp, double j2, double j3,
                                bool corner) {
-  double D[4];
-  both_bounds(sd, r0, r1, 3, D);
   double h = r1 - r0, e = pow(h, 4) / 384.0 * m4_of(D);
   int parts = 1;
   if (e > tolp) {
@@ -288,7 +290,8 @@ static km_status plan_interval(vec *atoms, const side sd[2], double r0,
   }
   for (int k = 0; k < parts; k++) {
     double a = r0 + h * k / parts, b = k + 1 == parts ? r1 : r0 + h * (k + 1) / parts;
-    atom at = {a, b, 0.0, k ? 0.0 : j2, k ? 0.0 : j3, k ? false : corner};
+    atom at = {a, b, 0.0, k ? 0.0 : j2, k ? 0.0 : j3, k ? false : corner, iv,
+               parts == 1};
     double Dk[4];
     if (parts > 1)
       both_bounds(sd, a, b, 3, Dk);
@@ -328,7 +331,7 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp kappa[2],
                                const double angle[2], bool closed, double tol,
                                km_error *err) {
   km_status st = KM_OK;
-  double *br = NULL;
+  double *br = NULL, *Dall = NULL;
   vec atoms = {NULL, 0, 0, sizeof(atom)}, nodes = {NULL, 0, 0, sizeof(gnode)};
   gl_rules *g = malloc(sizeof *g);
   km__frame_plan *p = calloc(1, sizeof *p);
@@ -378,14 +381,22 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp kappa[2],
     st = KM_EDEGENERATE;
     goto fail;
   }
+  /* bounds on theta's derivatives over every merged interval (once: the
+   * planning and the quadrature both use them) */
+  Dall = malloc((m - 1) * (NDER + 1) * sizeof(double));
+  if (!Dall) {
+    st = KM_ENOMEM;
+    goto fail;
+  }
+  for (size_t i = 0; i + 1 < m; i++)
+    both_bounds(sd, br[i], br[i + 1], NDER, Dall + i * (NDER + 1));
   /* atoms; jumps and corners at the merged breaks */
   double tolp = 0.5 * tol / Lmax;
   for (size_t i = 0; i + 1 < m; i++) {
     double j2 = 0.0, j3 = 0.0;
     bool corner = false;
     if (i > 0) {
-      double D[2];
-      both_bounds(sd, br[i - 1], br[i + 1], 1, D);
+      double D1 = fmax(Dall[(i - 1) * (NDER + 1) + 1], Dall[i * (NDER + 1) + 1]);
       for (int w = 0; w < 2; w++) {
         double vl[3], vr[3];
         side_eval(&sd[w], br[i], -1, vl);
@@ -393,10 +404,11 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp kappa[2],
         if (fabs(vr[0] - vl[0]) > 1e-12) corner = true;
         double d1 = fabs(vr[1] - vl[1]), d2 = fabs(vr[2] - vl[2]);
         j2 = fmax(j2, d1);
-        j3 = fmax(j3, d2 + d1 * 2 * D[1]);
+        j3 = fmax(j3, d2 + d1 * 2 * D1);
       }
     }
-    st = plan_interval(&atoms, sd, br[i], br[i + 1], tolp, j2, j3, corner);
+    st = plan_interval(&atoms, sd, br[i], br[i + 1], i, Dall + i * (NDER + 1),
+                       tolp, j2, j3, corner);
     if (st) goto fail;
   }
   /* merge atoms greedily into output pieces while the bound holds */
@@ -451,8 +463,12 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp kappa[2],
     p->first[k] = nodes.n;
     for (size_t ai = start[k]; ai < start[k + 1] && !st; ai++) {
       double a = A[ai].x0, b = A[ai].x1;
-      double D[NDER + 1], B[NDER + 1], Dh[NDER + 1];
-      both_bounds(sd, a, b, NDER, D);
+      double Dpart[NDER + 1], B[NDER + 1], Dh[NDER + 1];
+      const double *D = Dpart;
+      if (A[ai].whole)
+        D = Dall + A[ai].iv * (NDER + 1);
+      else
+        both_bounds(sd, a, b, NDER, Dpart);
       /* lowest order, then halving, whose bound meets tolq per unit r */
       int chunks = 1, n = 2;
       for (;;) {
@@ -520,6 +536,7 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp kappa[2],
   }
   free(atoms.p);
   free(br);
+  free(Dall);
   free(g);
   *out = p;
   return KM_OK;
@@ -527,6 +544,7 @@ fail:
   free(atoms.p);
   free(nodes.p);
   free(br);
+  free(Dall);
   free(g);
   km__frame_plan_free(p);
   return km__fail(err, st, KM_FIELD_TOLERANCE, -1, NAN,
