@@ -207,8 +207,12 @@ static void side_bounds(const side *sd, double r0, double r1, int nd,
 /* theta (less the start angle), d theta/dr and d2 theta/dr2 at r, from the
  * piece on the left (side < 0) or the right of r. */
 static void side_eval(const side *sd, double r, int side_dir, double v[3]) {
-  size_t i = km__pp_find(sd->theta, r * sd->L);
-  if (side_dir < 0 && i > 0 && sd->theta->x[i] >= r * sd->L) i--;
+  /* r comes from a break of one input divided by its length: times the
+   * length it may miss that break by a rounding unit either way */
+  double x = r * sd->L, eps = 1e-12 * sd->L;
+  size_t i = km__pp_find(sd->theta, x);
+  if (side_dir > 0 && i + 1 < sd->theta->m && x >= sd->theta->x[i + 1] - eps) i++;
+  if (side_dir < 0 && i > 0 && x <= sd->theta->x[i] + eps) i--;
   double a = sd->theta->x[i], h = sd->theta->x[i + 1] - a;
   double u = fmin(fmax((r * sd->L - a) / h, 0.0), 1.0);
   int dt = sd->theta->degree, dk = sd->kappa->degree;

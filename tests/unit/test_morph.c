@@ -361,6 +361,66 @@ static void spiral_end_frames_are_the_exact_spirals(void **state) {
   km_signature_free(&sb);
 }
 
+/* Frames without metrics or signature (the service's default answer) are
+ * built from a plan made once per morph (core/src/morph_plan.c). With
+ * equal lengths the turning blend of the spirals is exactly
+ *   theta_t(s) = theta0 + ((1 - t) / 2 - t / 4) s^2,
+ * and with anchor start the frame starts at the blended start point: the
+ * planned frame must lie within the tolerance of that curve, point by
+ * point in arc length. */
+typedef struct blended_spiral {
+  double th0, c2;
+} blended_spiral;
+
+static double blended_spiral_cos(double s, const void *p) {
+  const blended_spiral *b = p;
+  return cos(b->th0 + b->c2 * s * s);
+}
+
+static double blended_spiral_sin(double s, const void *p) {
+  const blended_spiral *b = p;
+  return sin(b->th0 + b->c2 * s * s);
+}
+
+static void planned_spiral_frames_are_the_exact_blended_spirals(void **state) {
+  (void)state;
+  km_signature sa, sb;
+  spiral_inputs(&sa, &sb);
+  km_morph_input A = {NULL, &sa}, B = {NULL, &sb};
+  km_morph_options o;
+  km_morph_options_default(&o);
+  o.anchor = KM_ANCHOR_START;
+  km_morph *m = morph_new(&A, &B, &o);
+  const double tol = 1e-5 * 4.0;
+  double phia = sa.angle, phib = phia + tu_wrap(sb.angle - phia);
+  for (int i = 0; i <= 8; i++) {
+    double t = i / 8.0;
+    km_curve c;
+    km_error err;
+    assert_status(km_morph_frame(m, t, &c, NULL, NULL, &err), KM_OK);
+    double t0, t1;
+    km_curve_domain(&c, &t0, &t1);
+    assert_close(t1 - t0, 4.0, 1e-12);
+    blended_spiral bs = {(1 - t) * phia + t * phib, (1 - t) / 2 - t / 4};
+    double worst = 0.0;
+    for (int j = 0; j <= 80; j++) {
+      double s = 4.0 * j / 80, q[1][2];
+      double x = (1 - t) * sa.start[0] + t * sb.start[0] +
+                 tu_integrate(blended_spiral_cos, &bs, 0.0, s, 8);
+      double y = (1 - t) * sa.start[1] + t * sb.start[1] +
+                 tu_integrate(blended_spiral_sin, &bs, 0.0, s, 8);
+      km_curve_eval(&c, t0 + s, 0, q);
+      worst = fmax(worst, hypot(q[0][0] - x, q[0][1] - y));
+    }
+    if (worst > tol) print_error("t = %g: %.3g from the exact frame\n", t, worst);
+    assert_le(worst, tol);
+    km_curve_free(&c);
+  }
+  km_morph_free(m);
+  km_signature_free(&sa);
+  km_signature_free(&sb);
+}
+
 /* ---- random pairs -------------------------------------------------------- */
 
 /* A random open pl_signature of length L: nc coefficients in [-kmax, kmax]
@@ -1135,6 +1195,7 @@ int main(void) {
       cmocka_unit_test(spiral_curvature_frames_never_exceed_the_inputs_curvature),
       cmocka_unit_test(spiral_linear_baseline_exceeds_the_inputs_curvature),
       cmocka_unit_test(spiral_end_frames_are_the_exact_spirals),
+      cmocka_unit_test(planned_spiral_frames_are_the_exact_blended_spirals),
       cmocka_unit_test(curvature_bound_holds_for_random_pairs_and_matches),
       cmocka_unit_test(curvature_bound_holds_for_curve_inputs),
       cmocka_unit_test(every_frame_has_the_interpolated_length),

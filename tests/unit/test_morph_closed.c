@@ -786,6 +786,160 @@ static void fixture_pairs_default_frames_do_not_self_intersect(void **state) {
   assert_int_equal(failures, 0);
 }
 
+/* ---- planned frames --------------------------------------------------------
+ * Frames asked for without metrics or signature (the service's default)
+ * come from a plan made once per morph (core/src/morph_plan.c) rather than
+ * from a blended signature: the same promises must hold for them. */
+
+static void planned_frame(const km_morph *m, double t, km_curve *c) {
+  km_error err;
+  km_status st = km_morph_frame(m, t, c, NULL, NULL, &err);
+  if (st != KM_OK) print_error("km_morph_frame(t = %g): %s\n", t, err.message);
+  assert_status(st, KM_OK);
+}
+
+static void planned_frames_of_circles_are_circles(void **state) {
+  (void)state;
+  km_signature s1, s2;
+  circle_signature(&s1, 1.0);
+  circle_signature(&s2, 2.0);
+  km_morph_input A = {NULL, &s1}, B = {NULL, &s2};
+  km_morph_options o;
+  km_morph_options_default(&o);
+  km_morph *m = morph_new(&A, &B, &o);
+  const double tol = 1e-5 * 4 * M_PI;
+  for (int i = 0; i <= 8; i++) {
+    double t = i / 8.0, r = (1 - t) + 2 * t, t0, t1, c[2];
+    km_curve f;
+    planned_frame(m, t, &f);
+    assert_true(f.closed);
+    km_curve_domain(&f, &t0, &t1);
+    assert_rel(t1 - t0, 2 * M_PI * r, 1e-12);
+    curve_centroid(&f, c);
+    size_t np;
+    double *P = curve_points(&f, 50, &np);
+    for (size_t k = 0; k < np; k++)
+      assert_close(hypot(P[2 * k] - c[0], P[2 * k + 1] - c[1]), r, 2 * tol);
+    free(P);
+    km_curve_free(&f);
+  }
+  km_morph_free(m);
+  km_signature_free(&s1);
+  km_signature_free(&s2);
+}
+
+/* With the default options every planned frame of the fixture pairs is
+ * closed (turning at the seam only by the inputs' seam corners), has
+ * length L_t, does not cross itself, and frames 0 and 1 are the inputs
+ * where they stand. */
+static void planned_default_frames_of_the_fixture_pairs(void **state) {
+  (void)state;
+  long failures = 0;
+  for (int p = 0; p < 6; p++) {
+    km_curve a, b;
+    shape_curve(PAIRS[p], 'a', &a);
+    shape_curve(PAIRS[p], 'b', &b);
+    km_morph_input A = {&a, NULL}, B = {&b, NULL};
+    km_morph_options o;
+    km_morph_options_default(&o);
+    km_morph *m = morph_new(&A, &B, &o);
+    double len[2], turning[2];
+    km_morph_inputs(m, len, turning);
+    double tol = 1e-5 * fmax(len[0], len[1]);
+    for (int i = 0; i <= 20; i++) {
+      double t = i / 20.0, Lt = (1 - t) * len[0] + t * len[1], t0, t1;
+      km_curve f;
+      planned_frame(m, t, &f);
+      km_curve_domain(&f, &t0, &t1);
+      assert_rel(t1 - t0, Lt, 1e-12);
+      assert_int_equal(f.closed, a.closed);
+      if (f.closed) {
+        /* closed, and the seam turns as the reconstructed frame's (by
+         * the inputs' seam corners, blended; else not at all) */
+        double p0[2], p1[2], a0, a1, k0, k1, q0[2], q1[2], b0, b1;
+        seam_side(&f, 1, p0, &a0, &k0);
+        seam_side(&f, -1, p1, &a1, &k1);
+        assert_close(hypot(p1[0] - p0[0], p1[1] - p0[1]), 0.0, 1e-12 * Lt);
+        frame g;
+        frame_get(m, t, &g);
+        seam_side(&g.c, 1, q0, &b0, &k0);
+        seam_side(&g.c, -1, q1, &b1, &k1);
+        assert_close(tu_wrap(a0 - a1), tu_wrap(b0 - b1), 1e-6);
+        frame_free(&g);
+      }
+      long n = km_curve_self_intersections(&f, tol);
+      long poly = polyline_crossings(&f, 6000);
+      if (n != 0 || poly != 0) {
+        print_error("%s: planned frame t = %g crosses itself %ld times (its "
+                    "dense polyline %ld times)\n", PAIRS[p], t, n, poly);
+        failures++;
+      }
+      if (i == 0 || i == 20) {
+        size_t nf, ni;
+        double *F = curve_points(&f, 20, &nf);
+        double *I = curve_points(i == 0 ? &a : &b, 60, &ni);
+        double d = directed_dist(F, nf, I, ni);
+        if (d > 2 * tol)
+          print_error("%s: planned frame t = %g is %.3g from its input\n",
+                      PAIRS[p], t, d);
+        assert_le(d, 2 * tol);
+        free(F);
+        free(I);
+      }
+      km_curve_free(&f);
+    }
+    km_morph_free(m);
+    km_curve_free(&a);
+    km_curve_free(&b);
+  }
+  assert_int_equal(failures, 0);
+}
+
+/* Planned and blended-and-reconstructed frames are both within the
+ * tolerance of the same exact frame, so within twice of each other (anchor
+ * start and closure none: both then place and close nothing of their own,
+ * and arc length is the parameter of both). */
+static void planned_and_reconstructed_frames_agree(void **state) {
+  (void)state;
+  for (int p = 0; p < 6; p++) {
+    km_curve a, b;
+    shape_curve(PAIRS[p], 'a', &a);
+    shape_curve(PAIRS[p], 'b', &b);
+    km_morph_input A = {&a, NULL}, B = {&b, NULL};
+    km_morph_options o;
+    km_morph_options_default(&o);
+    o.anchor = KM_ANCHOR_START;
+    o.closure = KM_CLOSURE_NONE;
+    km_morph *m = morph_new(&A, &B, &o);
+    double len[2], turning[2];
+    km_morph_inputs(m, len, turning);
+    double tol = 1e-5 * fmax(len[0], len[1]);
+    for (int i = 1; i <= 3; i++) {
+      double t = i / 4.0, t0, t1, worst = 0.0;
+      km_curve f;
+      frame g;
+      planned_frame(m, t, &f);
+      frame_get(m, t, &g);
+      km_curve_domain(&f, &t0, &t1);
+      for (int j = 0; j <= 400; j++) {
+        double s = (t1 - t0) * j / 400, q[1][2], r[1][2];
+        km_curve_eval(&f, t0 + s, 0, q);
+        km_curve_eval(&g.c, s, 0, r);
+        worst = fmax(worst, hypot(q[0][0] - r[0][0], q[0][1] - r[0][1]));
+      }
+      if (worst > 2 * tol)
+        print_error("%s, t = %g: planned and reconstructed frames %.3g apart "
+                    "(tolerance %.3g)\n", PAIRS[p], t, worst, tol);
+      assert_le(worst, 2 * tol);
+      km_curve_free(&f);
+      frame_free(&g);
+    }
+    km_morph_free(m);
+    km_curve_free(&a);
+    km_curve_free(&b);
+  }
+}
+
 /* arrow_rot90: the same polygon turned by 90 degrees. The curvature morph
  * of congruent shapes keeps the shape: every frame has the input's
  * curvature and corners (after the start is aligned). */
@@ -880,6 +1034,9 @@ int main(void) {
       cmocka_unit_test(fixture_pairs_end_frames_length_and_closure),
       cmocka_unit_test(fixture_pairs_with_auto_matches_degree_5_and_linear),
       cmocka_unit_test(fixture_pairs_default_frames_do_not_self_intersect),
+      cmocka_unit_test(planned_frames_of_circles_are_circles),
+      cmocka_unit_test(planned_default_frames_of_the_fixture_pairs),
+      cmocka_unit_test(planned_and_reconstructed_frames_agree),
       cmocka_unit_test(congruent_shapes_morph_through_congruent_frames),
       cmocka_unit_test(a_curve_looping_twice_is_rejected_against_a_circle),
   };
