@@ -118,7 +118,8 @@ static double bspline3(double u) {
   return v * v * v / 6.0;
 }
 
-/* The closure basis at r: first index and four values. */
+/* The closure basis at r: first index (-3 .. NF - 1) and four values,
+ * zero for indices outside 0 .. NF - 1. */
 static void basis_at(double r, int *bi, double bv[4]) {
   double u = r * NB;
   int iv = (int)floor(u);
@@ -586,47 +587,53 @@ static km_status close_frame(const km__frame_plan *p, double t, double theta0,
                              double *e) {
   double Lt = (1 - t) * p->La + t * p->Lb, al = 1 - t, be = t;
   size_t np = p->np;
-  double dc[NF];
+  bool lsq = close_lsq && p->closed;
+  /* coefficients padded by three zeros each side, so that every node reads
+   * its four basis functions without a test (see basis_at) */
+  double cp[NF + 6] = {0}, dcp[NF + 6] = {0}, dc[NF];
+  memcpy(cp + 3, c, sizeof dc);
   for (int it = 0;; it++) {
-    double G[2] = {0, 0}, J[2][NF];
-    memset(J, 0, sizeof J);
+    double G[2] = {0, 0}, J[2][NF], Jp[2][NF + 6];
+    memset(Jp, 0, sizeof Jp);
     for (size_t k = 0; k < np; k++) {
       double sx = 0.0, sy = 0.0;
       for (size_t j = p->first[k]; j < p->first[k + 1]; j++) {
         const gnode *nd = &p->node[j];
+        const double *bv = nd->bv;
+        int o = nd->bi + 3;
         double cs, sn;
         if (it == 0) {
-          double th = theta0 + al * nd->ta + be * nd->tb;
-          for (int q = 0; q < 4; q++)
-            if (nd->bv[q] != 0.0) th += c[nd->bi + q] * nd->bv[q];
+          double th = theta0 + al * nd->ta + be * nd->tb + cp[o] * bv[0] +
+                      cp[o + 1] * bv[1] + cp[o + 2] * bv[2] + cp[o + 3] * bv[3];
           cs = cos(th);
           sn = sin(th);
         } else {
-          double d = 0.0, dx, dy;
-          for (int q = 0; q < 4; q++)
-            if (nd->bv[q] != 0.0) d += dc[nd->bi + q] * nd->bv[q];
+          double d = dcp[o] * bv[0] + dcp[o + 1] * bv[1] + dcp[o + 2] * bv[2] +
+                     dcp[o + 3] * bv[3];
+          double dx, dy;
           exp_i_small(d, &dx, &dy);
           cs = e[2 * j] * dx - e[2 * j + 1] * dy;
           sn = e[2 * j] * dy + e[2 * j + 1] * dx;
         }
         e[2 * j] = cs;
         e[2 * j + 1] = sn;
-        sx += nd->w * cs;
-        sy += nd->w * sn;
-        if (close_lsq)
-          for (int q = 0; q < 4; q++)
-            if (nd->bv[q] != 0.0) {
-              J[0][nd->bi + q] -= nd->w * sn * nd->bv[q];
-              J[1][nd->bi + q] += nd->w * cs * nd->bv[q];
-            }
+        double wc = nd->w * cs, ws = nd->w * sn;
+        sx += wc;
+        sy += ws;
+        if (lsq)
+          for (int q = 0; q < 4; q++) {
+            Jp[0][o + q] -= ws * bv[q];
+            Jp[1][o + q] += wc * bv[q];
+          }
       }
       sum[2 * k] = sx;
       sum[2 * k + 1] = sy;
       G[0] += sx;
       G[1] += sy;
     }
+    for (int r = 0; r < 2; r++) memcpy(J[r], Jp[r] + 3, sizeof J[r]);
     double gap = Lt * hypot(G[0], G[1]);
-    if (!close_lsq || !p->closed || gap <= 1e-11 * Lt) return KM_OK;
+    if (!lsq || gap <= 1e-11 * Lt) return KM_OK;
     if (it == 40) return KM_ENOCONVERGE;
     /* Gauss-Newton in the metric: the first steps project, c = M^-1 J^T
      * lambda with J c = J c_old - G (the minimum-norm point of the
@@ -655,6 +662,7 @@ static km_status close_frame(const km__frame_plan *p, double t, double theta0,
       dc[i] = ci - c[i];
       c[i] = ci;
     }
+    memcpy(dcp + 3, dc, sizeof dc);
   }
 }
 
