@@ -78,6 +78,11 @@ bool km__solve_dense(double *A, double *y, int n);
 void km__bernstein_basis(double u, int d, double *row);
 /* qsort comparison of doubles. */
 int km__cmp_double(const void *a, const void *b);
+/* Discrete Fourier transform of n = 2^k complex values in place (X_m = sum
+ * x_j e^(-2 pi i j m / n); inverse: with e^(+...) and divided by n), with
+ * the n/2 twiddles e^(-2 pi i k / n) from km__fft_twiddles (2 per k). */
+void km__fft_twiddles(int n, double *tw);
+void km__fft(double *re, double *im, int n, const double *tw, bool inverse);
 
 /* Wrap an angle to (-pi, pi]. */
 double km__wrap_angle(double a);

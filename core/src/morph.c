@@ -354,41 +354,75 @@ static km_status reverse_input(input *in, double tol, km_error *err) {
 #define SHIFT_CANDIDATES 4
 
 /* Fills cand[] with up to SHIFT_CANDIDATES shifts, best first: the
- * deepest local minima of the cost over all shifts. Returns the count. */
+ * deepest local minima of the cost over all shifts. Returns the count.
+ * The cost of shift k,
+ *   sum_j (d_j - mean d)^2 + |pa_j - pb_(j+k)|^2,  d_j = ta_j - tb'_(j+k)
+ * (tb' continued by the total turning past the end), expands into sums of
+ * squares, prefix sums and the cyclic correlations sum_j ta_j tb_(j+k) and
+ * sum_j pa_j . pb_(j+k), which the FFT gives for all k at once. */
 static size_t best_shifts(const input *a, const input *b, double *cand) {
   static const int N = ALIGN_N;
-  double *buf = malloc(7 * (size_t)N * sizeof(double));
+  double *buf = malloc(14 * (size_t)N * sizeof(double));
   if (!buf) {
     cand[0] = 0.0;
     return 1;
   }
-  double *ta = buf, *tb = buf + N, *pa = buf + 2 * N, *pb = buf + 4 * N;
-  double *cost = buf + 6 * N;
+  double *ta = buf, *tb = buf + N, *cost = buf + 2 * N, *tw = buf + 3 * N;
+  double *ar = buf + 4 * N, *ai = buf + 5 * N, *br = buf + 6 * N, *bi = buf + 7 * N;
+  double *xr = buf + 8 * N, *xi = buf + 9 * N, *yr = buf + 10 * N, *yi = buf + 11 * N;
+  double *suffix_a = buf + 12 * N, *prefix_b = buf + 13 * N;
   double La = a->sig.length, Lb = b->sig.length;
   double R = 0.5 * (La + Lb) / (2 * KM_PI);
+  double sa = 0.0, sb = 0.0, saa = 0.0, sbb = 0.0, spa = 0.0, spb = 0.0;
   for (int j = 0; j < N; j++) {
     double r = (j + 0.5) / N, q[2];
     ta[j] = theta_at(a, La * r);
     tb[j] = theta_at(b, Lb * r);
     table_at(a, r, q);
-    pa[2 * j] = (q[0] - a->centroid[0]) / R;
-    pa[2 * j + 1] = (q[1] - a->centroid[1]) / R;
+    xr[j] = (q[0] - a->centroid[0]) / R;
+    xi[j] = (q[1] - a->centroid[1]) / R;
     table_at(b, r, q);
-    pb[2 * j] = (q[0] - b->centroid[0]) / R;
-    pb[2 * j + 1] = (q[1] - b->centroid[1]) / R;
+    yr[j] = (q[0] - b->centroid[0]) / R;
+    yi[j] = (q[1] - b->centroid[1]) / R;
+    ar[j] = ta[j];
+    br[j] = tb[j];
+    ai[j] = bi[j] = 0.0;
+    sa += ta[j];
+    sb += tb[j];
+    saa += ta[j] * ta[j];
+    sbb += tb[j] * tb[j];
+    spa += xr[j] * xr[j] + xi[j] * xi[j];
+    spb += yr[j] * yr[j] + yi[j] * yi[j];
   }
-  double total_b = b->sig.turning;
+  suffix_a[0] = 0.0; /* suffix_a[k]: sum of the last k of ta */
+  prefix_b[0] = 0.0; /* prefix_b[k]: sum of the first k of tb */
+  for (int k = 1; k < N; k++) {
+    suffix_a[k] = suffix_a[k - 1] + ta[N - k];
+    prefix_b[k] = prefix_b[k - 1] + tb[k - 1];
+  }
+  /* correlations: IFFT(conj(FFT u) FFT v)[k] = sum_j conj(u_j) v_(j+k) */
+  km__fft_twiddles(N, tw);
+  km__fft(ar, ai, N, tw, false);
+  km__fft(br, bi, N, tw, false);
+  km__fft(xr, xi, N, tw, false);
+  km__fft(yr, yi, N, tw, false);
+  for (int m = 0; m < N; m++) {
+    double r1 = ar[m] * br[m] + ai[m] * bi[m], i1 = ar[m] * bi[m] - ai[m] * br[m];
+    double r2 = xr[m] * yr[m] + xi[m] * yi[m], i2 = xr[m] * yi[m] - xi[m] * yr[m];
+    ar[m] = r1;
+    ai[m] = i1;
+    xr[m] = r2;
+    xi[m] = i2;
+  }
+  km__fft(ar, ai, N, tw, true); /* ar[k] = sum_j ta_j tb_(j+k) */
+  km__fft(xr, xi, N, tw, true); /* xr[k] = sum_j pa_j . pb_(j+k) */
+  double T = b->sig.turning;
   for (int k = 0; k < N; k++) {
-    double sum = 0.0, sum2 = 0.0, pos = 0.0;
-    for (int j = 0; j < N; j++) {
-      int q = j + k < N ? j + k : j + k - N;
-      double v = j + k < N ? tb[q] : tb[q] + total_b;
-      double d = ta[j] - v;
-      sum += d;
-      sum2 += d * d;
-      double dx = pa[2 * j] - pb[2 * q], dy = pa[2 * j + 1] - pb[2 * q + 1];
-      pos += dx * dx + dy * dy;
-    }
+    double sum = sa - sb - T * k;
+    double cross = ar[k] + T * suffix_a[k];
+    double vv = sbb + 2 * T * prefix_b[k] + k * T * T;
+    double sum2 = saa - 2 * cross + vv;
+    double pos = spa + spb - 2 * xr[k];
     cost[k] = sum2 - sum * sum / N + pos;
   }
   /* local minima, deepest first; the given start wins ties */
