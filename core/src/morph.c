@@ -48,7 +48,8 @@
 
 #define TABLE_N 512   /* samples per input for placement targets */
 #define FIT_N 256     /* frame samples for the Procrustes fit */
-#define ALIGN_N 512   /* samples of theta for start alignment */
+#define ALIGN_N TABLE_N /* samples of theta for start alignment: its shifts
+                          * then land on table points (see rotate_start) */
 #define LSQ_INTERVALS KM__CLOSURE_INTERVALS
 
 void km_morph_options_default(km_morph_options *o) {
@@ -136,12 +137,13 @@ static void table_step(const double *tc, int d, double h, double u0,
   out[1] = sy * 0.5 * du * h;
 }
 
-/* theta pieces, position table and centroid of an input's signature */
-static km_status input_tables(input *in) {
+/* theta pieces, and unless keep_table the position table and centroid, of
+ * an input's signature */
+static km_status input_tables(input *in, bool keep_table) {
   km__pp_free(&in->kappa);
   km__pp_free(&in->theta);
   km_status st = km__build_theta(&in->sig, &in->kappa, &in->theta);
-  if (st) return st;
+  if (st || keep_table) return st;
   double L = in->sig.length;
   int dk = in->kappa.degree, dt = dk + 1;
   double x = in->sig.start[0], y = in->sig.start[1];
@@ -208,7 +210,7 @@ static km_status recompute_sig(input *in, double tol, km_error *err) {
   if (st) return st;
   km_signature_free(&in->sig);
   in->sig = s;
-  return input_tables(in);
+  return input_tables(in, false);
 }
 
 static km_status pp_slice(km_pp *out, const km_pp *p, double x0, double x1);
@@ -331,7 +333,22 @@ static km_status rotate_start(input *in, double s0, km_error *err) {
   if (st) return st;
   km_signature_free(&in->sig);
   in->sig = r;
-  return input_tables(in);
+  /* a start on a table point (the alignment's shifts are) turns the table
+   * cyclically: the same points of the same curve */
+  double steps = s0 / L * TABLE_N;
+  long k = lround(steps);
+  bool on_table = fabs(steps - (double)k) < 1e-9 && k > 0 && k < TABLE_N;
+  if (on_table) {
+    double old[TABLE_N][2];
+    memcpy(old, in->table, sizeof old);
+    for (int j = 0; j < TABLE_N; j++) {
+      in->table[j][0] = old[(j + k) % TABLE_N][0];
+      in->table[j][1] = old[(j + k) % TABLE_N][1];
+    }
+    in->table[TABLE_N][0] = in->table[0][0];
+    in->table[TABLE_N][1] = in->table[0][1];
+  }
+  return input_tables(in, on_table);
 }
 
 static km_status reverse_input(input *in, double tol, km_error *err) {
@@ -589,7 +606,7 @@ static km_status prepare_input(input *in, const km_morph_input *src,
   else
     st = km__fail(err, KM_EINVAL, KM_FIELD_NONE, -1, NAN, "missing input");
   if (st) return st;
-  return input_tables(in);
+  return input_tables(in, false);
 }
 
 /* Frames of the default morph (turning blend, no matches, cubic output)
