@@ -82,6 +82,7 @@ struct km_morph {
   size_t nuser;    /* match pairs reported */
   km_curve lin[2]; /* compatible curves (linear method) */
   km__frame_plan *plan; /* frames planned once (morph_plan.c), or NULL */
+  bool close_by_corners; /* lsq closure by the frames' corners */
 };
 
 static void input_free(input *in) {
@@ -612,16 +613,52 @@ static km_status prepare_input(input *in, const km_morph_input *src,
 /* Frames of the default morph (turning blend, no matches, cubic output)
  * are planned once: see morph_plan.c. Others are blended piece by piece
  * and reconstructed frame by frame. */
+static km_status blend_signature(const km_morph *m, double t,
+                                 km_signature *out, km_error *err);
+static km_status close_lsq(const km_signature *sig, bool by_corners,
+                           km_signature *out, double *gap0, bool *used_corners,
+                           km_error *err);
+
+/* Whether the lsq closure goes by the frames' corners: so if it can at
+ * t = 1/4, 1/2 and 3/4, for every frame of the morph (a sequence must not
+ * switch between closures). */
+static bool corners_close(const km_morph *m) {
+  for (int k = 1; k <= 3; k++) {
+    km_signature blended, closed;
+    km_signature_init(&blended);
+    km_signature_init(&closed);
+    double gap;
+    bool used = false;
+    bool ok = blend_signature(m, k / 4.0, &blended, NULL) == KM_OK &&
+              close_lsq(&blended, true, &closed, &gap, &used, NULL) == KM_OK;
+    km_signature_free(&blended);
+    km_signature_free(&closed);
+    if (!ok || !used) return false;
+  }
+  return true;
+}
+
+/* Frames of the default morph (turning blend, no matches, cubic output)
+ * are planned once: see morph_plan.c. Others are blended piece by piece
+ * and reconstructed frame by frame. Either way the kind of closure is
+ * chosen here, once. */
 static km_status plan_frames(km_morph *m, km_error *err) {
   const input *a = &m->in[0], *b = &m->in[1];
-  if (m->opt.method != KM_METHOD_CURVATURE || m->opt.blend != KM_BLEND_TURNING ||
-      m->nk != 2 || m->opt.degree != 3)
+  km_closure how = m->opt.closure == KM_CLOSURE_AUTO ? KM_CLOSURE_LSQ : m->opt.closure;
+  bool lsq = m->closed && how == KM_CLOSURE_LSQ;
+  if (m->opt.method != KM_METHOD_CURVATURE) return KM_OK;
+  if (m->opt.blend != KM_BLEND_TURNING || m->nk != 2 || m->opt.degree != 3) {
+    bool corners = a->sig.ncorners + b->sig.ncorners > 0;
+    m->close_by_corners = lsq && corners && corners_close(m);
     return KM_OK;
+  }
   const km_pp kp[2] = {a->kappa, b->kappa}, tp[2] = {a->theta, b->theta};
   double len[2] = {a->sig.length, b->sig.length};
   double ang[2] = {a->sig.angle, b->sig.angle};
-  return km__frame_plan_build(&m->plan, kp, tp, len, ang, m->closed, m->tol,
-                              err);
+  km_status st = km__frame_plan_build(&m->plan, kp, tp, len, ang, m->closed,
+                                      m->tol, err);
+  if (!st) m->close_by_corners = lsq && km__frame_plan_by_corners(m->plan);
+  return st;
 }
 
 static km_status pp_copy(km_pp *out, const km_pp *p) {
@@ -1119,11 +1156,13 @@ static km_status blend_smooth(const km_morph *m, double t, km_pp *out,
       } else if (y <= 0) {
         x = 0.0;
       } else {
+        /* the first segment whose image reaches y: the ends of
+         * neighbouring images agree only up to rounding, and a corner at a
+         * match (as "auto" puts them) must not fall between them */
         for (size_t k = 0; k < nq; k++) {
-          double y0 = w ? sb_of(&qm[k], qm[k].x0, t) : qm[k].a0;
           double y1 = w ? sb_of(&qm[k], qm[k].x0 + qm[k].h, t)
                         : qm_sa(&qm[k], qm[k].x0 + qm[k].h);
-          if (y >= y0 && y <= y1) {
+          if (y <= y1 + 1e-12 * L || k + 1 == nq) {
             x = w ? qm_inv_b(&qm[k], y, t) : qm_inv_a(&qm[k], y);
             break;
           }
@@ -1342,10 +1381,15 @@ static km_status closure_nodes(const km_pp *kp, const km_pp *tp, double h,
   return KM_OK;
 }
 
-/* Closed curve nearest in curvature (L2) to sig: see the DESIGN note. On
- * success *out is the corrected signature and *gap0 the gap before. */
-static km_status close_lsq(const km_signature *sig, km_signature *out,
-                           double *gap0, km_error *err) {
+/* Closed curve nearest in curvature (L2) to sig: see the DESIGN note. With
+ * by_corners, the interior corners take the whole correction when they can
+ * (km__close_by_corners: the smooth curvature keeps its bound, straight
+ * edges stay straight; *used_corners then true), else the smooth curvature
+ * does. On success *out is the corrected signature and *gap0 the gap
+ * before. */
+static km_status close_lsq(const km_signature *sig, bool by_corners,
+                           km_signature *out, double *gap0, bool *used_corners,
+                           km_error *err) {
   enum { NB = LSQ_INTERVALS, NF = LSQ_INTERVALS - 3 };
   double L = sig->length, h = L / NB;
   km_pp kp, tp, dpsi, kt;
@@ -1359,22 +1403,72 @@ static km_status close_lsq(const km_signature *sig, km_signature *out,
   km_status st = km__build_theta(sig, &kp, &tp);
   if (!st) st = closure_nodes(&kp, &tp, h, &q, &nq);
   if (st) goto done;
-  /* Gram matrix of the basis derivatives (exact: 3-point Gauss per unit
-   * interval integrates the quadratic products... use 8 points) */
-  double M[NF * NF];
-  for (int i = 0; i < NF; i++)
-    for (int j = 0; j < NF; j++) {
-      double v = 0.0;
-      for (int iv = 0; iv < NB; iv++)
-        for (int k = 0; k < 8; k++) {
-          double u = iv + 0.5 + 0.5 * km__gl8_x[k];
-          v += 0.5 * km__gl8_w[k] * bspline3_d(u - i) * bspline3_d(u - j);
+  /* the gap before any correction, and the integrals of the stretches
+   * between interior corners (for the closure by corners) */
+  size_t nc = 0;
+  double *S = NULL, *tau = NULL, *delta = NULL;
+  for (size_t k = 0; k < sig->ncorners; k++)
+    if (sig->corners[k].s > 0 && sig->corners[k].s < L) nc++;
+  S = malloc((4 * nc + 2) * sizeof(double));
+  if (!S) {
+    st = KM_ENOMEM;
+    goto done;
+  }
+  tau = S + 2 * (nc + 1);
+  delta = tau + nc;
+  {
+    size_t m = 0, ci = 0;
+    S[0] = S[1] = 0.0;
+    for (size_t n = 0; n < nq; n++) {
+      while (ci < sig->ncorners && sig->corners[ci].s <= q[n].s) {
+        if (sig->corners[ci].s > 0 && sig->corners[ci].s < L) {
+          tau[m++] = sig->corners[ci].turn;
+          S[2 * m] = S[2 * m + 1] = 0.0;
         }
-      M[i * NF + j] = v / h;
+        ci++;
+      }
+      S[2 * m] += q[n].w * cos(q[n].theta);
+      S[2 * m + 1] += q[n].w * sin(q[n].theta);
     }
-  double gap_first = -1.0;
-  bool changed = false;
-  for (int it = 0; it < 40; it++) {
+    double gx = 0.0, gy = 0.0;
+    for (size_t k = 0; k <= nc; k++) {
+      gx += S[2 * k];
+      gy += S[2 * k + 1];
+    }
+    *gap0 = hypot(gx, gy);
+    if (*gap0 <= 1e-12 * L) {
+      /* closed already: either closure would change nothing */
+      free(S);
+      if (used_corners) *used_corners = by_corners;
+      st = km_signature_copy(out, sig, err);
+      goto done;
+    }
+  }
+  if (by_corners && km__close_by_corners(S, tau, nc, delta)) {
+    km_corner *cs = malloc((sig->ncorners + 1) * sizeof *cs);
+    if (!cs) {
+      free(S);
+      st = KM_ENOMEM;
+      goto done;
+    }
+    for (size_t k = 0, m = 0; k < sig->ncorners; k++) {
+      cs[k] = sig->corners[k];
+      if (cs[k].s > 0 && cs[k].s < L) cs[k].turn += delta[m++];
+    }
+    free(S);
+    st = km_signature_create(out, L, sig->start, sig->angle, &sig->kappa, cs,
+                             sig->ncorners, sig->closed, err);
+    free(cs);
+    if (used_corners) *used_corners = st == KM_OK;
+    goto done;
+  }
+  free(S);
+  /* the metric: Gram matrix of the basis derivatives in s (see
+   * morph_plan.c) */
+  double M[NF * NF];
+  km__closure_metric(M);
+  for (int i = 0; i < NF * NF; i++) M[i] /= h;
+  for (int it = 0;; it++) {
     double G[2] = {0, 0}, J[2][NF];
     memset(J, 0, sizeof J);
     for (size_t n = 0; n < nq; n++) {
@@ -1396,11 +1490,15 @@ static km_status close_lsq(const km_signature *sig, km_signature *out,
         J[1][i] += q[n].w * cs * bv[k];
       }
     }
-    double g = hypot(G[0], G[1]);
-    if (gap_first < 0) gap_first = g;
-    if (g <= 1e-12 * L) break;
-    changed = true;
-    /* minimum-norm Newton step in the metric M */
+    if (hypot(G[0], G[1]) <= 1e-12 * L) break;
+    if (it == 40) {
+      st = KM_ENOCONVERGE;
+      goto done;
+    }
+    /* Gauss-Newton in the metric M: project once (the least change of
+     * curvature that meets the linearised constraints), then minimum-norm
+     * steps (quadratic convergence); as in morph_plan.c */
+    bool project = it == 0;
     double Y[2][NF];
     for (int r = 0; r < 2; r++) {
       double A[NF * NF];
@@ -1411,29 +1509,22 @@ static km_status close_lsq(const km_signature *sig, km_signature *out,
         goto done;
       }
     }
-    double S[4] = {0, 0, 0, 0};
+    double S2[4] = {0, 0, 0, 0};
     for (int r = 0; r < 2; r++)
       for (int k = 0; k < 2; k++)
-        for (int i = 0; i < NF; i++) S[r * 2 + k] += J[r][i] * Y[k][i];
+        for (int i = 0; i < NF; i++) S2[r * 2 + k] += J[r][i] * Y[k][i];
     double rhs[2];
     for (int r = 0; r < 2; r++) {
       rhs[r] = -G[r];
-      for (int i = 0; i < NF; i++) rhs[r] += J[r][i] * c[i];
+      if (project)
+        for (int i = 0; i < NF; i++) rhs[r] += J[r][i] * c[i];
     }
-    if (!km__solve_dense(S, rhs, 2)) {
+    if (!km__solve_dense(S2, rhs, 2)) {
       st = KM_ENOCONVERGE;
       goto done;
     }
-    for (int i = 0; i < NF; i++) c[i] = Y[0][i] * rhs[0] + Y[1][i] * rhs[1];
-    if (it == 39) {
-      st = KM_ENOCONVERGE;
-      goto done;
-    }
-  }
-  *gap0 = gap_first;
-  if (!changed) {
-    st = km_signature_copy(out, sig, err);
-    goto done;
+    for (int i = 0; i < NF; i++)
+      c[i] = (project ? 0.0 : c[i]) + Y[0][i] * rhs[0] + Y[1][i] * rhs[1];
   }
   /* kappa~ = kappa + psi' (psi' is quadratic on each basis interval) */
   st = km__pp_alloc(&dpsi, 2, NB);
@@ -1746,7 +1837,7 @@ km_status km_morph_frame(const km_morph *m, double t, km_curve *out,
   if (st) goto done;
   if (m->closed && how == KM_CLOSURE_LSQ) {
     /* close_lsq measures the gap itself (its first residual) */
-    st = close_lsq(&blended, &closed, &gap, err);
+    st = close_lsq(&blended, m->close_by_corners, &closed, &gap, NULL, err);
     if (st) goto done;
     use = &closed;
   } else if (m->closed) {

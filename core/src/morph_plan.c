@@ -58,6 +58,9 @@ struct km__frame_plan {
   size_t nn;
   double chol[NF * NF]; /* Cholesky factor of the closure metric */
   double c_half[NF];    /* the closure correction at t = 1/2 */
+  size_t *corner_at;    /* breaks (1 .. np - 1) that are corners */
+  size_t ncorners;
+  bool by_corners;      /* closed frames close by their corners */
 };
 
 /* ---- small numerics ---------------------------------------------------- */
@@ -142,13 +145,23 @@ static double psi_at(const double *c, double r) {
   return v;
 }
 
+void km__closure_metric(double *M) {
+  static const double band[4] = {2.0 / 3.0, -1.0 / 8.0, -1.0 / 5.0, -1.0 / 120.0};
+  for (int i = 0; i < NF; i++)
+    for (int j = 0; j < NF; j++) {
+      int d = i > j ? i - j : j - i;
+      M[i * NF + j] = d < 4 ? band[d] : 0.0;
+    }
+}
+
 /* Cholesky of the Toeplitz metric (exact entries, see DESIGN). */
 static bool metric_factor(double *Lc) {
-  static const double band[4] = {2.0 / 3.0, -1.0 / 8.0, -1.0 / 5.0, -1.0 / 120.0};
+  double M[NF * NF];
+  km__closure_metric(M);
   memset(Lc, 0, NF * NF * sizeof(double));
   for (int i = 0; i < NF; i++)
     for (int j = 0; j <= i; j++) {
-      double v = i - j < 4 ? band[i - j] : 0.0;
+      double v = M[i * NF + j];
       for (int k = 0; k < j; k++) v -= Lc[i * NF + k] * Lc[j * NF + k];
       if (i == j) {
         if (!(v > 0)) return false;
@@ -319,6 +332,7 @@ void km__frame_plan_free(km__frame_plan *p) {
   free(p->tb_r);
   free(p->first);
   free(p->node);
+  free(p->corner_at);
   free(p);
 }
 
@@ -330,6 +344,9 @@ static int cmp_dbl(const void *a, const void *b) {
 static km_status close_frame(const km__frame_plan *p, double t, double theta0,
                              bool close_lsq, double *c, double *sum,
                              double *e);
+static bool corner_closure(const km__frame_plan *p, double t, double *sum,
+                           double *tau, double *delta, double *S,
+                           double *dp);
 
 km_status km__frame_plan_build(km__frame_plan **out, const km_pp kappa[2],
                                const km_pp theta[2], const double length[2],
@@ -514,6 +531,13 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp kappa[2],
   if (st) goto fail;
   p->x[np] = 1.0;
   p->first[np] = nodes.n;
+  p->corner_at = malloc((np + 1) * sizeof(size_t));
+  if (!p->corner_at) {
+    st = KM_ENOMEM;
+    goto fail;
+  }
+  for (size_t k = 1; k < np; k++)
+    if (p->corner[k]) p->corner_at[p->ncorners++] = k;
   for (size_t k = 0; k <= np; k++) {
     double v[3];
     side_eval(&sd[0], p->x[k], k == 0 ? 1 : -1, v);
@@ -538,6 +562,24 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp kappa[2],
       st = KM_OK;
     }
     if (st) goto fail;
+    /* Corners close the frames of this morph if they can at t = 1/4, 1/2
+     * and 3/4; the choice holds for every frame, so that a sequence does
+     * not switch between two closures (a frame where it fails takes the
+     * smooth one). */
+    size_t nc = p->ncorners;
+    double *buf = nc >= 3 ? malloc((2 * (np + p->nn) + 4 * nc + 2 + np) *
+                                   sizeof(double))
+                          : NULL;
+    if (buf) {
+      double *tau = buf + 2 * (np + p->nn), *delta = tau + nc, *S = delta + nc;
+      double *dp = S + 2 * (nc + 1), c0[NF] = {0};
+      p->by_corners = true;
+      for (int k = 1; k <= 3 && p->by_corners; k++)
+        p->by_corners = close_frame(p, k / 4.0, 0.0, false, c0, buf,
+                                    buf + 2 * np) == KM_OK &&
+                        corner_closure(p, k / 4.0, buf, tau, delta, S, dp);
+      free(buf);
+    }
   }
   free(atoms.p);
   free(br);
@@ -561,6 +603,64 @@ fail:
 size_t km__frame_plan_pieces(const km__frame_plan *p) { return p->np; }
 size_t km__frame_plan_nodes(const km__frame_plan *p) { return p->nn; }
 const double *km__frame_plan_breaks(const km__frame_plan *p) { return p->x; }
+bool km__frame_plan_by_corners(const km__frame_plan *p) { return p->by_corners; }
+
+/* ---- closing by the corners ------------------------------------------- */
+
+bool km__close_by_corners(const double *S, const double *tau, size_t nc,
+                          double *delta) {
+  if (nc < 3) return false;
+  double *W = malloc((4 * nc + 1) * sizeof(double));
+  if (!W) return false;
+  double *D = W + nc, *J = W + 2 * nc + 1; /* J: 2 nc (suffix sums) */
+  double wsum = 0.0;
+  for (size_t k = 0; k < nc; k++) {
+    W[k] = fabs(tau[k]);
+    wsum += W[k];
+    delta[k] = 0.0;
+  }
+  bool ok = false;
+  for (int it = 0; it < 60 && wsum > 0; it++) {
+    /* D_m = delta_1 + ... + delta_m; G = sum_m e^(i D_m) S_m and the
+     * derivatives i sum_(m >= k) e^(i D_m) S_m (suffix sums) */
+    D[0] = 0.0;
+    for (size_t k = 0; k < nc; k++) D[k + 1] = D[k] + delta[k];
+    double gx = 0.0, gy = 0.0;
+    for (size_t m = nc + 1; m-- > 0;) {
+      double c = cos(D[m]), sn = sin(D[m]);
+      gx += c * S[2 * m] - sn * S[2 * m + 1];
+      gy += sn * S[2 * m] + c * S[2 * m + 1];
+      if (m >= 1) {
+        J[2 * (m - 1)] = -gy; /* d gx / d delta_m */
+        J[2 * (m - 1) + 1] = gx; /* d gy / d delta_m */
+      }
+    }
+    if (hypot(gx, gy) <= 1e-14) {
+      ok = true;
+      break;
+    }
+    /* least sum delta^2 / W with the linearised constraints
+     * A delta = A delta_old - (gx, gy, 0), A = (Jx; Jy; 1 ... 1):
+     * delta = W A^T (A W A^T)^-1 rhs */
+    double M[9] = {0}, rhs[3] = {-gx, -gy, 0.0};
+    for (size_t k = 0; k < nc; k++) {
+      double a[3] = {J[2 * k], J[2 * k + 1], 1.0};
+      for (int r = 0; r < 3; r++) {
+        rhs[r] += a[r] * delta[k];
+        for (int q = 0; q < 3; q++) M[r * 3 + q] += W[k] * a[r] * a[q];
+      }
+    }
+    if (!km__solve_dense(M, rhs, 3)) break;
+    for (size_t k = 0; k < nc; k++)
+      delta[k] = W[k] * (J[2 * k] * rhs[0] + J[2 * k + 1] * rhs[1] + rhs[2]);
+  }
+  /* a corner may change by at most half its turn: beyond that the shape
+   * would be closed by corners it hardly has */
+  for (size_t k = 0; ok && k < nc; k++)
+    if (fabs(delta[k]) > 0.5 * fabs(tau[k])) ok = false;
+  free(W);
+  return ok;
+}
 
 /* ---- frames ------------------------------------------------------------ */
 
@@ -666,19 +766,66 @@ static km_status close_frame(const km__frame_plan *p, double t, double theta0,
   }
 }
 
+/* Closes a frame by its corners (km__close_by_corners) given the pieces'
+ * integrals sum (rotated in place on success); dp[k] receives the turn
+ * added before piece k. Scratch: tau, delta (nc each), S (2 (nc + 1)). */
+static bool corner_closure(const km__frame_plan *p, double t, double *sum,
+                           double *tau, double *delta, double *S,
+                           double *dp) {
+  size_t np = p->np, nc = p->ncorners, m = 0;
+  S[0] = S[1] = 0.0;
+  for (size_t k = 0; k < np; k++) {
+    if (m < nc && p->corner_at[m] == k) {
+      size_t b = p->corner_at[m];
+      tau[m] = (1 - t) * (p->ta_r[b] - p->ta_l[b]) + t * (p->tb_r[b] - p->tb_l[b]);
+      m++;
+      S[2 * m] = S[2 * m + 1] = 0.0;
+    }
+    S[2 * m] += sum[2 * k];
+    S[2 * m + 1] += sum[2 * k + 1];
+  }
+  if (!km__close_by_corners(S, tau, nc, delta)) return false;
+  double d = 0.0;
+  m = 0;
+  for (size_t k = 0; k < np; k++) {
+    if (m < nc && p->corner_at[m] == k) d += delta[m++];
+    dp[k] = d;
+    double cs = cos(d), sn = sin(d), x = sum[2 * k], y = sum[2 * k + 1];
+    sum[2 * k] = cs * x - sn * y;
+    sum[2 * k + 1] = sn * x + cs * y;
+  }
+  return true;
+}
+
 km_status km__frame_plan_curve(const km__frame_plan *p, double t,
                                double theta0, bool close_lsq, km_curve *out,
                                double *ends, km_error *err) {
   double Lt = (1 - t) * p->La + t * p->Lb, al = 1 - t, be = t;
   size_t np = p->np;
-  /* start from the correction at t = 1/2 scaled by 4 t (1 - t): frames
-   * near each other need nearly the same correction, and the ends none */
   double c[NF] = {0};
-  if (close_lsq && p->closed)
-    for (int i = 0; i < NF; i++) c[i] = 4 * t * (1 - t) * p->c_half[i];
-  double *sum = malloc(2 * (np + p->nn) * sizeof(double));
+  bool lsq = close_lsq && p->closed;
+  /* sums of the pieces, scratch of the nodes, and per corner its turn,
+   * its change and the stretch sums; per piece the turn added before it */
+  size_t nc = p->ncorners;
+  double *sum = malloc((2 * (np + p->nn) + 4 * nc + 2 + np) * sizeof(double));
   if (!sum) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
-  km_status st = close_frame(p, t, theta0, close_lsq, c, sum, sum + 2 * np);
+  double *tau = sum + 2 * (np + p->nn), *delta = tau + nc, *S = delta + nc;
+  double *dp = S + 2 * (nc + 1);
+  for (size_t k = 0; k < np; k++) dp[k] = 0.0;
+  km_status st = KM_OK;
+  bool by_corners = false;
+  if (lsq && p->by_corners) {
+    st = close_frame(p, t, theta0, false, c, sum, sum + 2 * np);
+    by_corners = !st && corner_closure(p, t, sum, tau, delta, S, dp);
+  }
+  if (!st && !by_corners) {
+    /* the smooth curvature takes the correction, started from the one at
+     * t = 1/2 scaled by 4 t (1 - t): frames near each other need nearly
+     * the same correction, and the ends none */
+    if (lsq)
+      for (int i = 0; i < NF; i++) c[i] = 4 * t * (1 - t) * p->c_half[i];
+    st = close_frame(p, t, theta0, close_lsq, c, sum, sum + 2 * np);
+  }
   if (st) {
     free(sum);
     return km__fail(err, st, KM_FIELD_NONE, -1, NAN,
@@ -704,9 +851,10 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t,
   if (ends) ends[0] = ends[1] = 0.0;
   for (size_t k = 0; k < np; k++) {
     double h = Lt * (p->x[k + 1] - p->x[k]);
-    double th0 = theta0 + al * p->ta_r[k] + be * p->tb_r[k] + psi_at(c, p->x[k]);
+    double th0 = theta0 + al * p->ta_r[k] + be * p->tb_r[k] +
+                 psi_at(c, p->x[k]) + dp[k];
     double th1 = theta0 + al * p->ta_l[k + 1] + be * p->tb_l[k + 1] +
-                 psi_at(c, p->x[k + 1]);
+                 psi_at(c, p->x[k + 1]) + dp[k];
     double Pn[2] = {P[0] + Lt * sum[2 * k], P[1] + Lt * sum[2 * k + 1]};
     if (k > 0 && p->corner[k]) {
       f.cp[cc++] = P[0];

@@ -33,6 +33,14 @@ size_t km__frame_plan_pieces(const km__frame_plan *p);
 size_t km__frame_plan_nodes(const km__frame_plan *p);
 /* The pieces' ends in normalised arc length r (pieces + 1 of them). */
 const double *km__frame_plan_breaks(const km__frame_plan *p);
+/* Whether the lsq closure of this morph's frames goes by their corners
+ * (decided once per morph, see morph_plan.c). */
+bool km__frame_plan_by_corners(const km__frame_plan *p);
+
+/* The lsq closure's metric: Gram matrix of the derivatives of its basis
+ * functions in the variable of unit knot spacing ((KM__CLOSURE_INTERVALS -
+ * 3)^2 values, exact). */
+void km__closure_metric(double *M);
 
 /* The frame at t as a cubic B-spline in its arc length, starting at the
  * origin with tangent angle theta0. close_lsq: closes a closed pair by the
@@ -42,5 +50,18 @@ const double *km__frame_plan_breaks(const km__frame_plan *p);
 km_status km__frame_plan_curve(const km__frame_plan *p, double t,
                                double theta0, bool close_lsq, km_curve *out,
                                double *ends, km_error *err);
+
+/* Closure by the corners: a frame whose integral of e^(i theta) splits at
+ * its nc interior corners (turns tau) into stretch integrals S (2 (nc + 1)
+ * values, complex, in order) closes when the corners turn by delta more:
+ * G = sum_m e^(i (delta_1 + ... + delta_m)) S_m = 0 with sum delta = 0 (the
+ * tangent stays closed). delta is the least such change in sum
+ * delta_k^2 / |tau_k| (corners change in proportion to their turn), by
+ * Gauss-Newton. Smooth stretches keep their curvature exactly. Returns
+ * false (delta unusable) with fewer than three corners, without
+ * convergence, or when a corner would change by more than half its
+ * turn. */
+bool km__close_by_corners(const double *S, const double *tau, size_t nc,
+                          double *delta);
 
 #endif
