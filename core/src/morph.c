@@ -17,20 +17,29 @@
  * theta is continuous across segments, which is the paper's G2 joining of
  * matched segments; proportional matches give exactly the global morph.
  * Closed curves: the tangent closes by itself (equal turning numbers); the
- * position is closed by "lsq": theta~ = theta_t + psi with psi a
- * combination of interior uniform cubic B-splines (psi and psi' vanish at
- * the seam, so the seam stays G2), minimising the L2 change of curvature
- * ||psi'||^2 subject to the two closure equations (Gauss-Newton on the
- * minimum-norm step), after Saba, Schneider, Hormann and Scateni (2014).
- * The paper's control-polygon corrections (c0, c1, g2) remain selectable.
+ * position is closed by "lsq", the least change of curvature that closes
+ * the frame, in one of two forms chosen once per morph (plan_frames):
+ * frames with corners close by turning them (km__close_by_corners: least
+ * sum of squared changes weighted by each corner's turn, total turning
+ * kept), which leaves the curvature between corners the blend's - straight
+ * edges stay straight, the bound holds; otherwise theta~ = theta_t + psi
+ * with psi a combination of interior uniform cubic B-splines (psi and psi'
+ * vanish at the seam, so the seam stays G2), minimising the L2 change of
+ * curvature ||psi'||^2 subject to the two closure equations (Gauss-Newton),
+ * after Saba, Schneider, Hormann and Scateni (2014). The paper's
+ * control-polygon corrections (c0, c1, g2) remain selectable.
+ * Frames of the default morph without metrics or signature come from a
+ * plan made once per morph (morph_plan.c); the rest below blends the
+ * signatures exactly and reconstructs.
  * Placement: curvature fixes a frame up to a rigid motion; "fit" takes the
  * rigid motion (2-D Procrustes, closed form) that best maps the frame onto
  * the linear blend of the two inputs at corresponding points, which keeps
  * frames where the eye expects them instead of swinging about the start.
  * Start of closed curves: without matches, `to` is rotated to the start
  * that best aligns the two turning functions (least squares over all
- * cyclic shifts, then refined), and reversed first if the orientations
- * differ.
+ * cyclic shifts, by FFT correlation; among the deepest minima the one whose
+ * previewed frames do not cross themselves), and reversed first if the
+ * orientations differ.
  * matches "auto": features (corners and curvature extrema, with the turning
  * they carry) are aligned by dynamic programming over both sequences,
  * rewarding pairs of like turning and penalising drift in r.

@@ -643,13 +643,13 @@ static void closed_frames_respect_the_curvature_bound(void **state) {
       }
       /* The blend itself is a convex combination whatever the matches, so
        * the bound is checked on the frames as blended (closure "none").
-       * The default closure then changes curvature by the least amount
-       * that closes the frame; with no matches that change is tiny and the
-       * bound is checked on the default frames too. (A match that maps 6%
-       * of a circle onto 77% of an ellipse leaves a gap of a sixth of the
-       * length, and closing that by curvature alone exceeds the bound by a
-       * few percent: closing by reparameterisation instead is future
-       * work.) */
+       * The default closure of these smooth pairs then changes curvature by
+       * the least amount that closes the frame; with no matches that change
+       * is tiny and the bound is checked on the default frames too. (A
+       * match that maps 6% of a circle onto 77% of an ellipse leaves a gap
+       * of a sixth of the length, and closing that by smooth curvature
+       * exceeds the bound by a few percent. Frames with corners close by
+       * their corners and keep the bound: polygons_morph_through_polygons.) */
       km_morph_options o;
       km_morph_options_default(&o);
       o.matches = pairs;
