@@ -85,7 +85,9 @@ km_status km__build_theta(const km_signature *sig, km_pp *kappa, km_pp *theta) {
   for (size_t i = 0; i + 1 < m; i++) {
     double a = br[i], b = br[i + 1], h = b - a;
     while (ci < sig->ncorners && sig->corners[ci].s <= a) th += sig->corners[ci++].turn;
-    size_t j = km__pp_find(&k0, 0.5 * (a + b));
+    /* the kappa piece holding [a, b]: found by a, a break itself (the
+     * midpoint of a piece one ulp wide rounds onto b, the next piece) */
+    size_t j = km__pp_find(&k0, a);
     double ja = k0.x[j], jh = k0.x[j + 1] - ja;
     double *kc = tp->kappa.c + i * (size_t)(dk + 1);
     km__bern_restrict(k0.c + j * (size_t)(dk + 1), dk, (a - ja) / jh,

@@ -471,6 +471,54 @@ static void reconstruct_rejects_other_degrees(void **state) {
   km_signature_free(&sig);
 }
 
+static void corner_one_ulp_before_a_curvature_break_keeps_its_turn(
+    void **state) {
+  (void)state;
+  /* kappa = 2^40 on [a, b] = [1/2 - 2^-40, 1/2] and 0 elsewhere, length 1,
+   * a corner of pi/2 at s_c one ulp before b. theta climbs to 1 rad over
+   * [a, b], so the piece [s_c, b] between the corner and the break, one ulp
+   * long, still turns by 2^40 * 2^-54 = 2^-14 rad; its midpoint rounds onto
+   * b. Exactly: theta = 1 + pi/2 after b, and the end point is
+   *   (a + sin(phi) / K, (1 - cos phi) / K) + (1/2)(cos, sin)(1 + pi/2)
+   * with phi = 1 - 2^-14, up to the 2^-54 long piece. */
+  const double K = 0x1p40, b = 0.5, a = b - 0x1p-40;
+  const double sc = b - 0x1p-54, phi = 1 - 0x1p-14, th1 = 1 + M_PI / 2;
+  const double kn[4] = {0, a, b, 1}, coef[3] = {0, K, 0};
+  km_fn kappa;
+  km_error err;
+  km_fn_init(&kappa);
+  assert_status(km_fn_create(&kappa, 0, 3, kn, coef, &err), KM_OK);
+  const km_corner corner = {sc, M_PI / 2};
+  const double start[2] = {0, 0};
+  km_signature sig;
+  km_signature_init(&sig);
+  assert_status(km_signature_create(&sig, 1.0, start, 0.0, &kappa, &corner,
+                                    1, false, &err),
+                KM_OK);
+  km_fn_free(&kappa);
+  double ex = a + sin(phi) / K + 0.5 * cos(th1);
+  double ey = (1 - cos(phi)) / K + 0.5 * sin(th1);
+  double p[2], th;
+  assert_status(km_signature_point(&sig, 1.0, p, &th), KM_OK);
+  assert_close(th, th1, 1e-12);
+  assert_close(p[0], ex, 1e-13);
+  assert_close(p[1], ey, 1e-13);
+  for (int deg = 3; deg <= 5; deg += 2) {
+    km_curve r;
+    double bound;
+    km_curve_init(&r);
+    assert_status(km_reconstruct(&sig, deg, 1e-9, &r, &bound, &err), KM_OK);
+    assert_le(bound, 1e-9);
+    double q[1][2], t0, t1;
+    km_curve_domain(&r, &t0, &t1);
+    km_curve_eval(&r, t1, 0, q);
+    assert_close(q[0][0], ex, bound + 1e-13);
+    assert_close(q[0][1], ey, bound + 1e-13);
+    km_curve_free(&r);
+  }
+  km_signature_free(&sig);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(unit_circle_is_reconstructed_within_each_tolerance),
@@ -483,6 +531,7 @@ int main(void) {
       cmocka_unit_test(fixture_outlines_survive_a_round_trip),
       cmocka_unit_test(repeated_control_point_survives_a_round_trip),
       cmocka_unit_test(reconstruct_rejects_other_degrees),
+      cmocka_unit_test(corner_one_ulp_before_a_curvature_break_keeps_its_turn),
   };
   return cmocka_run_group_tests_name("reconstruct", tests, NULL, NULL);
 }
