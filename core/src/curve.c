@@ -7,6 +7,7 @@
  * adaptive Gauss-Legendre per knot span: the speed is smooth inside a span
  * and may have kinks only at knots.
  */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -311,39 +312,42 @@ static double speed_of_curve(const void *ctx, double t) {
   return km__speed((const km_curve *)ctx, t);
 }
 
-static double gl_rule(km__scalar_fn f, const void *ctx, double a, double b,
-                      int n16) {
+static double gl16(km__scalar_fn f, const void *ctx, double a, double b) {
   double m = 0.5 * (a + b), h = 0.5 * (b - a), sum = 0.0;
-  const double *x = n16 ? km__gl16_x : km__gl8_x;
-  const double *w = n16 ? km__gl16_w : km__gl8_w;
-  int n = n16 ? 16 : 8;
-  for (int k = 0; k < n; k++) sum += w[k] * f(ctx, m + h * x[k]);
+  for (int k = 0; k < 16; k++) sum += km__gl16_w[k] * f(ctx, m + h * km__gl16_x[k]);
   return sum * h;
 }
 
+/* whole = the 16-point rule on [a, b], already computed. The error of the
+ * whole is estimated by the rule on the two halves: for an integrand
+ * analytic near [a, b] the halves are far more accurate, so the
+ * difference is the whole's error - also where a feature that is small
+ * beside the integral (a speed that nearly vanishes close to an end)
+ * slows the convergence, which comparing 8 with 16 points on one interval
+ * mistakes for rounding. The halves' sum is returned. Two sums of 16 and
+ * 32 rounded terms differ by some ulps of the value whatever the step:
+ * below 64 ulps nothing more can be gained. The budget bounds the work on
+ * pathological integrands (a speed that is rounding noise around zero). */
 static double integrate_rec(km__scalar_fn f, const void *ctx, double a,
-                            double b, double abs_tol, int depth,
+                            double b, double whole, double abs_tol, int depth,
                             long *budget) {
-  double g8 = gl_rule(f, ctx, a, b, 0), g16 = gl_rule(f, ctx, a, b, 1);
-  /* For an integrand analytic near [a, b] the n-point error falls
-   * geometrically with n, so the 16-point error is about the square of the
-   * relative 8-point error; below a few ulps of the value itself nothing
-   * more can be gained. The budget bounds the work on pathological
-   * integrands (a speed that is rounding noise around zero). */
-  double d = fabs(g16 - g8), mag = fabs(g16);
-  double est16 = d < 1e-3 * mag ? d * d / mag : d;
-  if (est16 <= fmax(abs_tol, 8e-16 * mag) || !(b - a > 1e-300)) return g16;
-  if (depth >= 40 || --*budget <= 0) return NAN; /* not to the precision */
   double m = 0.5 * (a + b);
-  return integrate_rec(f, ctx, a, m, 0.5 * abs_tol, depth + 1, budget) +
-         integrate_rec(f, ctx, m, b, 0.5 * abs_tol, depth + 1, budget);
+  double l = gl16(f, ctx, a, m), r = gl16(f, ctx, m, b), sum = l + r;
+  /* Nor where [a, b] is so narrow beside its position that the nodes are
+   * rounded by a part in a thousand: halving it only moves them. */
+  if (fabs(sum - whole) <= fmax(abs_tol, 64 * DBL_EPSILON * fabs(sum)) ||
+      b - a <= 1024 * DBL_EPSILON * fmax(fabs(a), fabs(b)))
+    return sum;
+  if (depth >= 40 || --*budget <= 0) return NAN; /* not to the precision */
+  return integrate_rec(f, ctx, a, m, l, 0.5 * abs_tol, depth + 1, budget) +
+         integrate_rec(f, ctx, m, b, r, 0.5 * abs_tol, depth + 1, budget);
 }
 
 double km__integrate_adaptive(km__scalar_fn f, const void *ctx, double a,
                               double b, double abs_tol) {
   if (!(b > a)) return 0.0;
   long budget = 256;
-  return integrate_rec(f, ctx, a, b, abs_tol, 0, &budget);
+  return integrate_rec(f, ctx, a, b, gl16(f, ctx, a, b), abs_tol, 0, &budget);
 }
 
 double km__length_adaptive(const km_curve *c, double a, double b,
@@ -397,37 +401,44 @@ double km_curve_param_at_length(const km_curve *c, double s) {
   double t0, t1;
   km_curve_domain(c, &t0, &t1);
   if (s <= 0) return t0;
-  double tol = 1e-15 * fmax(polygon_length(c), 1e-300);
-  /* find the span containing s */
+  double poly = polygon_length(c);
+  if (!(poly > 0)) return t0;
+  double tol = 1e-15 * poly;
+  /* find the span containing s; lengths in each span's own variable u, as
+   * km_curve_length_between measures them */
   size_t p = (size_t)c->degree;
-  double acc = 0.0, a = t0, b = t1;
+  double acc = 0.0, span_len = 0.0;
+  km__bspan sp;
+  bool found = false;
   for (size_t i = p; i < c->n; i++) {
     if (!(c->knots[i + 1] > c->knots[i])) continue;
-    double li = km__length_adaptive(c, c->knots[i], c->knots[i + 1], tol);
-    a = c->knots[i];
-    b = c->knots[i + 1];
-    if (acc + li >= s) break;
-    acc += li;
-    if (i + 1 == c->n) return t1;
+    km__bspan_make(&sp, c, i);
+    span_len = km__bspan_length(&sp, 0.0, 1.0, tol);
+    if (acc + span_len >= s) {
+      found = true;
+      break;
+    }
+    acc += span_len;
   }
-  double target = s - acc; /* length within [a, b] */
-  double lo = a, hi = b, t = a + (b - a) * 0.5;
-  double span_len = km__length_adaptive(c, a, b, tol);
-  if (span_len > 0) t = a + (b - a) * (target / span_len);
+  if (!found || !(span_len > 0)) return t1;
+  double target = s - acc; /* length within the span */
+  double lo = 0.0, hi = 1.0, u = target / span_len;
   for (int it = 0; it < KM_MAX_NEWTON_ITERATIONS; it++) {
-    double f = km__length_adaptive(c, a, t, tol) - target;
-    if (fabs(f) <= 1e-13 * fmax(span_len, 1e-300)) return t;
+    double f = km__bspan_length(&sp, 0.0, u, tol) - target;
+    if (fabs(f) <= 1e-13 * span_len) break;
     if (f > 0)
-      hi = t;
+      hi = u;
     else
-      lo = t;
-    double sp = km__speed(c, t);
-    double tn = sp > 0 ? t - f / sp : 0.5 * (lo + hi);
-    if (!(tn > lo && tn < hi) || !isfinite(tn)) tn = 0.5 * (lo + hi);
-    if (tn == t) return t;
-    t = tn;
+      lo = u;
+    double pos[2], d[2];
+    km__bspan_eval_u(&sp, u, pos, d);
+    double v = sqrt(d[0] * d[0] + d[1] * d[1]);
+    double un = v > 0 ? u - f / v : 0.5 * (lo + hi);
+    if (!(un > lo && un < hi) || !isfinite(un)) un = 0.5 * (lo + hi);
+    if (un == u) break;
+    u = un;
   }
-  return t;
+  return sp.a + (sp.b - sp.a) * u;
 }
 
 /* Bezier form of one span by blossoming the homogeneous control points:
@@ -466,21 +477,38 @@ void km__bspan_eval_u(const km__bspan *sp, double u, double pos[2],
                       double der_u[2]) {
   int p = sp->degree;
   double v = 1.0 - u;
+  if (!sp->rational) { /* weights 1: two coordinates, no quotient */
+    double e[KM__BSPAN_MAX][2];
+    for (int j = 0; j <= p; j++) {
+      e[j][0] = sp->h[j][0];
+      e[j][1] = sp->h[j][1];
+    }
+    for (int r = 1; r < p; r++)
+      for (int j = 0; j <= p - r; j++) {
+        e[j][0] = v * e[j][0] + u * e[j + 1][0];
+        e[j][1] = v * e[j][1] + u * e[j + 1][1];
+      }
+    for (int q = 0; q < 2; q++) {
+      pos[q] = v * e[0][q] + u * e[1][q];
+      der_u[q] = p * (e[1][q] - e[0][q]);
+    }
+    return;
+  }
   double d[KM__BSPAN_MAX][3];
   memcpy(d, sp->h, sizeof(double) * 3 * (size_t)(p + 1));
   for (int r = 1; r < p; r++)
     for (int j = 0; j <= p - r; j++)
       for (int q = 0; q < 3; q++) d[j][q] = v * d[j][q] + u * d[j + 1][q];
-  double H[3], dH[3];
-  for (int q = 0; q < 3; q++) {
-    H[q] = v * d[0][q] + u * d[1][q];
-    dH[q] = p * (d[1][q] - d[0][q]);
+  /* The last step joins two points P0, P1 of weights w0, w1: C = (v w0 P0
+   * + u w1 P1) / w and C' = p w0 w1 / w^2 (P1 - P0), with w = v w0 + u w1.
+   * Unlike the quotient rule (H' - C w') / w, no large terms cancel, so
+   * the direction keeps its digits whatever the weights. */
+  double w0 = d[0][2], w1 = d[1][2], w = v * w0 + u * w1;
+  double f = p * (w0 / w) * (w1 / w);
+  for (int q = 0; q < 2; q++) {
+    pos[q] = (v * d[0][q] + u * d[1][q]) / w;
+    der_u[q] = f * (d[1][q] / w1 - d[0][q] / w0);
   }
-  double w = H[2];
-  pos[0] = H[0] / w;
-  pos[1] = H[1] / w;
-  der_u[0] = (dH[0] - pos[0] * dH[2]) / w;
-  der_u[1] = (dH[1] - pos[1] * dH[2]) / w;
 }
 
 void km__bspan_eval(const km__bspan *sp, double t, double pos[2],
@@ -491,13 +519,48 @@ void km__bspan_eval(const km__bspan *sp, double t, double pos[2],
   der[1] /= len;
 }
 
+/* |dC/du|; without weights from the hodograph, p times the Bezier curve of
+ * the legs, at a third of the cost of position and derivative */
 static double bspan_speed_u(const void *ctx, double u) {
-  double p[2], d[2];
-  km__bspan_eval_u(ctx, u, p, d);
+  const km__bspan *sp = ctx;
+  double d[2];
+  if (sp->rational) {
+    double pos[2];
+    km__bspan_eval_u(sp, u, pos, d);
+  } else {
+    int p = sp->degree;
+    double v = 1.0 - u, e[KM__BSPAN_MAX][2];
+    for (int j = 0; j < p; j++) {
+      e[j][0] = sp->h[j + 1][0] - sp->h[j][0];
+      e[j][1] = sp->h[j + 1][1] - sp->h[j][1];
+    }
+    for (int r = 1; r < p; r++)
+      for (int j = 0; j < p - r; j++) {
+        e[j][0] = v * e[j][0] + u * e[j + 1][0];
+        e[j][1] = v * e[j][1] + u * e[j + 1][1];
+      }
+    d[0] = p * e[0][0];
+    d[1] = p * e[0][1];
+  }
   return sqrt(d[0] * d[0] + d[1] * d[1]);
 }
 
 double km__bspan_length(const km__bspan *sp, double u0, double u1,
                         double abs_tol) {
-  return km__integrate_adaptive(bspan_speed_u, sp, u0, u1, abs_tol);
+  /* The speed is computed from points of magnitude up to M: its rounding
+   * error, about 8 p eps M (up to four times that, integrated, where a
+   * rational span's weights vary widely: the weight factor of its speed
+   * integrates to a few units), bounds the precision any length can have
+   * (a short span far from the origin); asking for more only refines into
+   * noise. */
+  double M = 0.0, wmax = 0.0, wmin = INFINITY;
+  for (int k = 0; k <= sp->degree; k++) {
+    M = fmax(M, fmax(fabs(sp->h[k][0]), fabs(sp->h[k][1])) / sp->h[k][2]);
+    wmax = fmax(wmax, sp->h[k][2]);
+    wmin = fmin(wmin, sp->h[k][2]);
+  }
+  if (sp->rational) M *= fmin(wmax / wmin, 4.0);
+  double noise = 8.0 * DBL_EPSILON * sp->degree * M * (u1 - u0);
+  return km__integrate_adaptive(bspan_speed_u, sp, u0, u1,
+                                fmax(abs_tol, noise));
 }

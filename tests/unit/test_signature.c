@@ -12,6 +12,7 @@
 
 #include "fixtures.h"
 #include "km/curve.h"
+#include "km/reconstruct.h"
 #include "km/signature.h"
 #include "testutil.h"
 
@@ -666,6 +667,56 @@ static void curve_create_rejects_bad_input_naming_the_field(void **state) {
                       -2);
 }
 
+/* Signature that must succeed at the absolute tolerance tol. */
+static void sign_abs(const km_curve *c, double tol, km_signature *sig) {
+  km_error err;
+  km_signature_init(sig);
+  km_status st = km_signature_compute(c, tol, sig, &err);
+  if (st != KM_OK) print_error("signature failed: %s\n", err.message);
+  assert_status(st, KM_OK);
+}
+
+/* The exact curve's end point, from the signature alone. */
+static void signature_end(const km_signature *sig, double end[2]) {
+  double th;
+  assert_status(km_signature_point(sig, sig->length, end, &th), KM_OK);
+}
+
+static void sharp_turn_close_to_the_end_has_its_exact_length(void **state) {
+  (void)state;
+  /* C(t) = sigma (t - t^2/2, d t), a quadratic Bezier: |C'| = sigma
+   * sqrt((1-t)^2 + d^2), so the curve runs along x and turns up by nearly
+   * pi/2 within a length of about sigma d at its end, and
+   *   L = sigma (sqrt(1 + d^2) + d^2 asinh(1/d)) / 2.
+   * The speed's near-zero beside the end is a feature far smaller than the
+   * integral: an 8- against 16-point estimate takes its slow convergence
+   * for rounding (a length 4e-8 too short at d = 1e-4). */
+  const double kn[6] = {0, 0, 0, 1, 1, 1};
+  const double ds[2] = {1e-4, 1e-5}, sigmas[3] = {1.0, 1e-15, 1e12};
+  for (int i = 0; i < 2; i++) {
+    for (int j = 0; j < 3; j++) {
+      double d = ds[i], sg = sigmas[j];
+      double cp[6] = {0, 0, 0.5 * sg, 0.5 * d * sg, 0.5 * sg, d * sg};
+      double L = sg * 0.5 * (sqrt(1 + d * d) + d * d * asinh(1 / d));
+      km_curve c;
+      make_curve(&c, 2, 3, kn, cp, NULL, false);
+      assert_close(km_curve_length(&c), L, 1e-14 * L);
+      km_signature sig;
+      sign_abs(&c, 1e-12 * L, &sig);
+      assert_close(sig.length, L, 1e-14 * L);
+      assert_close(sig.angle, atan(d), 1e-12);
+      assert_close(sig.turning, M_PI / 2 - atan(d), 1e-12);
+      double end[2];
+      signature_end(&sig, end);
+      assert_close(end[0], 0.5 * sg, 1e-12 * L);
+      assert_close(end[1], d * sg, 1e-12 * L);
+      km_signature_free(&sig);
+      km_curve_free(&c);
+    }
+  }
+}
+
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(circle_has_constant_curvature_one_over_r),
@@ -684,6 +735,7 @@ int main(void) {
       cmocka_unit_test(cusp_is_refused_with_its_parameter),
       cmocka_unit_test(zero_length_curve_is_degenerate),
       cmocka_unit_test(curve_create_rejects_bad_input_naming_the_field),
+      cmocka_unit_test(sharp_turn_close_to_the_end_has_its_exact_length),
   };
   return cmocka_run_group_tests_name("signature", tests, NULL, NULL);
 }
