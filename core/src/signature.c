@@ -202,11 +202,16 @@ static km_status push_piece(builder *b, double s0, double s1,
   return KM_OK;
 }
 
-static km_status push_corner(builder *b, double s, double turn) {
+static km_status push_corner(builder *b, double s, double turn, double t) {
   if (b->ncorners > 0 && s - b->corners[b->ncorners - 1].s <= 1e-14 * b->L) {
-    /* one corner seen in several steps: one turn */
-    b->corners[b->ncorners - 1].turn =
-        km__wrap_angle(b->corners[b->ncorners - 1].turn + turn);
+    /* one corner seen in several steps: one turn, which may reverse */
+    double sum = km__wrap_angle(b->corners[b->ncorners - 1].turn + turn);
+    if (fabs(sum) > KM_PI - CUSP_MARGIN)
+      return km__fail(b->err, KM_ECUSP, KM_FIELD_CONTROL_POINTS, -1, t,
+                      "the tangent reverses at parameter t = %g (a cusp): "
+                      "the curve is not regular there",
+                      t);
+    b->corners[b->ncorners - 1].turn = sum;
     return KM_OK;
   }
   if (b->ncorners == b->ccap) {
@@ -241,6 +246,27 @@ static bool tangent_limit(const builder *b, double t, int side,
       return true;
     }
     tiny /= fmax(b->span_t, 1e-300);
+  }
+  /* At an end of the current span the first control point of its Bezier
+   * form that differs from the end point gives the direction: C - P0 is
+   * dominated by (P_k - P0) t^k however many legs are degenerate, where
+   * both the derivatives above and a chord are lost in rounding. */
+  const km__bspan *sp = &b->span;
+  int p = sp->degree;
+  if ((side > 0 && t == sp->a) || (side < 0 && t == sp->b)) {
+    int e = side > 0 ? 0 : p, step = side > 0 ? 1 : -1;
+    double ex = sp->h[e][0] / sp->h[e][2], ey = sp->h[e][1] / sp->h[e][2];
+    double floor_p = b->deriv_noise * (sp->b - sp->a); /* ~ rounding of points */
+    for (int k = e + step; k >= 0 && k <= p; k += step) {
+      double vx = (sp->h[k][0] / sp->h[k][2] - ex) * step;
+      double vy = (sp->h[k][1] / sp->h[k][2] - ey) * step;
+      double n = hypot(vx, vy);
+      if (n > floor_p) {
+        dir[0] = vx / n;
+        dir[1] = vy / n;
+        return true;
+      }
+    }
   }
   /* chord over a small step inside the span */
   double t0, t1;
@@ -335,10 +361,15 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
     double n = sqrt(d[1][0] * d[1][0] + d[1][1] * d[1][1]);
     speed[k] = n;
     if (k == 0 || k == NPTS - 1) continue;
-    if (n > 1e-12 * b->span_speed) {
+    /* C' well above its rounding error is the tangent, however small;
+     * below that its direction is noise (the speed vanishes there in
+     * exact arithmetic, or nearly), and the last reliable direction
+     * stands in: across such a stretch, far shorter than the rounding of
+     * the coordinates, only the turn between its ends counts */
+    if (n > 16.0 * b->deriv_noise) {
       dir[k][0] = d[1][0] / n;
       dir[k][1] = d[1][1] / n;
-    } else if (!tangent_limit(b, t[k], 1, dir[k])) {
+    } else {
       dir[k][0] = dir[k - 1][0];
       dir[k][1] = dir[k - 1][1];
     }
@@ -416,7 +447,7 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
     } else if (fabs(turn) * (b->L - *s_at) <= 0.05 * tol) {
       if (isnan(b->pending_start)) b->pending_start = th[0];
     } else if (fabs(turn) > CORNER_NOISE) {
-      km_status st = push_corner(b, *s_at, km__wrap_angle(turn));
+      km_status st = push_corner(b, *s_at, km__wrap_angle(turn), mid);
       if (st) return st;
     } else if (isnan(b->pending_start)) {
       b->pending_start = th[0];
@@ -495,11 +526,7 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
     return KM_OK;
   }
   /* bisect in t */
-  double dm[2];
-  if (!tangent_limit(b, mid, 1, dm)) {
-    dm[0] = dir[NPTS / 2][0];
-    dm[1] = dir[NPTS / 2][1];
-  }
+  double dm[2] = {dir[NPTS / 2][0], dir[NPTS / 2][1]}; /* the node at mid */
   km_status st = fit_piece(b, ua, mid, 0.0, s_at, theta, dir_a, dm, depth + 1);
   if (st) return st;
   return fit_piece(b, mid, ub, 0.0, s_at, theta, dm, dir_b, depth + 1);
@@ -511,7 +538,7 @@ static km_status check_turn(builder *b, double turn, double t, double s) {
                     "the tangent reverses at parameter t = %g (arc length "
                     "%g): a cusp, the curve is not regular there",
                     t, s);
-  if (fabs(turn) > CORNER_NOISE) return push_corner(b, s, turn);
+  if (fabs(turn) > CORNER_NOISE) return push_corner(b, s, turn, t);
   return KM_OK;
 }
 
@@ -615,12 +642,17 @@ km_status km_signature_compute(const km_curve *c, double tol,
     /* the span's pieces must end exactly at its arc length: knots are
      * breakpoints at their exact images */
     if (b.m > m0 && s_at - s_start > 0) {
-      double f = len / (s_at - s_start);
+      double f = len / (s_at - s_start), s_end = s_start + len;
       for (size_t q = m0 + 1; q <= b.m; q++) b.s[q] = s_start + (b.s[q] - s_start) * f;
+      /* a corner at the span's end (a turn hidden below resolution next
+       * to a degenerate end) stays exactly on that break: one ulp off it
+       * would leave a piece one ulp long where kappa may be huge */
       for (size_t q = c0; q < b.ncorners; q++)
-        if (b.corners[q].s > s_start)
+        if (b.corners[q].s >= s_at)
+          b.corners[q].s = s_end;
+        else if (b.corners[q].s > s_start)
           b.corners[q].s = s_start + (b.corners[q].s - s_start) * f;
-      s_at = s_start + len;
+      s_at = s_end;
       b.s[b.m] = s_at;
     }
     prev_dir[0] = db[0];
@@ -638,12 +670,10 @@ km_status km_signature_compute(const km_curve *c, double tol,
     if (st) goto cleanup;
   }
   /* the pieces' arc lengths sum to the total up to rounding: snap */
-  double scale = L / b.s[b.m];
+  double s_last = b.s[b.m], scale = L / s_last;
   for (size_t i = 0; i <= b.m; i++) b.s[i] *= scale;
-  for (size_t i = 0; i < b.ncorners; i++) {
-    b.corners[i].s *= scale;
-    if (b.corners[i].s > L) b.corners[i].s = L;
-  }
+  for (size_t i = 0; i < b.ncorners; i++) /* the seam's corner is at L */
+    b.corners[i].s = b.corners[i].s >= s_last ? L : fmin(b.corners[i].s * scale, L);
   b.s[b.m] = L;
   /* kappa = d theta / ds on every piece */
   st = km__pp_alloc(&kp, THETA_DEGREE - 1, b.m);

@@ -716,6 +716,45 @@ static void sharp_turn_close_to_the_end_has_its_exact_length(void **state) {
   }
 }
 
+static void closed_rational_curve_with_a_tiny_span_closes(void **state) {
+  (void)state;
+  /* A closed rational cubic whose first span is 1e-9 wide in t and ends in
+   * a nearly degenerate leg (weights 0.01 and 10): the tangent turns by
+   * 2.68 rad there within a length below 1e-15 of the curve's, so the turn
+   * is a corner that must sit exactly on the span's end. A closed curve
+   * ends where it starts and, being simple, turns by 2 pi. */
+  const double kn[10] = {0, 0, 0, 0, 1e-9, 1e-9,
+                         1.000000001, 1.000000001, 1.000000001, 1.000000001};
+  const double cp[12] = {-0.0097656214236667427, -0.00030289158464942399,
+                         0.00016800183108262701, -0.0027754634927901123,
+                         0.0046691081101701368, 0.0002986190585183479,
+                         -0.0077230487525749604, -0.0014888227664606702,
+                         -0.0083865110246433214, 0.0026475928892957957,
+                         -0.0097656214236667427, -0.00030289158464942399};
+  const double w[6] = {0.01, 0.01, 0.01, 0.01, 10, 10};
+  km_curve c;
+  make_curve(&c, 3, 6, kn, cp, w, true);
+  const double rel[2] = {1e-5, 1e-9};
+  for (int i = 0; i < 2; i++) {
+    km_signature sig;
+    sign(&c, rel[i], &sig);
+    double tol = rel[i] * sig.length, end[2];
+    assert_close(sig.turning, 2 * M_PI, 1e-9);
+    signature_end(&sig, end);
+    assert_close(end[0], cp[0], tol);
+    assert_close(end[1], cp[1], tol);
+    /* every corner lies on a breakpoint of kappa */
+    for (size_t k = 0; k < sig.ncorners; k++) {
+      bool on = false;
+      for (size_t j = 0; j < sig.kappa.n + (size_t)sig.kappa.degree + 1; j++)
+        on = on || sig.kappa.knots[j] == sig.corners[k].s;
+      assert_true(on);
+    }
+    km_signature_free(&sig);
+  }
+  km_curve_free(&c);
+}
+
 
 int main(void) {
   const struct CMUnitTest tests[] = {
@@ -736,6 +775,7 @@ int main(void) {
       cmocka_unit_test(zero_length_curve_is_degenerate),
       cmocka_unit_test(curve_create_rejects_bad_input_naming_the_field),
       cmocka_unit_test(sharp_turn_close_to_the_end_has_its_exact_length),
+      cmocka_unit_test(closed_rational_curve_with_a_tiny_span_closes),
   };
   return cmocka_run_group_tests_name("signature", tests, NULL, NULL);
 }
