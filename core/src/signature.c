@@ -16,7 +16,14 @@
  *     their arc-length images and curvature jumps at C1 knots survive.
  *   - Where the one-sided tangents at a knot differ, the turn is a corner;
  *     a turn of (nearly) pi is a cusp and is refused.
+ *   - Everything computed from the curve carries the rounding of its
+ *     coordinates: C' within a few times its rounding error gives no
+ *     direction, lengths are asked no more precisely than that error
+ *     allows, and the tolerance is raised to it (limits.h). A curve far
+ *     from the origin is thus handled at the precision it has, not
+ *     refined into noise.
  */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -175,6 +182,8 @@ typedef struct builder {
   km__bspan span;       /* the current span in Bezier form */
   double deriv_noise;   /* rounding error of |C'| in this span */
   long budget;          /* fit_piece calls left: bounds adversarial input */
+  double free_len;      /* position error left for pieces taken as turning
+                           uniformly (twice their length) */
   km_error *err;
 } builder;
 
@@ -284,6 +293,18 @@ static bool tangent_limit(const builder *b, double t, int side,
   return true;
 }
 
+/* Rounding error of the speed |dC/du| in a span, about 8 p eps M for
+ * points of magnitude up to M (a few times more where a rational span's
+ * weights vary widely): it bounds the precision of any length and
+ * direction computed there. */
+static double span_noise(const km__bspan *sp) {
+  double M = 0.0;
+  for (int q = 0; q <= sp->degree; q++)
+    M = fmax(M, fmax(fabs(sp->h[q][0]), fabs(sp->h[q][1])) /
+                    fmax(sp->h[q][2], 1e-300));
+  return 8.0 * DBL_EPSILON * sp->degree * M;
+}
+
 /* arc length inside the current span, in its own variable u */
 static double span_length(const builder *b, double ua, double ub) {
   /* relative to the piece, not the curve: near a sharp tip pieces are
@@ -292,6 +313,12 @@ static double span_length(const builder *b, double ua, double ub) {
   double a = b->span.a, w = b->span.b - a;
   return km__bspan_length(&b->span, (ua - a) / w, (ub - a) / w,
                           1e-14 * (ub - ua) * b->span_speed);
+}
+
+/* Bernstein coefficients of theta linear in s from th0 to th1. */
+static void linear_theta(double th0, double th1, double *coef) {
+  for (int j = 0; j <= THETA_DEGREE; j++)
+    coef[j] = th0 + (th1 - th0) * j / THETA_DEGREE;
 }
 
 /* Cumulative integral of f sampled at the Chebyshev-Lobatto points
@@ -406,7 +433,9 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
                     "the arc length near parameter t = %g cannot be computed "
                     "to full precision",
                     ua);
-  if (fabs(h - ref) > 1e-12 * ref + 1e-16 * b->L) {
+  /* the lengths agree to their rounding: the speed's, deriv_noise, over
+   * the piece, and a few ulps */
+  if (fabs(h - ref) > 1e-12 * ref + 1e-16 * b->L + b->deriv_noise * (ub - ua)) {
     /* the speed is not resolved by the nodes (near-degenerate leg) */
     for (int k = 1; k < NPTS; k++)
       s[k] = s[k - 1] + span_length(b, t[k - 1], t[k]);
@@ -497,6 +526,27 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
         ok = false;
     }
   }
+  if (!ok && !coarse) {
+    /* Where theta moves less than its rounding noise (a speed near zero,
+     * coordinates far from the origin) the interpolant through noisy
+     * values swings and bisecting only samples more noise: theta linear
+     * in s is accepted when it meets every node and check point. */
+    bool lin = true;
+    for (int k = 1; lin && k < NPTS - 1; k++)
+      lin = fabs(th[0] + (th[NPTS - 1] - th[0]) * ((s[k] - s[0]) / h) - th[k]) <=
+            tol_here;
+    if (lin) {
+      linear_theta(th[0], th[NPTS - 1], coef);
+      ok = true;
+    }
+  }
+  if (!ok && noise >= 0.1 && big_step < KM_PI - 0.5 &&
+      2.0 * h <= b->free_len) {
+    /* directions that are noise, on a piece short enough (see free_len) */
+    b->free_len -= 2.0 * h;
+    linear_theta(th[0], th[NPTS - 1], coef);
+    ok = true;
+  }
   if (!ok && (depth >= KM_MAX_REFINE_DEPTH || tiny_t)) {
     /* cannot resolve further: acceptable only if theta barely moves */
     double lo = th[0], hi = th[0];
@@ -510,8 +560,7 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
                       "curvature could not be resolved near parameter t = "
                       "%g",
                       mid);
-    for (int j = 0; j <= THETA_DEGREE; j++)
-      coef[j] = th[0] + (th[NPTS - 1] - th[0]) * j / THETA_DEGREE;
+    linear_theta(th[0], th[NPTS - 1], coef);
     ok = true;
   }
   if (ok) {
@@ -592,7 +641,32 @@ km_status km_signature_compute(const km_curve *c, double tol,
   }
   b.L = L;
   if (!(tol > 0) || !isfinite(tol)) tol = 1e-5 * L;
-  if (tol < KM_MIN_RELATIVE_TOLERANCE * L) tol = KM_MIN_RELATIVE_TOLERANCE * L;
+  /* Nor below the rounding of the curve itself (limits.h). A curve too
+   * small for its distance from the origin to meet even the default
+   * tolerance (1e-5 of its length) is refused: its shape is rounding
+   * noise at that scale. */
+  double tol_min = fmax(KM_MIN_RELATIVE_TOLERANCE * L,
+                        KM_MIN_TOLERANCE_ULPS * DBL_EPSILON * c->degree * extent);
+  if (tol < tol_min) {
+    if (tol_min > 1e-5 * L) {
+      st = km__fail(err, KM_ERANGE, KM_FIELD_CONTROL_POINTS, -1, NAN,
+                    "the curve (length %g) is too small for its distance "
+                    "from the origin (coordinates up to %g): its shape is "
+                    "known to less than a tolerance of %g; move it nearer "
+                    "the origin",
+                    L, extent, tol_min);
+      goto cleanup;
+    }
+    tol = tol_min;
+  }
+  /* Where no interpolant meets the checks because the directions are
+   * rounding noise (off by a tenth of a radian or more somewhere: a speed
+   * within ten times its rounding error) but do not reverse (a cusp is
+   * refused, not smoothed), a short piece may be taken as turning
+   * uniformly between its end directions: that moves the curve by at most
+   * twice its length, and all such pieces together may cost a twentieth
+   * of the tolerance. */
+  b.free_len = 0.05 * tol;
   b.tol_theta = fmin(0.25 * tol / L, 1e-3);
 
   double s_at = 0.0, theta = 0.0, start_angle = 0.0;
@@ -604,17 +678,14 @@ km_status km_signature_compute(const km_curve *c, double tol,
     if (!(ub > ua)) continue;
     double len = span_len[i];
     if (!(len > 1e-15 * L)) continue; /* a span that is a single point */
-    b.span_t = ub - ua;
     km__bspan_make(&b.span, c, i);
+    /* or one whose length is its rounding error: equal control points
+     * far from the origin; the turn across it is checked as a corner */
+    double noise = span_noise(&b.span);
+    if (!(len > noise)) continue;
+    b.span_t = ub - ua;
     b.span_speed = len / (ub - ua);
-    {
-      /* |C'| is p/h times differences of points of magnitude up to M */
-      double M = 0.0;
-      for (int q = 0; q <= c->degree; q++)
-        M = fmax(M, fmax(fabs(b.span.h[q][0]), fabs(b.span.h[q][1])) /
-                        fmax(b.span.h[q][2], 1e-300));
-      b.deriv_noise = 8.0 * 2.220446049250313e-16 * c->degree * M / (ub - ua);
-    }
+    b.deriv_noise = noise / (ub - ua); /* of |C'| */
     double da[2], db[2];
     if (!tangent_limit(&b, ua, 1, da) || !tangent_limit(&b, ub, -1, db)) {
       st = km__fail(err, KM_EDEGENERATE, KM_FIELD_CONTROL_POINTS, -1, ua,

@@ -716,6 +716,65 @@ static void sharp_turn_close_to_the_end_has_its_exact_length(void **state) {
   }
 }
 
+static void high_order_degenerate_ends_take_the_first_distinct_point(
+    void **state) {
+  (void)state;
+  /* A degree-9 Bezier R R R R S S T T T T: C - R ~ (S - R) u^4 at the
+   * start and C - T ~ (S - T) (1-u)^4 at the end, and C' is a positive
+   * combination of S - R and T - S, so the tangent turns monotonically
+   * from the direction of S - R to that of T - S (173 degrees here, never
+   * reversing). The first three derivatives vanish at both ends, and at
+   * coordinates near 1e15 a chord short enough to stand for the tangent is
+   * lost in rounding. */
+  const double R[2] = {-894895856175555.1, -975982298534599.8};
+  const double S[2] = {484367133066834.56, 745204853368963.1};
+  const double T[2] = {-414511328823758.25, -700495917211642.6};
+  double cp[20], kn[20];
+  for (int i = 0; i < 10; i++) {
+    const double *P = i < 4 ? R : i < 6 ? S : T;
+    cp[2 * i] = P[0];
+    cp[2 * i + 1] = P[1];
+    kn[i] = 0.0;
+    kn[10 + i] = 1.0;
+  }
+  km_curve c;
+  make_curve(&c, 9, 10, kn, cp, NULL, false);
+  double L = km_curve_length(&c);
+  km_signature sig;
+  sign_abs(&c, 1e-13 * L, &sig);
+  assert_close(tu_wrap(sig.angle - atan2(S[1] - R[1], S[0] - R[0])), 0, 1e-12);
+  assert_close(sig.turning,
+               tu_turn(S[0] - R[0], S[1] - R[1], T[0] - S[0], T[1] - S[1]),
+               1e-9);
+  assert_ncorners(&sig, 0);
+  double end[2];
+  signature_end(&sig, end);
+  assert_close(end[0], T[0], 1e-12 * L);
+  assert_close(end[1], T[1], 1e-12 * L);
+  km_signature_free(&sig);
+  km_curve_free(&c);
+
+  /* C(t) = (t^4, t^5) on [0, 1] as a degree-9 Bezier: its tangent starts
+   * along +x exactly, ends at angle atan(5/4), and
+   *   L = [(2/5) u^(5/2) - (32/3) u^(3/2)] / 1250, u = 16 + 25 t^2. */
+  const double px[6] = {0, 0, 0, 0, 1, 0}, py[6] = {0, 0, 0, 0, 0, 1};
+  tu_poly_to_bspline(px, 5, 9, kn, 10, cp, 2);
+  tu_poly_to_bspline(py, 5, 9, kn, 10, cp + 1, 2);
+  make_curve(&c, 9, 10, kn, cp, NULL, false);
+  double u1 = 41, u0 = 16;
+  L = (0.4 * pow(u1, 2.5) - 32.0 / 3 * pow(u1, 1.5) -
+       (0.4 * pow(u0, 2.5) - 32.0 / 3 * pow(u0, 1.5))) / 1250;
+  sign_abs(&c, 1e-11 * L, &sig);
+  assert_close(sig.length, L, 1e-14 * L);
+  assert_close(sig.angle, 0.0, 1e-15);
+  assert_close(sig.turning, atan(1.25), 1e-12);
+  signature_end(&sig, end);
+  assert_close(end[0], 1.0, 1e-11 * L);
+  assert_close(end[1], 1.0, 1e-11 * L);
+  km_signature_free(&sig);
+  km_curve_free(&c);
+}
+
 static void closed_rational_curve_with_a_tiny_span_closes(void **state) {
   (void)state;
   /* A closed rational cubic whose first span is 1e-9 wide in t and ends in
@@ -755,6 +814,50 @@ static void closed_rational_curve_with_a_tiny_span_closes(void **state) {
   km_curve_free(&c);
 }
 
+/* km_signature_compute on ctx at tolerance 1e-12: its status, negated. */
+static int tight_signature_status(void *ctx) {
+  km_signature sig;
+  km_error err;
+  km_signature_init(&sig);
+  km_status st = km_signature_compute(ctx, 1e-12, &sig, &err);
+  if (st == KM_OK) km_signature_free(&sig);
+  return -(int)st;
+}
+
+static void curve_far_from_the_origin_keeps_to_its_rounding(void **state) {
+  (void)state;
+  /* A unit circle about (1e6, 1e6): its points are known to about 1e-10,
+   * so a tolerance of 1e-12 is raised to the curve's rounding instead of
+   * refining into noise; length 2 pi, curvature 1, turning 2 pi. */
+  double kn[12], cp[18], w[9];
+  tu_circle_nurbs(1e6, 1e6, 1.0, 1, kn, cp, w);
+  km_curve c;
+  make_curve(&c, 2, 9, kn, cp, w, true);
+  assert_int_equal(tu_run_bounded(tight_signature_status, &c, 5), 0);
+  km_signature sig;
+  sign_abs(&c, 1e-12, &sig);
+  assert_close(sig.length, 2 * M_PI, 1e-8);
+  assert_close(sig.turning, 2 * M_PI, 1e-9);
+  for (int i = 0; i <= 100; i++)
+    assert_close(km_fn_value(&sig.kappa, sig.length * i / 100), 1.0, 1e-3);
+  double end[2];
+  signature_end(&sig, end);
+  assert_close(end[0], cp[0], 1e-7);
+  assert_close(end[1], cp[1], 1e-7);
+  km_signature_free(&sig);
+  km_curve_free(&c);
+
+  /* A circle of radius 1e-6 there: its shape is below the rounding of its
+   * coordinates even at the default tolerance, and it is refused */
+  tu_circle_nurbs(1e6, 1e6, 1e-6, 1, kn, cp, w);
+  make_curve(&c, 2, 9, kn, cp, w, true);
+  assert_int_equal(tu_run_bounded(tight_signature_status, &c, 5), -KM_ERANGE);
+  km_error err;
+  km_signature_init(&sig);
+  assert_status(km_signature_compute(&c, 0.0, &sig, &err), KM_ERANGE);
+  assert_int_equal(err.field, KM_FIELD_CONTROL_POINTS);
+  km_curve_free(&c);
+}
 
 int main(void) {
   const struct CMUnitTest tests[] = {
@@ -775,7 +878,10 @@ int main(void) {
       cmocka_unit_test(zero_length_curve_is_degenerate),
       cmocka_unit_test(curve_create_rejects_bad_input_naming_the_field),
       cmocka_unit_test(sharp_turn_close_to_the_end_has_its_exact_length),
+      cmocka_unit_test(
+          high_order_degenerate_ends_take_the_first_distinct_point),
       cmocka_unit_test(closed_rational_curve_with_a_tiny_span_closes),
+      cmocka_unit_test(curve_far_from_the_origin_keeps_to_its_rounding),
   };
   return cmocka_run_group_tests_name("signature", tests, NULL, NULL);
 }

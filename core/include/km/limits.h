@@ -24,6 +24,14 @@
  * answer is rounding noise, so tighter requests are clamped to it. */
 #define KM_MIN_RELATIVE_TOLERANCE 1e-13
 
+/* Nor below the rounding of the curve itself: its points are known to a
+ * few ulps of its largest coordinate M, and directions computed from them
+ * move a span by up to 8 p ulps of M (p the degree). A signature's
+ * tolerance is at least KM_MIN_TOLERANCE_ULPS * p * DBL_EPSILON * M; a
+ * curve so small beside its distance from the origin that this exceeds
+ * the default tolerance (1e-5 of its length) is refused (KM_ERANGE). */
+#define KM_MIN_TOLERANCE_ULPS 16
+
 /* Output pieces one signature or reconstruction may create. Bounds memory
  * and time for adversarial input (~100 bytes a piece). */
 #define KM_MAX_PIECES 2000000
