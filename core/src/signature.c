@@ -22,6 +22,9 @@
  *     allows, and the tolerance is raised to it (limits.h). A curve far
  *     from the origin is thus handled at the precision it has, not
  *     refined into noise.
+ *   - The work is counted in evaluations of the curve, for the whole curve
+ *     and for each span (limits.h): a span that would need more is refused
+ *     with KM_ELIMIT quickly, whatever the rest of the curve.
  */
 #include <float.h>
 #include <math.h>
@@ -169,6 +172,7 @@ double km_signature_bending_energy(const km_signature *sig) {
 typedef struct builder {
   const km_curve *c;
   double L;         /* total length */
+  double tol;       /* allowed distance to the curve */
   double tol_theta; /* allowed |theta - theta~| */
   double span_t;    /* width in t of the span being processed */
   double span_speed; /* its mean speed: the scale of |C'| there */
@@ -181,7 +185,8 @@ typedef struct builder {
   size_t span_first;    /* index of the current span's first piece */
   km__bspan span;       /* the current span in Bezier form */
   double deriv_noise;   /* rounding error of |C'| in this span */
-  long budget;          /* fit_piece calls left: bounds adversarial input */
+  long work;            /* curve evaluations left for the whole curve */
+  long span_work;       /* and for the span being processed */
   double free_len;      /* position error left for pieces taken as turning
                            uniformly (twice their length) */
   km_error *err;
@@ -305,14 +310,60 @@ static double span_noise(const km__bspan *sp) {
   return 8.0 * DBL_EPSILON * sp->degree * M;
 }
 
+/* The same integrated over a part of the span, for lengths: the speed of
+ * a rational span is p w0 w1 / w^2 |P1 - P0| (km__bspan_eval_u), and its
+ * rounding follows the weight factor, which may reach the ratio of the
+ * extreme weights at a point but integrates to a few units over the span:
+ * four times the plain bound covers it. */
+static double span_length_noise(const km__bspan *sp) {
+  if (!sp->rational) return span_noise(sp);
+  double wmax = 0.0, wmin = INFINITY;
+  for (int q = 0; q <= sp->degree; q++) {
+    wmax = fmax(wmax, sp->h[q][2]);
+    wmin = fmin(wmin, sp->h[q][2]);
+  }
+  return span_noise(sp) * fmin(wmax / wmin, 4.0);
+}
+
+/* The speed in a span's variable u, counting evaluations: the work budget
+ * is spent in evaluations, wherever they are made. */
+typedef struct counted_span {
+  const km__bspan *sp;
+  long evals;
+} counted_span;
+
+static double counted_speed(const void *ctx, double u) {
+  counted_span *cs = (counted_span *)ctx;
+  double p[2], d[2];
+  cs->evals++;
+  km__bspan_eval_u(cs->sp, u, p, d);
+  return sqrt(d[0] * d[0] + d[1] * d[1]);
+}
+
+/* Arc length of sp over [u0, u1] to abs_tol or to its rounding (noise per
+ * unit u), whichever is larger; NaN where even that cannot be reached. */
+static double counted_length(const km__bspan *sp, double u0, double u1,
+                             double abs_tol, double noise, long *evals) {
+  counted_span cs = {sp, 0};
+  double len = km__integrate_adaptive(counted_speed, &cs, u0, u1,
+                                      fmax(abs_tol, noise * (u1 - u0)));
+  *evals += cs.evals;
+  return len;
+}
+
 /* arc length inside the current span, in its own variable u */
-static double span_length(const builder *b, double ua, double ub) {
+static double span_length(builder *b, double ua, double ub) {
   /* relative to the piece, not the curve: near a sharp tip pieces are
    * many orders of magnitude shorter than the curve and their node
    * positions need their own digits */
   double a = b->span.a, w = b->span.b - a;
-  return km__bspan_length(&b->span, (ua - a) / w, (ub - a) / w,
-                          1e-14 * (ub - ua) * b->span_speed);
+  long evals = 0;
+  double len = counted_length(&b->span, (ua - a) / w, (ub - a) / w,
+                              1e-14 * (ub - ua) * b->span_speed,
+                              span_length_noise(&b->span), &evals);
+  b->work -= evals;
+  b->span_work -= evals;
+  return len;
 }
 
 /* Bernstein coefficients of theta linear in s from th0 to th1. */
@@ -366,11 +417,20 @@ static void cheb_cumulative(const double *f, int n, double *F) {
 static km_status fit_piece(builder *b, double ua, double ub, double known_len,
                            double *s_at, double *theta, const double dir_a[2],
                            const double dir_b[2], int depth) {
-  if (--b->budget < 0)
+  if (b->span_work < 0)
     return km__fail(b->err, KM_ELIMIT, KM_FIELD_TOLERANCE, -1, ua,
-                    "the curve needs too many pieces at this tolerance (near "
-                    "parameter t = %g): loosen the tolerance",
-                    ua);
+                    "the curve needs too much work at tolerance %g near "
+                    "parameter t = %g (its directions there are not "
+                    "resolved in double precision): loosen the tolerance",
+                    b->tol, ua);
+  if (b->work < 0)
+    return km__fail(b->err, KM_ELIMIT, KM_FIELD_TOLERANCE, -1, ua,
+                    "the curve needs too many pieces at tolerance %g (the "
+                    "work ran out near parameter t = %g): loosen the "
+                    "tolerance",
+                    b->tol, ua);
+  b->work -= NPTS;
+  b->span_work -= NPTS;
   double t[NPTS], th[NPTS], s[NPTS], dir[NPTS][2];
   double mid = 0.5 * (ua + ub), half = 0.5 * (ub - ua);
   for (int k = 0; k < NPTS; k++)
@@ -602,7 +662,7 @@ km_status km_signature_compute(const km_curve *c, double tol,
   b.c = c;
   b.err = err;
   b.pending_start = NAN;
-  b.budget = 50000 + 100 * (long)c->n;
+  b.work = KM_SIGNATURE_WORK_BASE + KM_SIGNATURE_WORK_PER_POINT * (long)c->n;
   km_status st = KM_OK;
   km_pp kp;
   km__pp_init(&kp);
@@ -620,7 +680,10 @@ km_status km_signature_compute(const km_curve *c, double tol,
     if (c->knots[i + 1] > c->knots[i]) {
       km__bspan sp;
       km__bspan_make(&sp, c, i);
-      span_len[i] = km__bspan_length(&sp, 0.0, 1.0, 1e-15 * poly);
+      long evals = 0;
+      span_len[i] = counted_length(&sp, 0.0, 1.0, 1e-15 * poly,
+                                   span_length_noise(&sp), &evals);
+      b.work -= evals;
     }
     L += span_len[i];
     if (isnan(L)) break; /* reported below; no more work for this curve */
@@ -667,6 +730,7 @@ km_status km_signature_compute(const km_curve *c, double tol,
    * twice its length, and all such pieces together may cost a twentieth
    * of the tolerance. */
   b.free_len = 0.05 * tol;
+  b.tol = tol;
   b.tol_theta = fmin(0.25 * tol / L, 1e-3);
 
   double s_at = 0.0, theta = 0.0, start_angle = 0.0;
@@ -686,6 +750,7 @@ km_status km_signature_compute(const km_curve *c, double tol,
     b.span_t = ub - ua;
     b.span_speed = len / (ub - ua);
     b.deriv_noise = noise / (ub - ua); /* of |C'| */
+    b.span_work = KM_SIGNATURE_WORK_PER_SPAN;
     double da[2], db[2];
     if (!tangent_limit(&b, ua, 1, da) || !tangent_limit(&b, ub, -1, db)) {
       st = km__fail(err, KM_EDEGENERATE, KM_FIELD_CONTROL_POINTS, -1, ua,
