@@ -251,15 +251,20 @@ static bool tangent_limit(const builder *b, double t, int side,
   km_curve_eval_side(b->c, t, side, 3, d);
   double scale = b->span_speed;
   double tiny = 1e-10 * scale;
+  /* and above the rounding of the derivative: at a point where C' vanishes
+   * to high order its computed value is noise, whatever its size beside
+   * the span's speed */
+  double noise = 16.0 * b->deriv_noise;
   for (int k = 1; k <= 3; k++) {
     double n = hypot(d[k][0], d[k][1]);
-    if (n > tiny) {
+    if (n > fmax(tiny, noise)) {
       double sg = (side < 0 && (k % 2 == 0)) ? -1.0 : 1.0;
       dir[0] = sg * d[k][0] / n;
       dir[1] = sg * d[k][1] / n;
       return true;
     }
     tiny /= fmax(b->span_t, 1e-300);
+    noise *= b->c->degree / fmax(b->span_t, 1e-300);
   }
   /* At an end of the current span the first control point of its Bezier
    * form that differs from the end point gives the direction: C - P0 is
