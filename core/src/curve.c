@@ -548,19 +548,25 @@ static double bspan_speed_u(const void *ctx, double u) {
 double km__bspan_length(const km__bspan *sp, double u0, double u1,
                         double abs_tol) {
   /* The speed is computed from points of magnitude up to M: its rounding
-   * error, about 8 p eps M (up to four times that, integrated, where a
-   * rational span's weights vary widely: the weight factor of its speed
-   * integrates to a few units), bounds the precision any length can have
-   * (a short span far from the origin); asking for more only refines into
-   * noise. */
+   * error, about 8 p eps M, bounds the precision any length can have (a
+   * short span far from the origin); asking for more only refines into
+   * noise. A rational span's speed carries the weight factor p w0 w1 /
+   * w^2 (km__bspan_eval_u), and its rounding with it: up to the ratio r of
+   * the extreme weights at a point, a few units integrated over the span.
+   * Four times the bound is asked first; where that is still below the
+   * local noise, r times it, the most the noise can be. */
   double M = 0.0, wmax = 0.0, wmin = INFINITY;
   for (int k = 0; k <= sp->degree; k++) {
     M = fmax(M, fmax(fabs(sp->h[k][0]), fabs(sp->h[k][1])) / sp->h[k][2]);
     wmax = fmax(wmax, sp->h[k][2]);
     wmin = fmin(wmin, sp->h[k][2]);
   }
-  if (sp->rational) M *= fmin(wmax / wmin, 4.0);
+  double r = sp->rational ? wmax / wmin : 1.0;
   double noise = 8.0 * DBL_EPSILON * sp->degree * M * (u1 - u0);
-  return km__integrate_adaptive(bspan_speed_u, sp, u0, u1,
-                                fmax(abs_tol, noise));
+  double len = km__integrate_adaptive(bspan_speed_u, sp, u0, u1,
+                                      fmax(abs_tol, noise * fmin(r, 4.0)));
+  if (isnan(len) && r > 4.0)
+    len = km__integrate_adaptive(bspan_speed_u, sp, u0, u1,
+                                 fmax(abs_tol, noise * r));
+  return len;
 }

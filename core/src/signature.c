@@ -304,8 +304,8 @@ static bool tangent_limit(const builder *b, double t, int side,
 }
 
 /* Rounding error of the speed |dC/du| in a span, about 8 p eps M for
- * points of magnitude up to M (a few times more where a rational span's
- * weights vary widely): it bounds the precision of any length and
+ * points of magnitude up to M (more where a rational span's weights vary
+ * widely, see counted_length): it bounds the precision of any length and
  * direction computed there. */
 static double span_noise(const km__bspan *sp) {
   double M = 0.0;
@@ -313,21 +313,6 @@ static double span_noise(const km__bspan *sp) {
     M = fmax(M, fmax(fabs(sp->h[q][0]), fabs(sp->h[q][1])) /
                     fmax(sp->h[q][2], 1e-300));
   return 8.0 * DBL_EPSILON * sp->degree * M;
-}
-
-/* The same integrated over a part of the span, for lengths: the speed of
- * a rational span is p w0 w1 / w^2 |P1 - P0| (km__bspan_eval_u), and its
- * rounding follows the weight factor, which may reach the ratio of the
- * extreme weights at a point but integrates to a few units over the span:
- * four times the plain bound covers it. */
-static double span_length_noise(const km__bspan *sp) {
-  if (!sp->rational) return span_noise(sp);
-  double wmax = 0.0, wmin = INFINITY;
-  for (int q = 0; q <= sp->degree; q++) {
-    wmax = fmax(wmax, sp->h[q][2]);
-    wmin = fmin(wmin, sp->h[q][2]);
-  }
-  return span_noise(sp) * fmin(wmax / wmin, 4.0);
 }
 
 /* The speed in a span's variable u, counting evaluations: the work budget
@@ -345,13 +330,24 @@ static double counted_speed(const void *ctx, double u) {
   return sqrt(d[0] * d[0] + d[1] * d[1]);
 }
 
-/* Arc length of sp over [u0, u1] to abs_tol or to its rounding (noise per
- * unit u), whichever is larger; NaN where even that cannot be reached. */
+/* Arc length of sp over [u0, u1] to abs_tol or to its rounding, as
+ * km__bspan_length (which see), counting the evaluations into *evals; NaN
+ * where even that cannot be reached. */
 static double counted_length(const km__bspan *sp, double u0, double u1,
-                             double abs_tol, double noise, long *evals) {
+                             double abs_tol, long *evals) {
+  double wmax = 0.0, wmin = INFINITY;
+  for (int q = 0; q <= sp->degree; q++) {
+    wmax = fmax(wmax, sp->h[q][2]);
+    wmin = fmin(wmin, sp->h[q][2]);
+  }
+  double r = sp->rational ? wmax / wmin : 1.0;
+  double noise = span_noise(sp) * (u1 - u0);
   counted_span cs = {sp, 0};
   double len = km__integrate_adaptive(counted_speed, &cs, u0, u1,
-                                      fmax(abs_tol, noise * (u1 - u0)));
+                                      fmax(abs_tol, noise * fmin(r, 4.0)));
+  if (isnan(len) && r > 4.0)
+    len = km__integrate_adaptive(counted_speed, &cs, u0, u1,
+                                 fmax(abs_tol, noise * r));
   *evals += cs.evals;
   return len;
 }
@@ -364,8 +360,7 @@ static double span_length(builder *b, double ua, double ub) {
   double a = b->span.a, w = b->span.b - a;
   long evals = 0;
   double len = counted_length(&b->span, (ua - a) / w, (ub - a) / w,
-                              1e-14 * (ub - ua) * b->span_speed,
-                              span_length_noise(&b->span), &evals);
+                              1e-14 * (ub - ua) * b->span_speed, &evals);
   b->work -= evals;
   b->span_work -= evals;
   return len;
@@ -686,8 +681,7 @@ km_status km_signature_compute(const km_curve *c, double tol,
       km__bspan sp;
       km__bspan_make(&sp, c, i);
       long evals = 0;
-      span_len[i] = counted_length(&sp, 0.0, 1.0, 1e-15 * poly,
-                                   span_length_noise(&sp), &evals);
+      span_len[i] = counted_length(&sp, 0.0, 1.0, 1e-15 * poly, &evals);
       b.work -= evals;
     }
     L += span_len[i];
