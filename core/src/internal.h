@@ -84,6 +84,11 @@ int km__cmp_double(const void *a, const void *b);
 void km__fft_twiddles(int n, double *tw);
 void km__fft(double *re, double *im, int n, const double *tw, bool inverse);
 
+/* F[k] = integral from -1 to x_k of the degree-14 interpolant of f at the
+ * 15 Chebyshev-Lobatto points x_k = -cos(k pi / 14) of [-1, 1] (the
+ * signature's nodes). */
+void km__cheb_cumulative15(const double *f, double *F);
+
 /* Wrap an angle to (-pi, pi]. */
 double km__wrap_angle(double a);
 
@@ -124,6 +129,12 @@ double km__pp_integral_sq(const km_pp *p);
 /* out(u0 + r (u1-u0)) = wa a(r over a's domain) + wb b(r over b's), exact. */
 km_status km__pp_blend(km_pp *out, const km_pp *a, double wa, const km_pp *b,
                        double wb, double u0, double u1);
+/* Pieces merged into runs of degree max(degree, p's) that stay within delta
+ * of p everywhere (a rigorous bound, from Bernstein coefficients); runs do
+ * not cross a jump of p larger than delta / 4. The caller frees out. */
+km_status km__pp_merge(const km_pp *p, int degree, double delta, km_pp *out);
+/* Derivative of every piece (degree one lower; 0 stays 0). */
+km_status km__pp_derivative(const km_pp *p, km_pp *out);
 
 
 /* theta(s) of a signature as pieces (breaks at kappa's breaks and at the

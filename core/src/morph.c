@@ -661,10 +661,10 @@ static km_status plan_frames(km_morph *m, km_error *err) {
     m->close_by_corners = lsq && corners && corners_close(m);
     return KM_OK;
   }
-  const km_pp kp[2] = {a->kappa, b->kappa}, tp[2] = {a->theta, b->theta};
+  const km_pp tp[2] = {a->theta, b->theta};
   double len[2] = {a->sig.length, b->sig.length};
   double ang[2] = {a->sig.angle, b->sig.angle};
-  km_status st = km__frame_plan_build(&m->plan, kp, tp, len, ang, m->closed,
+  km_status st = km__frame_plan_build(&m->plan, tp, len, ang, m->closed,
                                       m->tol, err);
   if (!st) m->close_by_corners = lsq && km__frame_plan_by_corners(m->plan);
   return st;

@@ -37,6 +37,8 @@
 #define NF (KM__CLOSURE_INTERVALS - 3)
 #define MAX_RULE 8      /* highest Gauss-Legendre order used */
 #define NDER (2 * MAX_RULE)
+#define MERGE_DEGREE 7   /* of theta on merged input pieces */
+#define MERGE_SHARE 0.1  /* of the tolerance, for merging them */
 
 typedef struct gnode {
   double w;      /* weight in r */
@@ -348,13 +350,17 @@ static bool corner_closure(const km__frame_plan *p, double t, double *sum,
                            double *tau, double *delta, double *S,
                            double *dp);
 
-km_status km__frame_plan_build(km__frame_plan **out, const km_pp kappa[2],
-                               const km_pp theta[2], const double length[2],
+km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const double length[2],
                                const double angle[2], bool closed, double tol,
                                km_error *err) {
   km_status st = KM_OK;
   double *br = NULL, *Dall = NULL;
   vec atoms = {NULL, 0, 0, sizeof(atom)}, nodes = {NULL, 0, 0, sizeof(gnode)};
+  km_pp mt[2], mk[2];
+  for (int w = 0; w < 2; w++) {
+    km__pp_init(&mt[w]);
+    km__pp_init(&mk[w]);
+  }
   gl_rules *g = malloc(sizeof *g);
   km__frame_plan *p = calloc(1, sizeof *p);
   if (!p || !g) {
@@ -362,14 +368,22 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp kappa[2],
     goto fail;
   }
   gl_make(g);
+  double Lmax = fmax(length[0], length[1]);
+  /* The inputs' pieces merged where one polynomial carries them within
+   * MERGE_SHARE of the tolerance in position (|dC| <= L |d theta|): a
+   * signature breaks at every knot of its curve, and every merged break of
+   * the two inputs would otherwise cost output pieces and quadrature
+   * nodes in every frame. */
   side sd[2];
   for (int w = 0; w < 2; w++) {
-    sd[w].kappa = &kappa[w];
-    sd[w].theta = &theta[w];
+    st = km__pp_merge(&theta[w], MERGE_DEGREE, MERGE_SHARE * tol / Lmax, &mt[w]);
+    if (!st) st = km__pp_derivative(&mt[w], &mk[w]);
+    if (st) goto fail;
+    sd[w].kappa = &mk[w];
+    sd[w].theta = &mt[w];
     sd[w].L = length[w];
     sd[w].angle = angle[w];
   }
-  double Lmax = fmax(length[0], length[1]);
   p->La = length[0];
   p->Lb = length[1];
   p->tol = tol;
@@ -379,7 +393,7 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp kappa[2],
     goto fail;
   }
   /* merged breaks of both inputs in r */
-  size_t nbr = theta[0].m + theta[1].m + 2;
+  size_t nbr = mt[0].m + mt[1].m + 2;
   br = malloc(nbr * sizeof(double));
   if (!br) {
     st = KM_ENOMEM;
@@ -387,7 +401,7 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp kappa[2],
   }
   size_t q = 0;
   for (int w = 0; w < 2; w++)
-    for (size_t i = 0; i <= theta[w].m; i++) br[q++] = theta[w].x[i] / length[w];
+    for (size_t i = 0; i <= mt[w].m; i++) br[q++] = mt[w].x[i] / length[w];
   qsort(br, q, sizeof(double), cmp_dbl);
   size_t m = 0;
   for (size_t i = 0; i < q; i++) {
@@ -585,6 +599,10 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp kappa[2],
   free(br);
   free(Dall);
   free(g);
+  for (int w = 0; w < 2; w++) {
+    km__pp_free(&mt[w]);
+    km__pp_free(&mk[w]);
+  }
   *out = p;
   return KM_OK;
 fail:
@@ -593,6 +611,10 @@ fail:
   free(br);
   free(Dall);
   free(g);
+  for (int w = 0; w < 2; w++) {
+    km__pp_free(&mt[w]);
+    km__pp_free(&mk[w]);
+  }
   km__frame_plan_free(p);
   return km__fail(err, st, KM_FIELD_TOLERANCE, -1, NAN,
                   st == KM_ELIMIT ? "the frames need too many pieces at this "

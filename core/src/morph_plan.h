@@ -19,13 +19,12 @@
 
 typedef struct km__frame_plan km__frame_plan;
 
-/* Plans frames between two inputs given as kappa and theta pieces in their
- * own arc length (km__build_theta), with lengths and start angles. Every
- * frame built from the plan is within tol of the exact frame (tol: the
- * frame tolerance; a half goes to the Hermite pieces, a tenth to the
- * quadrature). */
-km_status km__frame_plan_build(km__frame_plan **out, const km_pp kappa[2],
-                               const km_pp theta[2], const double length[2],
+/* Plans frames between two inputs given as theta pieces in their own arc
+ * length (km__build_theta), with lengths and start angles. Every frame
+ * built from the plan is within tol of the exact frame (tol: the frame
+ * tolerance; a half goes to the Hermite pieces, a tenth to the quadrature
+ * and a tenth to merging the inputs' pieces). */
+km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const double length[2],
                                const double angle[2], bool closed, double tol,
                                km_error *err);
 void km__frame_plan_free(km__frame_plan *p);

@@ -212,3 +212,156 @@ km_status km__pp_to_fn(km_fn *out, const km_pp *p) {
   *out = f;
   return KM_OK;
 }
+
+/* ---- merging pieces ------------------------------------------------------
+ * A signature keeps a break at every knot of its curve, so a smooth curve
+ * of many control points has as many pieces although a few would carry it.
+ * Work that is proportional to the number of pieces (morph frames: every
+ * merged break of two inputs costs quadrature nodes) merges them first:
+ * one polynomial of degree d interpolating p at the Chebyshev-Lobatto
+ * points of a run of pieces replaces the run where it stays within delta of
+ * p. That is checked on the Bernstein coefficients of the difference over
+ * every original piece of the run, which bound the difference there, so
+ * the merged function is within delta of p everywhere, not only where it
+ * was sampled. The interpolant meets p at the run's ends, so continuity is
+ * kept; runs never cross a jump. */
+
+typedef struct merge_fit {
+  int d;
+  double u[KM_MAX_FN_DEGREE + 2];                            /* nodes */
+  double inv[(KM_MAX_FN_DEGREE + 2) * (KM_MAX_FN_DEGREE + 2)]; /* values -> coefficients */
+} merge_fit;
+
+static bool merge_fit_make(merge_fit *mf, int d) {
+  int n = d + 1;
+  double A[(KM_MAX_FN_DEGREE + 2) * (KM_MAX_FN_DEGREE + 2)];
+  double y[KM_MAX_FN_DEGREE + 2];
+  mf->d = d;
+  for (int k = 0; k <= d; k++) mf->u[k] = 0.5 * (1.0 - cos(KM_PI * k / d));
+  mf->u[0] = 0.0;
+  mf->u[d] = 1.0;
+  for (int j = 0; j < n; j++) {
+    for (int k = 0; k < n; k++) km__bernstein_basis(mf->u[k], d, A + k * n);
+    for (int k = 0; k < n; k++) y[k] = k == j ? 1.0 : 0.0;
+    if (!km__solve_dense(A, y, n)) return false;
+    for (int k = 0; k < n; k++) mf->inv[k * n + j] = y[k];
+  }
+  return true;
+}
+
+/* Fits pieces [i0, i1) of p with one polynomial (coefficients into coef)
+ * and returns whether it stays within delta of every piece. */
+static bool merge_try(const km_pp *p, const merge_fit *mf, size_t i0,
+                      size_t i1, double delta, double *coef) {
+  int d = mf->d, n = d + 1, dp = p->degree;
+  double X0 = p->x[i0], W = p->x[i1] - X0, v[KM_MAX_FN_DEGREE + 2];
+  size_t i = i0;
+  for (int k = 0; k < n; k++) {
+    double x = X0 + W * mf->u[k];
+    while (i + 1 < i1 && x >= p->x[i + 1]) i++;
+    double h = p->x[i + 1] - p->x[i];
+    double u = fmin(fmax((x - p->x[i]) / h, 0.0), 1.0);
+    v[k] = km__bern_eval(p->c + i * (size_t)(dp + 1), dp, u);
+  }
+  v[0] = p->c[i0 * (size_t)(dp + 1)];
+  v[d] = p->c[(i1 - 1) * (size_t)(dp + 1) + (size_t)dp];
+  for (int j = 0; j < n; j++) {
+    double s = 0.0;
+    for (int k = 0; k < n; k++) s += mf->inv[j * n + k] * v[k];
+    coef[j] = s;
+  }
+  coef[0] = v[0];
+  coef[d] = v[d];
+  for (i = i0; i < i1; i++) {
+    double r[KM_MAX_FN_DEGREE + 2], o[KM_MAX_FN_DEGREE + 2];
+    km__bern_restrict(coef, d, (p->x[i] - X0) / W, (p->x[i + 1] - X0) / W, r);
+    km__bern_elevate(p->c + i * (size_t)(dp + 1), dp, d, o);
+    for (int j = 0; j < n; j++)
+      if (!(fabs(r[j] - o[j]) <= delta)) return false;
+  }
+  return true;
+}
+
+km_status km__pp_merge(const km_pp *p, int degree, double delta, km_pp *out) {
+  int d = degree > p->degree ? degree : p->degree;
+  size_t m = p->m, dp = (size_t)p->degree;
+  merge_fit *mf = malloc(sizeof *mf);
+  double *x = malloc((m + 1) * sizeof(double));
+  double *c = malloc(m * (size_t)(d + 1) * sizeof(double));
+  km_status st = mf && x && c ? KM_OK : KM_ENOMEM;
+  if (!st && !merge_fit_make(mf, d)) st = KM_ENOCONVERGE;
+  size_t np = 0, i = 0;
+  while (!st && i < m) {
+    /* the run may extend up to the next jump */
+    size_t lim = i + 1;
+    while (lim < m && fabs(p->c[lim * (dp + 1)] - p->c[(lim - 1) * (dp + 1) + dp]) <=
+                          0.25 * delta)
+      lim++;
+    double *coef = c + np * (size_t)(d + 1);
+    size_t good = i + 1, bad = lim + 1;
+    double trial[KM_MAX_FN_DEGREE + 2];
+    /* grow the run geometrically, then bisect between the longest that
+     * fits and the shortest that does not */
+    for (size_t k = 2; i + k <= lim; k *= 2) {
+      if (merge_try(p, mf, i, i + k, delta, trial)) {
+        good = i + k;
+        memcpy(coef, trial, (size_t)(d + 1) * sizeof(double));
+      } else {
+        bad = i + k;
+        break;
+      }
+    }
+    if (bad > lim && good < lim) {
+      if (merge_try(p, mf, i, lim, delta, trial)) {
+        good = lim;
+        memcpy(coef, trial, (size_t)(d + 1) * sizeof(double));
+      } else {
+        bad = lim;
+      }
+    }
+    while (bad - good > 1) {
+      size_t mid = good + (bad - good) / 2;
+      if (merge_try(p, mf, i, mid, delta, trial)) {
+        good = mid;
+        memcpy(coef, trial, (size_t)(d + 1) * sizeof(double));
+      } else {
+        bad = mid;
+      }
+    }
+    if (good == i + 1) km__bern_elevate(p->c + i * (dp + 1), p->degree, d, coef);
+    x[np] = p->x[i];
+    np++;
+    i = good;
+  }
+  if (st) {
+    free(mf);
+    free(x);
+    free(c);
+    return st;
+  }
+  x[np] = p->x[m];
+  km_pp r;
+  st = km__pp_alloc(&r, d, np);
+  if (!st) {
+    memcpy(r.x, x, (np + 1) * sizeof(double));
+    memcpy(r.c, c, np * (size_t)(d + 1) * sizeof(double));
+    *out = r;
+  }
+  free(mf);
+  free(x);
+  free(c);
+  return st;
+}
+
+km_status km__pp_derivative(const km_pp *p, km_pp *out) {
+  int d = p->degree;
+  km_pp r;
+  km_status st = km__pp_alloc(&r, d > 0 ? d - 1 : 0, p->m);
+  if (st) return st;
+  memcpy(r.x, p->x, (p->m + 1) * sizeof(double));
+  for (size_t i = 0; i < p->m; i++)
+    km__bern_derivative(p->c + i * (size_t)(d + 1), d, p->x[i + 1] - p->x[i],
+                        r.c + i * (size_t)(r.degree + 1));
+  *out = r;
+  return KM_OK;
+}
