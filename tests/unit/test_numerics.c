@@ -1,0 +1,212 @@
+/* test_numerics.c - the core's internal numerical kernels that public
+ * results rest on without showing them: the signature's spectral
+ * integration matrix, and merging of piecewise polynomials within a bound.
+ *
+ * Oracles: exact integrals of monomials and of exp, polynomials written
+ * exactly in Bernstein form (restrictions of one polynomial are the same
+ * polynomial), a kink in the third derivative like a cubic spline's knot,
+ * and a jump like a corner of a tangent angle.
+ */
+#include <math.h>
+#include <stdbool.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../../core/src/internal.h"
+#include "testutil.h"
+
+#define PI 3.14159265358979323846
+
+/* ---- spectral integration ---------------------------------------------- */
+
+static void cheb_cumulative_integrates_monomials_exactly(void **state) {
+  (void)state;
+  for (int j = 0; j <= 14; j++) {
+    double f[15], F[15];
+    for (int k = 0; k < 15; k++) f[k] = pow(-cos(k * PI / 14), j);
+    km__cheb_cumulative15(f, F);
+    for (int k = 0; k < 15; k++) {
+      double x = -cos(k * PI / 14);
+      double want = (pow(x, j + 1) - pow(-1.0, j + 1)) / (j + 1);
+      assert_close(F[k], want, 2e-15);
+    }
+  }
+}
+
+static void cheb_cumulative_of_exp_is_spectrally_accurate(void **state) {
+  (void)state;
+  /* the degree-14 interpolant of e^x on [-1, 1] errs by at most
+   * e / (2^13 15!) ~ 2.5e-16: the integral is right to rounding */
+  double f[15], F[15];
+  for (int k = 0; k < 15; k++) f[k] = exp(-cos(k * PI / 14));
+  km__cheb_cumulative15(f, F);
+  for (int k = 0; k < 15; k++)
+    assert_close(F[k], exp(-cos(k * PI / 14)) - exp(-1.0), 2e-15);
+}
+
+/* ---- merging pieces ---------------------------------------------------- */
+
+/* Bernstein coefficients over [0, 1] of sum a_i x^i (degree d). */
+static void power_to_bernstein(const double *a, int d, double *b) {
+  for (int j = 0; j <= d; j++) {
+    double s = 0.0;
+    for (int i = 0; i <= j; i++) {
+      double cji = 1.0, cdi = 1.0; /* C(j, i), C(d, i) */
+      for (int q = 0; q < i; q++) {
+        cji = cji * (j - q) / (q + 1);
+        cdi = cdi * (d - q) / (q + 1);
+      }
+      s += cji / cdi * a[i];
+    }
+    b[j] = s;
+  }
+}
+
+static double power_eval(const double *a, int d, double x) {
+  double v = 0.0;
+  for (int i = d; i >= 0; i--) v = v * x + a[i];
+  return v;
+}
+
+/* P(x) = 0.3 + x - 0.8 x^2 + 0.2 x^3 - 0.1 x^5 + 0.05 x^7 */
+static const double P7[8] = {0.3, 1.0, -0.8, 0.2, 0.0, -0.1, 0.0, 0.05};
+/* (x - 1/2)^3 */
+static const double KINK[8] = {-0.125, 0.75, -1.5, 1.0, 0, 0, 0, 0};
+
+/* f = P7 + kink_c (x - 1/2)_+^3 + jump_c [x >= jump_at] on m pieces of
+ * [0, 1] (breaks uneven, and at 1/2 and jump_at), each exact. */
+static double model(double x, double kink_c, double jump_c, double jump_at) {
+  double v = power_eval(P7, 7, x);
+  if (x >= 0.5) v += kink_c * power_eval(KINK, 3, x);
+  if (x >= jump_at) v += jump_c;
+  return v;
+}
+
+static void make_model(km_pp *p, size_t m, double kink_c, double jump_c,
+                       double jump_at) {
+  assert_int_equal(km__pp_alloc(p, 7, m), KM_OK);
+  double bp[8], bk[8], bk3[4];
+  power_to_bernstein(P7, 7, bp);
+  power_to_bernstein(KINK, 3, bk3);
+  km__bern_elevate(bk3, 3, 7, bk);
+  for (size_t i = 0; i <= m; i++) {
+    double u = (double)i / (double)m;
+    p->x[i] = u + 0.3 * sin(7.0 * u) * u * (1 - u) / (double)m; /* uneven */
+  }
+  /* breaks exactly at 1/2 and at the jump */
+  p->x[m / 2] = 0.5;
+  size_t ij = (size_t)(jump_at * (double)m + 0.5);
+  if (jump_at < 1.0 && ij != m / 2 && ij > 0 && ij < m) p->x[ij] = jump_at;
+  for (size_t i = 0; i < m; i++) {
+    double *c = p->c + i * 8, a = p->x[i], b = p->x[i + 1];
+    km__bern_restrict(bp, 7, a, b, c);
+    if (a >= 0.5) {
+      double r[8];
+      km__bern_restrict(bk, 7, a, b, r);
+      for (int j = 0; j < 8; j++) c[j] += kink_c * r[j];
+    }
+    if (a >= jump_at)
+      for (int j = 0; j < 8; j++) c[j] += jump_c;
+  }
+}
+
+static double max_gap(const km_pp *a, const km_pp *b, int samples) {
+  double g = 0.0;
+  for (int k = 0; k <= samples; k++) {
+    double x = (double)k / samples;
+    g = fmax(g, fabs(km__pp_eval(a, x) - km__pp_eval(b, x)));
+  }
+  return g;
+}
+
+static void merge_of_one_polynomial_is_one_piece(void **state) {
+  (void)state;
+  km_pp p, q;
+  km__pp_init(&q);
+  make_model(&p, 40, 0.0, 0.0, 2.0);
+  assert_int_equal(km__pp_merge(&p, 7, 1e-12, &q), KM_OK);
+  assert_int_equal(q.m, 1);
+  assert_true(q.x[0] == 0.0 && q.x[1] == p.x[p.m]);
+  for (int k = 0; k <= 1000; k++) {
+    double x = k / 1000.0;
+    assert_close(km__pp_eval(&q, x), power_eval(P7, 7, x), 1e-13);
+  }
+  km__pp_free(&p);
+  km__pp_free(&q);
+}
+
+static void merge_stays_within_delta_across_a_kink(void **state) {
+  (void)state;
+  /* a jump of f''' at 1/2, as at a cubic spline's knot: no polynomial
+   * meets it exactly, so runs across it are taken only within delta */
+  const double deltas[3] = {1e-4, 1e-7, 1e-10};
+  for (int i = 0; i < 3; i++) {
+    km_pp p, q;
+    km__pp_init(&q);
+    make_model(&p, 200, 0.7, 0.0, 2.0);
+    assert_int_equal(km__pp_merge(&p, 7, deltas[i], &q), KM_OK);
+    /* fewer pieces, the same domain, within delta of f everywhere */
+    assert_true(q.m < p.m);
+    assert_true(q.x[0] == p.x[0] && q.x[q.m] == p.x[p.m]);
+    for (int k = 0; k <= 20000; k++) {
+      double x = k / 20000.0;
+      assert_true(fabs(km__pp_eval(&q, x) - model(x, 0.7, 0.0, 2.0)) <=
+                  deltas[i] * (1 + 1e-9) + 1e-14);
+    }
+    /* breaks of q are breaks of p */
+    for (size_t k = 0; k <= q.m; k++) {
+      bool found = false;
+      for (size_t j = 0; j <= p.m && !found; j++) found = q.x[k] == p.x[j];
+      assert_true(found);
+    }
+    km__pp_free(&p);
+    km__pp_free(&q);
+  }
+}
+
+static void merge_never_crosses_a_jump(void **state) {
+  (void)state;
+  /* a corner in a tangent angle: f jumps by 0.4 at 0.3 */
+  km_pp p, q;
+  km__pp_init(&q);
+  make_model(&p, 100, 0.0, 0.4, 0.3);
+  assert_int_equal(km__pp_merge(&p, 7, 1e-6, &q), KM_OK);
+  /* the smooth runs each side merge into one piece each */
+  assert_int_equal(q.m, 2);
+  assert_true(q.x[1] == 0.3);
+  assert_close(km__pp_eval(&q, 0.3 - 1e-12), model(0.3 - 1e-12, 0, 0.4, 0.3), 1e-11);
+  assert_close(km__pp_eval(&q, 0.3), model(0.3, 0, 0.4, 0.3), 1e-12);
+  assert_true(max_gap(&p, &q, 5000) <= 1e-6);
+  km__pp_free(&p);
+  km__pp_free(&q);
+}
+
+static void derivative_of_pieces_is_exact(void **state) {
+  (void)state;
+  km_pp p, d;
+  km__pp_init(&d);
+  make_model(&p, 13, 0.0, 0.0, 2.0);
+  assert_int_equal(km__pp_derivative(&p, &d), KM_OK);
+  assert_int_equal(d.degree, 6);
+  assert_int_equal(d.m, p.m);
+  double dp[7];
+  for (int i = 0; i < 7; i++) dp[i] = (i + 1) * P7[i + 1];
+  for (int k = 0; k <= 1000; k++) {
+    double x = k / 1000.0;
+    assert_close(km__pp_eval(&d, x), power_eval(dp, 6, x), 1e-12);
+  }
+  km__pp_free(&p);
+  km__pp_free(&d);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(cheb_cumulative_integrates_monomials_exactly),
+      cmocka_unit_test(cheb_cumulative_of_exp_is_spectrally_accurate),
+      cmocka_unit_test(merge_of_one_polynomial_is_one_piece),
+      cmocka_unit_test(merge_stays_within_delta_across_a_kink),
+      cmocka_unit_test(merge_never_crosses_a_jump),
+      cmocka_unit_test(derivative_of_pieces_is_exact),
+  };
+  return cmocka_run_group_tests_name("numerics", tests, NULL, NULL);
+}
