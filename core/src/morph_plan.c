@@ -56,6 +56,13 @@ struct km__frame_plan {
   double *ta_l, *ta_r;  /* Ta left / right of each break */
   double *tb_l, *tb_r;
   size_t *first;        /* nodes of piece k: first[k] .. first[k+1] - 1 */
+  /* closure basis functions (padded indices, see close_frame) that piece k
+   * reaches: jlo[k] .. jlo[k] + jw[k] - 1; its Jacobian window starts at
+   * joff[k] of a frame's scratch (2 jw[k] values), jtotal in all */
+  unsigned char *jlo, *jw;
+  size_t *joff, jtotal;
+  double wb[NF];        /* sum over the nodes of w B_i: integral of B_i */
+  gnode *at_break;      /* the closure basis at every break (bi, bv) */
   gnode *node;
   size_t nn;
   double chol[NF * NF]; /* Cholesky factor of the closure metric */
@@ -138,12 +145,12 @@ static void basis_at(double r, int *bi, double bv[4]) {
   *bi = i0;
 }
 
-static double psi_at(const double *c, double r) {
-  int bi;
-  double bv[4], v = 0.0;
-  basis_at(r, &bi, bv);
-  for (int k = 0; k < 4; k++)
-    if (bi + k >= 0 && bi + k < NF) v += c[bi + k] * bv[k];
+/* psi at break k, from the basis values there (computed once per plan). */
+static double psi_at_break(const km__frame_plan *p, const double *c, size_t k) {
+  const gnode *b = &p->at_break[k];
+  double v = 0.0;
+  for (int q = 0; q < 4; q++)
+    if (b->bi + q >= 0 && b->bi + q < NF) v += c[b->bi + q] * b->bv[q];
   return v;
 }
 
@@ -333,6 +340,10 @@ void km__frame_plan_free(km__frame_plan *p) {
   free(p->tb_l);
   free(p->tb_r);
   free(p->first);
+  free(p->jlo);
+  free(p->jw);
+  free(p->joff);
+  free(p->at_break);
   free(p->node);
   free(p->corner_at);
   free(p);
@@ -341,6 +352,12 @@ void km__frame_plan_free(km__frame_plan *p) {
 static int cmp_dbl(const void *a, const void *b) {
   double x = *(const double *)a, y = *(const double *)b;
   return (x > y) - (x < y);
+}
+
+/* Scratch a frame's closure needs: the pieces' sums (2 per piece), e^(i
+ * theta) at the nodes (2 per node) and the pieces' Jacobian windows. */
+static size_t frame_scratch(const km__frame_plan *p) {
+  return 2 * (p->np + p->nn) + p->jtotal;
 }
 
 static km_status close_frame(const km__frame_plan *p, double t, double theta0,
@@ -545,6 +562,39 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
   if (st) goto fail;
   p->x[np] = 1.0;
   p->first[np] = nodes.n;
+  p->at_break = malloc((np + 1) * sizeof(gnode));
+  if (!p->at_break) {
+    st = KM_ENOMEM;
+    goto fail;
+  }
+  for (size_t k = 0; k <= np; k++) basis_at(p->x[k], &p->at_break[k].bi, p->at_break[k].bv);
+  p->jlo = malloc(np + 1);
+  p->jw = malloc(np + 1);
+  p->joff = malloc((np + 1) * sizeof(size_t));
+  if (!p->jlo || !p->jw || !p->joff) {
+    st = KM_ENOMEM;
+    goto fail;
+  }
+  {
+    const gnode *N = nodes.p;
+    size_t off = 0;
+    for (size_t k = 0; k < np; k++) {
+      int lo = NF + 6, hi = 0;
+      for (size_t j = p->first[k]; j < p->first[k + 1]; j++) {
+        int o = N[j].bi + 3;
+        lo = o < lo ? o : lo;
+        hi = o + 3 > hi ? o + 3 : hi;
+        for (int b = 0; b < 4; b++)
+          if (N[j].bi + b >= 0 && N[j].bi + b < NF) p->wb[N[j].bi + b] += N[j].w * N[j].bv[b];
+      }
+      if (lo > hi) lo = hi = 0; /* a piece without nodes */
+      p->jlo[k] = (unsigned char)lo;
+      p->jw[k] = (unsigned char)(hi - lo + 1);
+      p->joff[k] = off;
+      off += 2 * (size_t)p->jw[k];
+    }
+    p->jtotal = off;
+  }
   p->corner_at = malloc((np + 1) * sizeof(size_t));
   if (!p->corner_at) {
     st = KM_ENOMEM;
@@ -567,7 +617,7 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
   p->nn = nodes.n;
   nodes.p = NULL;
   if (closed) {
-    double *sum = malloc(2 * (np + p->nn) * sizeof(double));
+    double *sum = malloc(frame_scratch(p) * sizeof(double));
     st = sum ? close_frame(p, 0.5, 0.0, true, p->c_half, sum, sum + 2 * np)
              : KM_ENOMEM;
     free(sum);
@@ -581,11 +631,11 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
      * not switch between two closures (a frame where it fails takes the
      * smooth one). */
     size_t nc = p->ncorners;
-    double *buf = nc >= 3 ? malloc((2 * (np + p->nn) + 4 * nc + 2 + np) *
+    double *buf = nc >= 3 ? malloc((frame_scratch(p) + 4 * nc + 2 + np) *
                                    sizeof(double))
                           : NULL;
     if (buf) {
-      double *tau = buf + 2 * (np + p->nn), *delta = tau + nc, *S = delta + nc;
+      double *tau = buf + frame_scratch(p), *delta = tau + nc, *S = delta + nc;
       double *dp = S + 2 * (nc + 1), c0[NF] = {0};
       p->by_corners = true;
       for (int k = 1; k <= 3 && p->by_corners; k++)
@@ -690,8 +740,7 @@ bool km__close_by_corners(const double *S, const double *tau, size_t nc,
  * 0.1^10 / 10! < 3e-17), beyond that by sin and cos. */
 static void exp_i_small(double d, double *cs, double *sn) {
   if (fabs(d) > 0.1) {
-    *cs = cos(d);
-    *sn = sin(d);
+    km__sincos(d, sn, cs);
     return;
   }
   double d2 = d * d;
@@ -699,91 +748,196 @@ static void exp_i_small(double d, double *cs, double *sn) {
   *sn = d * (1 - d2 / 6 * (1 - d2 / 20 * (1 - d2 / 42 * (1 - d2 / 72))));
 }
 
+/* One pass over the nodes: sum[2k], sum[2k+1] = integral over piece k of
+ * e^(i (theta_t + psi)), G their total. On the first pass (e_known false)
+ * e^(i theta) is computed by sin and cos at every node; later ones turn
+ * the stored e by the change of psi (coefficients dcp), which is small.
+ * With jk, d G / d c is accumulated too, into J and into each piece's
+ * window of jk. Coefficients are padded by three zeros each side, so that
+ * every node reads its four basis functions without a test (basis_at). */
+static void frame_pass(const km__frame_plan *p, double t, double theta0,
+                       const double *cp, const double *dcp, bool e_known,
+                       double *sum, double *e, double *jk, double G[2],
+                       double J[2][NF]) {
+  double al = 1 - t, be = t, Jp[2][NF + 6];
+  if (jk) memset(Jp, 0, sizeof Jp);
+  G[0] = G[1] = 0.0;
+  for (size_t k = 0; k < p->np; k++) {
+    double sx = 0.0, sy = 0.0;
+    double *jx = jk ? jk + p->joff[k] - p->jlo[k] : NULL;
+    double *jy = jk ? jx + p->jw[k] : NULL;
+    if (jk)
+      for (int q = 0; q < p->jw[k]; q++) jx[p->jlo[k] + q] = jy[p->jlo[k] + q] = 0.0;
+    int run = -1;
+    double ax[4] = {0, 0, 0, 0}, ay[4] = {0, 0, 0, 0};
+    for (size_t j = p->first[k]; j < p->first[k + 1]; j++) {
+      const gnode *nd = &p->node[j];
+      const double *bv = nd->bv;
+      int o = nd->bi + 3;
+      double cs, sn;
+      if (!e_known) {
+        double th = theta0 + al * nd->ta + be * nd->tb + cp[o] * bv[0] +
+                    cp[o + 1] * bv[1] + cp[o + 2] * bv[2] + cp[o + 3] * bv[3];
+        km__sincos(th, &sn, &cs);
+      } else {
+        double d = dcp[o] * bv[0] + dcp[o + 1] * bv[1] + dcp[o + 2] * bv[2] +
+                   dcp[o + 3] * bv[3];
+        double dx, dy;
+        exp_i_small(d, &dx, &dy);
+        cs = e[2 * j] * dx - e[2 * j + 1] * dy;
+        sn = e[2 * j] * dy + e[2 * j + 1] * dx;
+      }
+      e[2 * j] = cs;
+      e[2 * j + 1] = sn;
+      double wc = nd->w * cs, ws = nd->w * sn;
+      sx += wc;
+      sy += ws;
+      if (jk) {
+        /* nodes of a piece mostly share their basis functions: sum in
+         * registers while they do */
+        if (o != run) {
+          if (run >= 0)
+            for (int q = 0; q < 4; q++) {
+              jx[run + q] += ax[q];
+              jy[run + q] += ay[q];
+            }
+          run = o;
+          for (int q = 0; q < 4; q++) ax[q] = ay[q] = 0.0;
+        }
+        for (int q = 0; q < 4; q++) {
+          ax[q] -= ws * bv[q];
+          ay[q] += wc * bv[q];
+        }
+      }
+    }
+    if (jk && run >= 0)
+      for (int q = 0; q < 4; q++) {
+        jx[run + q] += ax[q];
+        jy[run + q] += ay[q];
+      }
+    if (jk)
+      for (int q = p->jlo[k]; q < p->jlo[k] + p->jw[k]; q++) {
+        Jp[0][q] += jx[q];
+        Jp[1][q] += jy[q];
+      }
+    sum[2 * k] = sx;
+    sum[2 * k + 1] = sy;
+    G[0] += sx;
+    G[1] += sy;
+  }
+  if (jk)
+    for (int r = 0; r < 2; r++) memcpy(J[r], Jp[r] + 3, sizeof J[r]);
+}
+
+/* Y = M^-1 J^T (rows) and S = J M^-1 J^T for the closure metric M: what
+ * minimum-norm steps with this J need, kept for a chord step. */
+static void metric_rows(const km__frame_plan *p, double J[2][NF],
+                        double Y[2][NF], double S[4]) {
+  for (int r = 0; r < 2; r++) {
+    memcpy(Y[r], J[r], sizeof Y[r]);
+    chol_solve(p->chol, Y[r]);
+  }
+  for (int r = 0; r < 2; r++)
+    for (int k = 0; k < 2; k++) {
+      double v = 0.0;
+      for (int i = 0; i < NF; i++) v += J[r][i] * Y[k][i];
+      S[r * 2 + k] = v;
+    }
+}
+
+/* The minimum-norm step dc = M^-1 J^T lambda with J dc = rhs; false if J
+ * is singular. */
+static bool metric_step(double Y[2][NF], const double S[4], const double rhs[2],
+                        double dc[NF]) {
+  double A[4] = {S[0], S[1], S[2], S[3]}, l[2] = {rhs[0], rhs[1]};
+  if (!km__solve_dense(A, l, 2)) return false;
+  for (int i = 0; i < NF; i++) dc[i] = Y[0][i] * l[0] + Y[1][i] * l[1];
+  return true;
+}
+
+static double max_abs(const double *v, int n) {
+  double m = 0.0;
+  for (int i = 0; i < n; i++) m = fmax(m, fabs(v[i]));
+  return m;
+}
+
 /* theta_t plus the closure correction psi (coefficients c, started from
  * c), integrated over every piece: sum[2k], sum[2k+1] = integral of
- * e^(i theta) dr over piece k. e (2 per node) is scratch: e^(i theta) at
- * the nodes, computed by sin and cos once and then turned by the change
- * of psi at every step, which is small. */
+ * e^(i theta) dr over piece k. scratch: e^(i theta) at the nodes (2 per
+ * node), then the pieces' Jacobian windows (jtotal).
+ *
+ * The lsq closure solves G(c) = 0 for the least change of curvature: a
+ * projection onto the linearised constraints (the minimum-norm point of
+ * J c = J c_old - G in the metric integral psi'^2, whose Gram matrix is
+ * Toeplitz with entries 2/3, -1/8, -1/5, -1/120), then a chord step with
+ * the same J: dc1 = M^-1 J^T lambda, J dc1 = -G(c1). Its result needs no
+ * further pass when a bound on what is left says so:
+ *   G(c1 + dc1) = (J(c1) - J(c0)) dc1 + R,
+ * |J(c1) - J(c0)| dc1 <= max|dc0| sum_i |dc1_i| wb_i (|e^(i a) - e^(i b)|
+ * <= |a - b|, and |psi change| <= max|dc| since the basis sums to at most
+ * one), |R| <= max|dc1|^2 / 2 (the Taylor remainder of e^(i d), the
+ * weights summing to one). Below 1e-11 the pieces' sums take the linear
+ * change J_k dc1 (each within its share of the same bound) and the frame
+ * is closed to 1e-11 of its length, as by a further pass. Otherwise Newton steps
+ * with fresh Jacobians follow, which converge quadratically. */
 static km_status close_frame(const km__frame_plan *p, double t, double theta0,
                              bool close_lsq, double *c, double *sum,
-                             double *e) {
-  double Lt = (1 - t) * p->La + t * p->Lb, al = 1 - t, be = t;
-  size_t np = p->np;
+                             double *scratch) {
+  double Lt = (1 - t) * p->La + t * p->Lb;
   bool lsq = close_lsq && p->closed;
-  /* coefficients padded by three zeros each side, so that every node reads
-   * its four basis functions without a test (see basis_at) */
-  double cp[NF + 6] = {0}, dcp[NF + 6] = {0}, dc[NF];
+  double *e = scratch, *jk = lsq ? scratch + 2 * p->nn : NULL;
+  double cp[NF + 6] = {0}, dcp[NF + 6] = {0}, dc[NF], G[2], J[2][NF];
+  double Y[2][NF], S[4];
   memcpy(cp + 3, c, sizeof dc);
-  for (int it = 0;; it++) {
-    double G[2] = {0, 0}, J[2][NF], Jp[2][NF + 6];
-    memset(Jp, 0, sizeof Jp);
-    for (size_t k = 0; k < np; k++) {
-      double sx = 0.0, sy = 0.0;
-      for (size_t j = p->first[k]; j < p->first[k + 1]; j++) {
-        const gnode *nd = &p->node[j];
-        const double *bv = nd->bv;
-        int o = nd->bi + 3;
-        double cs, sn;
-        if (it == 0) {
-          double th = theta0 + al * nd->ta + be * nd->tb + cp[o] * bv[0] +
-                      cp[o + 1] * bv[1] + cp[o + 2] * bv[2] + cp[o + 3] * bv[3];
-          cs = cos(th);
-          sn = sin(th);
-        } else {
-          double d = dcp[o] * bv[0] + dcp[o + 1] * bv[1] + dcp[o + 2] * bv[2] +
-                     dcp[o + 3] * bv[3];
-          double dx, dy;
-          exp_i_small(d, &dx, &dy);
-          cs = e[2 * j] * dx - e[2 * j + 1] * dy;
-          sn = e[2 * j] * dy + e[2 * j + 1] * dx;
-        }
-        e[2 * j] = cs;
-        e[2 * j + 1] = sn;
-        double wc = nd->w * cs, ws = nd->w * sn;
-        sx += wc;
-        sy += ws;
-        if (lsq)
-          for (int q = 0; q < 4; q++) {
-            Jp[0][o + q] -= ws * bv[q];
-            Jp[1][o + q] += wc * bv[q];
-          }
+  frame_pass(p, t, theta0, cp, NULL, false, sum, e, jk, G, J);
+  if (!lsq || Lt * hypot(G[0], G[1]) <= 1e-11 * Lt) return KM_OK;
+  /* projection */
+  metric_rows(p, J, Y, S);
+  double rhs[2] = {-G[0], -G[1]};
+  for (int r = 0; r < 2; r++)
+    for (int i = 0; i < NF; i++) rhs[r] += J[r][i] * c[i];
+  if (!metric_step(Y, S, rhs, dc)) return KM_ENOCONVERGE;
+  for (int i = 0; i < NF; i++) {
+    double ci = dc[i];
+    dc[i] = ci - c[i];
+    c[i] = ci;
+  }
+  double dc0 = max_abs(dc, NF);
+  memcpy(dcp + 3, dc, sizeof dc);
+  frame_pass(p, t, theta0, cp, dcp, true, sum, e, NULL, G, NULL);
+  if (Lt * hypot(G[0], G[1]) <= 1e-11 * Lt) return KM_OK;
+  /* chord step with the projection's Jacobian */
+  double r2[2] = {-G[0], -G[1]};
+  if (!metric_step(Y, S, r2, dc)) return KM_ENOCONVERGE;
+  double dc1 = max_abs(dc, NF), cross = 0.0;
+  for (int i = 0; i < NF; i++) cross += fabs(dc[i]) * p->wb[i];
+  if (dc0 * cross + 0.5 * dc1 * dc1 <= 1e-11 && isfinite(dc1)) {
+    for (int i = 0; i < NF; i++) c[i] += dc[i];
+    for (size_t k = 0; k < p->np; k++) {
+      const double *jx = jk + p->joff[k], *jy = jx + p->jw[k];
+      double dx = 0.0, dy = 0.0;
+      for (int q = 0; q < p->jw[k]; q++) {
+        int i = p->jlo[k] + q - 3;
+        if (i < 0 || i >= NF) continue;
+        dx += jx[q] * dc[i];
+        dy += jy[q] * dc[i];
       }
-      sum[2 * k] = sx;
-      sum[2 * k + 1] = sy;
-      G[0] += sx;
-      G[1] += sy;
+      sum[2 * k] += dx;
+      sum[2 * k + 1] += dy;
     }
-    for (int r = 0; r < 2; r++) memcpy(J[r], Jp[r] + 3, sizeof J[r]);
-    double gap = Lt * hypot(G[0], G[1]);
-    if (!lsq || gap <= 1e-11 * Lt) return KM_OK;
+    return KM_OK;
+  }
+  /* Newton with fresh Jacobians from the chord's point */
+  for (int i = 0; i < NF; i++) c[i] += dc[i];
+  memcpy(dcp + 3, dc, sizeof dc);
+  for (int it = 0;; it++) {
+    frame_pass(p, t, theta0, cp, dcp, true, sum, e, jk, G, J);
+    if (Lt * hypot(G[0], G[1]) <= 1e-11 * Lt) return KM_OK;
     if (it == 40) return KM_ENOCONVERGE;
-    /* Gauss-Newton in the metric: the first steps project, c = M^-1 J^T
-     * lambda with J c = J c_old - G (the minimum-norm point of the
-     * linearised constraints: the least change of curvature), which also
-     * moves c along the constraints and so converges only linearly; the
-     * later ones take the minimum-norm step dc = M^-1 J^T lambda with
-     * J dc = -G, which converges quadratically and leaves c within the
-     * square of the remaining step of that least change. */
-    bool project = it == 0;
-    double Y[2][NF];
-    for (int r = 0; r < 2; r++) {
-      memcpy(Y[r], J[r], sizeof Y[r]);
-      chol_solve(p->chol, Y[r]);
-    }
-    double S[4] = {0, 0, 0, 0}, rhs[2];
-    for (int r = 0; r < 2; r++) {
-      for (int k = 0; k < 2; k++)
-        for (int i = 0; i < NF; i++) S[r * 2 + k] += J[r][i] * Y[k][i];
-      rhs[r] = -G[r];
-      if (project)
-        for (int i = 0; i < NF; i++) rhs[r] += J[r][i] * c[i];
-    }
-    if (!km__solve_dense(S, rhs, 2)) return KM_ENOCONVERGE;
-    for (int i = 0; i < NF; i++) {
-      double ci = (project ? 0.0 : c[i]) + Y[0][i] * rhs[0] + Y[1][i] * rhs[1];
-      dc[i] = ci - c[i];
-      c[i] = ci;
-    }
+    metric_rows(p, J, Y, S);
+    double r3[2] = {-G[0], -G[1]};
+    if (!metric_step(Y, S, r3, dc)) return KM_ENOCONVERGE;
+    for (int i = 0; i < NF; i++) c[i] += dc[i];
     memcpy(dcp + 3, dc, sizeof dc);
   }
 }
@@ -829,9 +983,9 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t,
   /* sums of the pieces, scratch of the nodes, and per corner its turn,
    * its change and the stretch sums; per piece the turn added before it */
   size_t nc = p->ncorners;
-  double *sum = malloc((2 * (np + p->nn) + 4 * nc + 2 + np) * sizeof(double));
+  double *sum = malloc((frame_scratch(p) + 4 * nc + 2 + np) * sizeof(double));
   if (!sum) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
-  double *tau = sum + 2 * (np + p->nn), *delta = tau + nc, *S = delta + nc;
+  double *tau = sum + frame_scratch(p), *delta = tau + nc, *S = delta + nc;
   double *dp = S + 2 * (nc + 1);
   for (size_t k = 0; k < np; k++) dp[k] = 0.0;
   km_status st = KM_OK;
@@ -874,18 +1028,21 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t,
   for (size_t k = 0; k < np; k++) {
     double h = Lt * (p->x[k + 1] - p->x[k]);
     double th0 = theta0 + al * p->ta_r[k] + be * p->tb_r[k] +
-                 psi_at(c, p->x[k]) + dp[k];
+                 psi_at_break(p, c, k) + dp[k];
     double th1 = theta0 + al * p->ta_l[k + 1] + be * p->tb_l[k + 1] +
-                 psi_at(c, p->x[k + 1]) + dp[k];
+                 psi_at_break(p, c, k + 1) + dp[k];
     double Pn[2] = {P[0] + Lt * sum[2 * k], P[1] + Lt * sum[2 * k + 1]};
     if (k > 0 && p->corner[k]) {
       f.cp[cc++] = P[0];
       f.cp[cc++] = P[1];
     }
-    f.cp[cc++] = P[0] + h / 3.0 * cos(th0);
-    f.cp[cc++] = P[1] + h / 3.0 * sin(th0);
-    f.cp[cc++] = Pn[0] - h / 3.0 * cos(th1);
-    f.cp[cc++] = Pn[1] - h / 3.0 * sin(th1);
+    double c0, s0, c1, s1;
+    km__sincos(th0, &s0, &c0);
+    km__sincos(th1, &s1, &c1);
+    f.cp[cc++] = P[0] + h / 3.0 * c0;
+    f.cp[cc++] = P[1] + h / 3.0 * s0;
+    f.cp[cc++] = Pn[0] - h / 3.0 * c1;
+    f.cp[cc++] = Pn[1] - h / 3.0 * s1;
     if (k + 1 < np) {
       int mult = p->corner[k + 1] ? 3 : 2;
       for (int r = 0; r < mult; r++) f.knots[kk++] = Lt * p->x[k + 1];

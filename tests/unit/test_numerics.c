@@ -44,6 +44,33 @@ static void cheb_cumulative_of_exp_is_spectrally_accurate(void **state) {
     assert_close(F[k], exp(-cos(k * PI / 14)) - exp(-1.0), 2e-15);
 }
 
+/* ---- sin and cos ------------------------------------------------------- */
+
+static void sincos_agrees_with_libm(void **state) {
+  (void)state;
+  uint64_t rng = 12345;
+  double worst = 0.0;
+  for (int k = 0; k < 400000; k++) {
+    /* every scale up to the fast range, and the quadrant boundaries */
+    double x = k < 200000 ? tu_uniform(&rng, -1.0, 1.0) * pow(10.0, tu_uniform(&rng, -8, 5))
+                          : (k - 300000) * (PI / 4) * (1 + 1e-16 * (k % 3 - 1));
+    if (!(fabs(x) < 1e5)) continue;
+    double s, c;
+    km__sincos(x, &s, &c);
+    worst = fmax(worst, fmax(fabs(s - sin(x)), fabs(c - cos(x))));
+    assert_close(s * s + c * c, 1.0, 4e-16);
+  }
+  /* libm is correctly rounded to within an ulp; with the reduction, a few
+   * ulps of 1 */
+  assert_true(worst <= 6e-16);
+  /* beyond the fast range it is libm's own */
+  double s, c;
+  km__sincos(3e7, &s, &c);
+  assert_true(s == sin(3e7) && c == cos(3e7));
+  km__sincos(0.0, &s, &c);
+  assert_true(s == 0.0 && c == 1.0);
+}
+
 /* ---- merging pieces ---------------------------------------------------- */
 
 /* Bernstein coefficients over [0, 1] of sum a_i x^i (degree d). */
@@ -203,6 +230,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(cheb_cumulative_integrates_monomials_exactly),
       cmocka_unit_test(cheb_cumulative_of_exp_is_spectrally_accurate),
+      cmocka_unit_test(sincos_agrees_with_libm),
       cmocka_unit_test(merge_of_one_polynomial_is_one_piece),
       cmocka_unit_test(merge_stays_within_delta_across_a_kink),
       cmocka_unit_test(merge_never_crosses_a_jump),
