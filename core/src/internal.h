@@ -169,6 +169,12 @@ km_status km__pp_merge(const km_pp *p, int degree, double delta, km_pp *out);
 km_status km__pp_derivative(const km_pp *p, km_pp *out);
 
 
+/* km_signature_compute, with rel_tol times the curve's length as the
+ * tolerance where tol is not positive (the public default is 1e-5). */
+struct km_signature;
+km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
+                                struct km_signature *out, km_error *err);
+
 /* theta(s) of a signature as pieces (breaks at kappa's breaks and at the
  * corners; corner turns folded into the pieces' start values) beside the
  * matching kappa pieces. */

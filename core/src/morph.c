@@ -138,9 +138,10 @@ static void table_step(const double *tc, int d, double h, double u0,
   for (int c = 0; c < chunks; c++) {
     double mid = u0 + (c + 0.5) * du;
     for (int k = 0; k < 4; k++) {
-      double th = km__bern_eval(tc, d, mid + 0.5 * du * X[k]);
-      sx += W[k] * cos(th);
-      sy += W[k] * sin(th);
+      double th = km__bern_eval(tc, d, mid + 0.5 * du * X[k]), cs, sn;
+      km__sincos(th, &sn, &cs);
+      sx += W[k] * cs;
+      sy += W[k] * sn;
     }
   }
   out[0] = sx * 0.5 * du * h;
@@ -212,15 +213,6 @@ static double theta_at(const input *in, double s) {
   if (u < 0) u = 0;
   if (u > 1) u = 1;
   return km__bern_eval(in->theta.c + i * (size_t)(dt + 1), dt, u);
-}
-
-static km_status recompute_sig(input *in, double tol, km_error *err) {
-  km_signature s;
-  km_status st = km_signature_compute(&in->curve, tol, &s, err);
-  if (st) return st;
-  km_signature_free(&in->sig);
-  in->sig = s;
-  return input_tables(in, false);
 }
 
 static km_status pp_slice(km_pp *out, const km_pp *p, double x0, double x1);
@@ -361,15 +353,72 @@ static km_status rotate_start(input *in, double s0, km_error *err) {
   return input_tables(in, on_table);
 }
 
-static km_status reverse_input(input *in, double tol, km_error *err) {
-  km_status st = ensure_curve(in, tol, err);
+/* The signature of the same curve traced backwards, exactly:
+ * kappa_r(s) = -kappa(L - s) (knots mirrored, coefficients reversed and
+ * negated), a corner at s turning by tau becomes one at L - s turning by
+ * -tau (the seam's, at L, stays there), the start is the old end and the
+ * start angle the old end tangent's plus pi. */
+static km_status reverse_signature(const km_signature *sig, km_signature *out,
+                                   km_error *err) {
+  double L = sig->length;
+  const km_fn *f = &sig->kappa;
+  size_t n = f->n, nk = n + (size_t)f->degree + 1, nc = sig->ncorners;
+  double *buf = malloc((nk + n) * sizeof(double) + (nc + 1) * sizeof(km_corner));
+  if (!buf) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  double *knots = buf, *coef = buf + nk;
+  km_corner *cr = (km_corner *)(coef + n);
+  for (size_t i = 0; i < nk; i++) knots[i] = L - f->knots[nk - 1 - i];
+  for (size_t i = 0; i < n; i++) coef[i] = -f->coef[n - 1 - i];
+  knots[0] = 0.0;
+  knots[nk - 1] = L;
+  double end_angle = sig->angle + km_fn_integral(f);
+  size_t m = 0;
+  for (size_t i = nc; i-- > 0;) {
+    const km_corner *c = &sig->corners[i];
+    bool seam = sig->closed && c->s >= L;
+    if (!seam) end_angle += c->turn;
+    if (seam) continue;
+    cr[m].s = L - c->s;
+    cr[m].turn = -c->turn;
+    m++;
+  }
+  for (size_t i = 0; i < nc; i++)
+    if (sig->closed && sig->corners[i].s >= L) {
+      cr[m].s = L;
+      cr[m].turn = -sig->corners[i].turn;
+      m++;
+    }
+  double start[2] = {sig->start[0], sig->start[1]};
+  km_status st = KM_OK;
+  if (!sig->closed && km_signature_point(sig, L, start, NULL) != KM_OK)
+    st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  km_fn kr;
+  km_fn_init(&kr);
+  if (!st) st = km_fn_create(&kr, f->degree, n, knots, coef, err);
+  if (!st)
+    st = km_signature_create(out, L, start, km__wrap_angle(end_angle + KM_PI), &kr,
+                             cr, m, sig->closed, err);
+  km_fn_free(&kr);
+  free(buf);
+  return st;
+}
+
+/* `to` traced backwards: its signature exactly, its curve (if kept) by
+ * reversing the control points. */
+static km_status reverse_input(input *in, km_error *err) {
+  km_signature r;
+  km_status st = reverse_signature(&in->sig, &r, err);
   if (st) return st;
-  km_curve r;
-  st = km_curve_reverse(&r, &in->curve, err);
-  if (st) return st;
-  km_curve_free(&in->curve);
-  in->curve = r;
-  return recompute_sig(in, tol, err);
+  km_signature_free(&in->sig);
+  in->sig = r;
+  if (in->has_curve) {
+    km_curve c;
+    st = km_curve_reverse(&c, &in->curve, err);
+    if (st) return st;
+    km_curve_free(&in->curve);
+    in->curve = c;
+  }
+  return input_tables(in, false);
 }
 
 /* Best cyclic shift of b's start (fraction of Lb): least squares over
@@ -596,6 +645,8 @@ static size_t auto_matches(const input *a, const input *b, double *pairs,
 
 /* ---- creation ---------------------------------------------------------- */
 
+/* An input's copy, signature and tables; a signature computed from its
+ * curve is held to tol, or without one to 1e-6 of its own length. */
 static km_status prepare_input(input *in, const km_morph_input *src,
                                double tol, km_error *err) {
   memset(in, 0, sizeof *in);
@@ -612,7 +663,7 @@ static km_status prepare_input(input *in, const km_morph_input *src,
   if (src->sig)
     st = km_signature_copy(&in->sig, src->sig, err);
   else if (src->curve)
-    st = km_signature_compute(&in->curve, tol, &in->sig, err);
+    st = km__signature_compute(&in->curve, tol, 1e-6, &in->sig, err);
   else
     st = km__fail(err, KM_EINVAL, KM_FIELD_NONE, -1, NAN, "missing input");
   if (st) return st;
@@ -728,24 +779,6 @@ static km_status morph_shifted(const km_morph *base, double dshift,
   return KM_OK;
 }
 
-/* Arc length by 16-point Gauss-Legendre per span: close enough to scale
- * the signatures' tolerance (the morph's own is set from the exact lengths
- * once they are known) at a fraction of the full-precision work. */
-static double length_estimate(const km_curve *c) {
-  double L = 0.0;
-  for (size_t i = (size_t)c->degree; i < c->n; i++) {
-    if (!(c->knots[i + 1] > c->knots[i])) continue;
-    km__bspan sp;
-    km__bspan_make(&sp, c, i);
-    for (int k = 0; k < 16; k++) {
-      double pos[2], d[2];
-      km__bspan_eval_u(&sp, 0.5 + 0.5 * km__gl16_x[k], pos, d);
-      L += 0.5 * km__gl16_w[k] * hypot(d[0], d[1]);
-    }
-  }
-  return L > 0 && isfinite(L) ? L : km_curve_length(c);
-}
-
 /* The start of a closed `to` is chosen by the alignment cost; the
  * candidates are returned in cand/ncand, best first. */
 static km_status create_impl(km_morph **out, const km_morph_input *from,
@@ -764,19 +797,25 @@ static km_status create_impl(km_morph **out, const km_morph_input *from,
   m->opt = *opt;
   m->opt.matches = NULL;
   if (m->opt.degree != 5) m->opt.degree = 3;
-  /* a provisional tolerance for the inputs' signatures */
-  double La0 = from->sig ? from->sig->length : length_estimate(from->curve);
-  double Lb0 = to->sig ? to->sig->length : length_estimate(to->curve);
-  double tol = opt->tolerance > 0 ? opt->tolerance : 1e-5 * fmax(La0, Lb0);
-  m->tol = tol;
-  /* inputs' signatures at a tenth of the tolerance: their error adds to
-   * the frames' */
+  /* Inputs' signatures at a tenth of the tolerance: their error adds to
+   * the frames'. The default tolerance, 1e-5 of the longer length, is
+   * known only with both lengths; a tenth of 1e-5 of each curve's own is
+   * at least as tight, and needs no length before the signature. */
+  double tol = opt->tolerance > 0 ? opt->tolerance : 0.0;
   st = prepare_input(&m->in[0], from, 0.1 * tol, err);
   if (st) goto fail;
   st = prepare_input(&m->in[1], to, 0.1 * tol, err);
   if (st) goto fail;
   input *a = &m->in[0], *b = &m->in[1];
-  if (!(opt->tolerance > 0)) m->tol = tol = 1e-5 * fmax(a->sig.length, b->sig.length);
+  if (!(opt->tolerance > 0)) tol = 1e-5 * fmax(a->sig.length, b->sig.length);
+  m->tol = tol;
+  /* Curvature frames need the signatures only: the curves would be turned
+   * and copied with every change of start for nothing. */
+  if (opt->method == KM_METHOD_CURVATURE)
+    for (int i = 0; i < 2; i++) {
+      km_curve_free(&m->in[i].curve);
+      m->in[i].has_curve = false;
+    }
   if (a->sig.closed != b->sig.closed) {
     st = km__fail(err, KM_EMIXED, KM_FIELD_CLOSED, -1, NAN,
                   "cannot morph an open curve into a closed one (from is %s, "
@@ -790,7 +829,7 @@ static km_status create_impl(km_morph **out, const km_morph_input *from,
     double na = a->sig.turning / (2 * KM_PI), nb = b->sig.turning / (2 * KM_PI);
     long ta = lround(na), tb = lround(nb);
     if (ta == -tb && ta != 0 && opt->orient == KM_ORIENT_AUTO) {
-      st = reverse_input(b, 0.1 * tol, err);
+      st = reverse_input(b, err);
       if (st) goto fail;
       tb = lround(b->sig.turning / (2 * KM_PI));
     }

@@ -33,13 +33,54 @@ km_status km__pp_alloc(km_pp *p, int degree, size_t m) {
   return KM_OK;
 }
 
+/* Binomial coefficients C(d, j), d <= KM_MAX_FN_DEGREE + 1 (Pascal's
+ * triangle; every entry is exact in double). */
+static const double BINOM[KM_MAX_FN_DEGREE + 2][KM_MAX_FN_DEGREE + 2] = {
+    {1},
+    {1, 1},
+    {1, 2, 1},
+    {1, 3, 3, 1},
+    {1, 4, 6, 4, 1},
+    {1, 5, 10, 10, 5, 1},
+    {1, 6, 15, 20, 15, 6, 1},
+    {1, 7, 21, 35, 35, 21, 7, 1},
+    {1, 8, 28, 56, 70, 56, 28, 8, 1},
+    {1, 9, 36, 84, 126, 126, 84, 36, 9, 1},
+    {1, 10, 45, 120, 210, 252, 210, 120, 45, 10, 1},
+    {1, 11, 55, 165, 330, 462, 462, 330, 165, 55, 11, 1},
+    {1, 12, 66, 220, 495, 792, 924, 792, 495, 220, 66, 12, 1},
+    {1, 13, 78, 286, 715, 1287, 1716, 1716, 1287, 715, 286, 78, 13, 1},
+    {1, 14, 91, 364, 1001, 2002, 3003, 3432, 3003, 2002, 1001, 364, 91, 14, 1},
+    {1, 15, 105, 455, 1365, 3003, 5005, 6435, 6435, 5005, 3003, 1365, 455, 105, 15, 1},
+    {1, 16, 120, 560, 1820, 4368, 8008, 11440, 12870, 11440, 8008, 4368, 1820, 560, 120, 16, 1},
+    {1, 17, 136, 680, 2380, 6188, 12376, 19448, 24310, 24310, 19448, 12376, 6188, 2380, 680, 136, 17, 1},
+    {1, 18, 153, 816, 3060, 8568, 18564, 31824, 43758, 48620, 43758, 31824, 18564, 8568, 3060, 816, 153, 18, 1},
+    {1, 19, 171, 969, 3876, 11628, 27132, 50388, 75582, 92378, 92378, 75582, 50388, 27132, 11628, 3876, 969, 171, 19, 1},
+    {1, 20, 190, 1140, 4845, 15504, 38760, 77520, 125970, 167960, 184756, 167960, 125970, 77520, 38760, 15504, 4845, 1140, 190, 20, 1},
+    {1, 21, 210, 1330, 5985, 20349, 54264, 116280, 203490, 293930, 352716, 352716, 293930, 203490, 116280, 54264, 20349, 5985, 1330, 210, 21, 1},
+};
+
 double km__bern_eval(const double *c, int d, double u) {
-  double b[KM_MAX_FN_DEGREE + 2];
-  memcpy(b, c, (size_t)(d + 1) * sizeof(double));
-  double v = 1.0 - u;
-  for (int r = 1; r <= d; r++)
-    for (int j = 0; j <= d - r; j++) b[j] = v * b[j] + u * b[j + 1];
-  return b[0];
+  /* Horner in s = u / (1 - u) (or its reciprocal past the middle, so that
+   * s <= 1): sum c_j C(d, j) u^j (1-u)^(d-j) = (1-u)^d sum c_j C(d, j) s^j.
+   * Its rounding error is bounded like de Casteljau's, (2d + 1) eps
+   * sum |c_j| B_j(u) (Schumaker and Volk), at O(d) instead of O(d^2): this
+   * is the innermost call of signatures, tables and plans. */
+  if (d == 0) return c[0];
+  const double *bn = BINOM[d];
+  double v = 1.0 - u, acc, f = 1.0;
+  if (u <= 0.5) {
+    double s = u / v;
+    acc = c[d];
+    for (int j = d - 1; j >= 0; j--) acc = acc * s + c[j] * bn[j];
+    for (int j = 0; j < d; j++) f *= v;
+  } else {
+    double s = v / u;
+    acc = c[0];
+    for (int j = 1; j <= d; j++) acc = acc * s + c[j] * bn[j];
+    for (int j = 0; j < d; j++) f *= u;
+  }
+  return acc * f;
 }
 
 /* Split at u: left coefficients (over [0,u]) into L, right into R (either

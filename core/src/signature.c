@@ -353,17 +353,17 @@ static double counted_length(const km__bspan *sp, double u0, double u1,
   return len;
 }
 
-/* Arc length of a whole span by the 16-point Gauss-Legendre rule: exact to
- * rounding for a span whose speed is smooth, which is checked (fit_piece)
- * before it is used as the length. */
-static double gl16_length(const km__bspan *sp) {
-  double len = 0.0;
+/* Arc length of a span over [u0, u1] of its own variable by the 16-point
+ * Gauss-Legendre rule: exact to rounding where the speed is smooth, which
+ * is checked (fit_piece) before it is used as the length. */
+static double gl16_length(const km__bspan *sp, double u0, double u1) {
+  double len = 0.0, m = 0.5 * (u0 + u1), hw = 0.5 * (u1 - u0);
   for (int k = 0; k < 16; k++) {
     double pos[2], d[2];
-    km__bspan_eval_u(sp, 0.5 + 0.5 * km__gl16_x[k], pos, d);
-    len += 0.5 * km__gl16_w[k] * sqrt(d[0] * d[0] + d[1] * d[1]);
+    km__bspan_eval_u(sp, m + hw * km__gl16_x[k], pos, d);
+    len += km__gl16_w[k] * sqrt(d[0] * d[0] + d[1] * d[1]);
   }
-  return len;
+  return len * hw;
 }
 
 /* arc length inside the current span, in its own variable u */
@@ -499,14 +499,19 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
    * can be shorter than the rounding unit of the absolute arc length */
   for (int k = 0; k < NPTS; k++) s[k] = half * F[k];
   double h = s[NPTS - 1] - s[0];
-  /* A whole span comes with its length by 16-point Gauss-Legendre
-   * (known_len): where the spectral length at these 15 other nodes agrees
+  /* The length by 16-point Gauss-Legendre (a whole span comes with it,
+   * known_len): where the spectral length at these 15 other nodes agrees
    * to 1e-13 both rules have resolved the speed, and that is the length;
-   * elsewhere it is measured adaptively, for the span too. */
-  double ref;
-  if (known_len > 0 &&
-      fabs(h - known_len) <= 1e-13 * known_len + b->deriv_noise * (ub - ua)) {
-    ref = known_len;
+   * elsewhere it is measured adaptively (for the span too). */
+  double ref, est = known_len;
+  if (!(est > 0)) {
+    double a = b->span.a, w = b->span.b - a;
+    est = gl16_length(&b->span, (ua - a) / w, (ub - a) / w);
+    b->work -= 16;
+    b->span_work -= 16;
+  }
+  if (est > 0 && fabs(h - est) <= 1e-13 * est + b->deriv_noise * (ub - ua)) {
+    ref = est;
   } else {
     ref = span_length(b, ua, ub);
     if (known_len > 0) b->span_len = ref;
@@ -676,6 +681,11 @@ static km_status check_turn(builder *b, double turn, double t, double s) {
 
 km_status km_signature_compute(const km_curve *c, double tol,
                                km_signature *out, km_error *err) {
+  return km__signature_compute(c, tol, 1e-5, out, err);
+}
+
+km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
+                                km_signature *out, km_error *err) {
   if (!c || !c->knots || !c->cp || c->degree < KM_MIN_DEGREE ||
       c->degree > KM_MAX_DEGREE || c->n < (size_t)c->degree + 1)
     return km__fail(err, KM_EINVAL, KM_FIELD_NONE, -1, NAN,
@@ -708,7 +718,7 @@ km_status km_signature_compute(const km_curve *c, double tol,
       km__bspan sp;
       km__bspan_make(&sp, c, i);
       long evals = 0;
-      double est = gl16_length(&sp);
+      double est = gl16_length(&sp, 0.0, 1.0);
       b.work -= 16;
       if (!(est > 1e-9 * poly) || !(est > 1e6 * span_noise(&sp)))
         est = counted_length(&sp, 0.0, 1.0, 1e-15 * poly, &evals);
@@ -733,7 +743,7 @@ km_status km_signature_compute(const km_curve *c, double tol,
     goto cleanup;
   }
   b.L = L;
-  if (!(tol > 0) || !isfinite(tol)) tol = 1e-5 * L;
+  if (!(tol > 0) || !isfinite(tol)) tol = rel_tol * L;
   /* Nor below the rounding of the curve itself (limits.h). A curve too
    * small for its distance from the origin to meet even the default
    * tolerance (1e-5 of its length) is refused: its shape is rounding

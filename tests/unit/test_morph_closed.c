@@ -1046,6 +1046,43 @@ static void congruent_shapes_morph_through_congruent_frames(void **state) {
   km_curve_free(&b);
 }
 
+/* A shape morphed into itself traced backwards (crescent_to_heart's
+ * heart: corners, curvature of both signs): `to` is reversed back, which
+ * is done on its signature exactly (kappa(L - s) negated, corners mirrored
+ * with their turns negated), its start aligned, and every frame is the
+ * heart where it stands. */
+static void reversed_copy_morphs_through_the_shape_itself(void **state) {
+  (void)state;
+  km_curve a, b;
+  shape_curve("crescent_to_heart", 'b', &a);
+  km_curve_init(&b);
+  assert_status(km_curve_reverse(&b, &a, NULL), KM_OK);
+  km_morph_input A = {&a, NULL}, B = {&b, NULL};
+  km_morph_options o;
+  km_morph_options_default(&o);
+  km_morph *m = morph_new(&A, &B, &o);
+  double L = km_curve_length(&a), tol = 1e-5 * L;
+  double len[2], turning[2];
+  km_morph_inputs(m, len, turning);
+  assert_close(turning[1], turning[0], 1e-9);
+  assert_rel(len[1], L, 1e-9);
+  for (int i = 0; i <= 4; i++) {
+    frame f;
+    frame_get(m, i / 4.0, &f);
+    assert_true(curves_distance(&f.c, &a) <= 2 * tol);
+    frame_free(&f);
+    /* and the planned frame, without metrics */
+    km_curve c;
+    km_curve_init(&c);
+    assert_status(km_morph_frame(m, i / 4.0, &c, NULL, NULL, NULL), KM_OK);
+    assert_true(curves_distance(&c, &a) <= 2 * tol);
+    km_curve_free(&c);
+  }
+  km_morph_free(m);
+  km_curve_free(&a);
+  km_curve_free(&b);
+}
+
 /* whether an integer stands in a message as a whole number */
 static int message_has_integer(const char *msg, long want) {
   const char *p = msg;
@@ -1112,6 +1149,7 @@ int main(void) {
       cmocka_unit_test(planned_default_frames_of_the_fixture_pairs),
       cmocka_unit_test(planned_and_reconstructed_frames_agree),
       cmocka_unit_test(congruent_shapes_morph_through_congruent_frames),
+      cmocka_unit_test(reversed_copy_morphs_through_the_shape_itself),
       cmocka_unit_test(a_curve_looping_twice_is_rejected_against_a_circle),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -44,6 +44,35 @@ static void cheb_cumulative_of_exp_is_spectrally_accurate(void **state) {
     assert_close(F[k], exp(-cos(k * PI / 14)) - exp(-1.0), 2e-15);
 }
 
+/* ---- Bernstein evaluation ---------------------------------------------- */
+
+static void bern_eval_is_within_its_rounding_bound(void **state) {
+  (void)state;
+  /* against the defining sum in extended precision: the error stays below
+   * (2d + 1) eps sum |c_j| B_j(u), the bound of de Casteljau's algorithm */
+  uint64_t rng = 777;
+  for (int d = 0; d <= 21; d++)
+    for (int trial = 0; trial < 200; trial++) {
+      double c[22];
+      for (int j = 0; j <= d; j++) c[j] = tu_uniform(&rng, -3.0, 3.0);
+      double u = trial == 0 ? 0.0 : trial == 1 ? 1.0 : trial == 2 ? 0.5
+                                                : tu_uniform(&rng, 0.0, 1.0);
+      long double sum = 0.0L, abs_sum = 0.0L;
+      for (int j = 0; j <= d; j++) {
+        long double b = 1.0L;
+        for (int q = 0; q < j; q++) b = b * (d - q) / (q + 1);
+        for (int q = 0; q < j; q++) b *= u;
+        for (int q = j; q < d; q++) b *= 1.0L - u;
+        sum += c[j] * b;
+        abs_sum += fabsl(c[j] * b);
+      }
+      double got = km__bern_eval(c, d, u);
+      assert_true(fabsl(got - sum) <= (2 * d + 2) * 1.12e-16L * abs_sum + 1e-300);
+      if (trial == 0) assert_true(got == c[0]);
+      if (trial == 1) assert_true(got == c[d]);
+    }
+}
+
 /* ---- sin and cos ------------------------------------------------------- */
 
 static void sincos_agrees_with_libm(void **state) {
@@ -230,6 +259,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(cheb_cumulative_integrates_monomials_exactly),
       cmocka_unit_test(cheb_cumulative_of_exp_is_spectrally_accurate),
+      cmocka_unit_test(bern_eval_is_within_its_rounding_bound),
       cmocka_unit_test(sincos_agrees_with_libm),
       cmocka_unit_test(merge_of_one_polynomial_is_one_piece),
       cmocka_unit_test(merge_stays_within_delta_across_a_kink),
