@@ -346,9 +346,11 @@ static void travel(const seg *s, int p, int sg[2]) {
 }
 
 /* Two sub-curves that follow each other along the curve (A's end is B's
- * start) and travel the same way in x and in y cannot meet anywhere else:
- * A lies in the box from its start to the shared point, B in the box from
- * there on, and the boxes touch only at that point. Subdividing toward the
+ * start) and travel the same way in x or in y cannot cross: say both go
+ * up in y; A lies below the shared point's y and B above it, so they can
+ * meet only on that line, where neither passes to the other side - a
+ * touch at most, never a proper crossing. (At an extremum in x the two
+ * travel opposite ways in x but the same way in y.) Subdividing toward the
  * shared end would otherwise cost some forty levels a pair. */
 static bool consecutive_same_way(const ctx *x, const seg *A, const seg *B) {
   size_t last = (x->bz->n - 1) / (size_t)x->p - 1;
@@ -368,11 +370,11 @@ static bool consecutive_same_way(const ctx *x, const seg *A, const seg *B) {
   int sf[2], sg[2];
   travel(f, x->p, sf);
   travel(g, x->p, sg);
-  return sf[0] != 0 && sf[1] != 0 && sf[0] == sg[0] && sf[1] == sg[1];
+  return (sf[0] != 0 && sf[0] == sg[0]) || (sf[1] != 0 && sf[1] == sg[1]);
 }
 
 static int by_xmin(const void *a, const void *b) {
-  double u = ((const seg *)a)->xmin, v = ((const seg *)b)->xmin;
+  double u = (*(const seg *const *)a)->xmin, v = (*(const seg *const *)b)->xmin;
   return (u > v) - (u < v);
 }
 
@@ -393,6 +395,7 @@ long km_curve_self_intersections(const km_curve *c, double tol) {
   km__h_init(&bz);
   ctx x;
   memset(&x, 0, sizeof x);
+  seg **order = NULL;
   long result = -1;
   if (km__h_from_curve(&h, c, 3) || km__h_to_bezier(&bz, &h)) goto cleanup;
   int p = c->degree;
@@ -427,16 +430,21 @@ long km_curve_self_intersections(const km_curve *c, double tol) {
     collect(&x, &s, 0);
   }
   if (x.oom) goto cleanup;
-  qsort(x.segs, x.nseg, sizeof *x.segs, by_xmin);
+  /* the sweep orders pointers: a sub-curve is hundreds of bytes */
+  order = malloc((x.nseg + 1) * sizeof *order);
+  if (!order) goto cleanup;
+  for (size_t i = 0; i < x.nseg; i++) order[i] = &x.segs[i];
+  qsort(order, x.nseg, sizeof *order, by_xmin);
   for (size_t i = 0; i < x.nseg && !x.oom; i++)
     for (size_t j = i + 1; j < x.nseg && !x.oom; j++) {
-      if (x.segs[j].xmin > x.segs[i].xmax + x.tol) break;
-      if (consecutive_same_way(&x, &x.segs[i], &x.segs[j])) continue;
-      pair(&x, &x.segs[i], &x.segs[j], 0);
+      if (order[j]->xmin > order[i]->xmax + x.tol) break;
+      if (consecutive_same_way(&x, order[i], order[j])) continue;
+      pair(&x, order[i], order[j], 0);
     }
   if (x.oom) goto cleanup;
   result = (long)x.nhit;
 cleanup:
+  free(order);
   free(x.segs);
   free(x.hits);
   km__h_free(&h);

@@ -56,11 +56,6 @@ struct km__frame_plan {
   double *ta_l, *ta_r;  /* Ta left / right of each break */
   double *tb_l, *tb_r;
   size_t *first;        /* nodes of piece k: first[k] .. first[k+1] - 1 */
-  /* closure basis functions (padded indices, see close_frame) that piece k
-   * reaches: jlo[k] .. jlo[k] + jw[k] - 1; its Jacobian window starts at
-   * joff[k] of a frame's scratch (2 jw[k] values), jtotal in all */
-  unsigned char *jlo, *jw;
-  size_t *joff, jtotal;
   double wb[NF];        /* sum over the nodes of w B_i: integral of B_i */
   gnode *at_break;      /* the closure basis at every break (bi, bv) */
   gnode *node;
@@ -340,9 +335,6 @@ void km__frame_plan_free(km__frame_plan *p) {
   free(p->tb_l);
   free(p->tb_r);
   free(p->first);
-  free(p->jlo);
-  free(p->jw);
-  free(p->joff);
   free(p->at_break);
   free(p->node);
   free(p->corner_at);
@@ -354,10 +346,10 @@ static int cmp_dbl(const void *a, const void *b) {
   return (x > y) - (x < y);
 }
 
-/* Scratch a frame's closure needs: the pieces' sums (2 per piece), e^(i
- * theta) at the nodes (2 per node) and the pieces' Jacobian windows. */
+/* Scratch a frame's closure needs: the pieces' sums (2 per piece) and
+ * e^(i theta) at the nodes (2 per node). */
 static size_t frame_scratch(const km__frame_plan *p) {
-  return 2 * (p->np + p->nn) + p->jtotal;
+  return 2 * (p->np + p->nn);
 }
 
 static km_status close_frame(const km__frame_plan *p, double t, double theta0,
@@ -568,32 +560,11 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
     goto fail;
   }
   for (size_t k = 0; k <= np; k++) basis_at(p->x[k], &p->at_break[k].bi, p->at_break[k].bv);
-  p->jlo = malloc(np + 1);
-  p->jw = malloc(np + 1);
-  p->joff = malloc((np + 1) * sizeof(size_t));
-  if (!p->jlo || !p->jw || !p->joff) {
-    st = KM_ENOMEM;
-    goto fail;
-  }
   {
     const gnode *N = nodes.p;
-    size_t off = 0;
-    for (size_t k = 0; k < np; k++) {
-      int lo = NF + 6, hi = 0;
-      for (size_t j = p->first[k]; j < p->first[k + 1]; j++) {
-        int o = N[j].bi + 3;
-        lo = o < lo ? o : lo;
-        hi = o + 3 > hi ? o + 3 : hi;
-        for (int b = 0; b < 4; b++)
-          if (N[j].bi + b >= 0 && N[j].bi + b < NF) p->wb[N[j].bi + b] += N[j].w * N[j].bv[b];
-      }
-      if (lo > hi) lo = hi = 0; /* a piece without nodes */
-      p->jlo[k] = (unsigned char)lo;
-      p->jw[k] = (unsigned char)(hi - lo + 1);
-      p->joff[k] = off;
-      off += 2 * (size_t)p->jw[k];
-    }
-    p->jtotal = off;
+    for (size_t j = 0; j < nodes.n; j++)
+      for (int b = 0; b < 4; b++)
+        if (N[j].bi + b >= 0 && N[j].bi + b < NF) p->wb[N[j].bi + b] += N[j].w * N[j].bv[b];
   }
   p->corner_at = malloc((np + 1) * sizeof(size_t));
   if (!p->corner_at) {
@@ -750,26 +721,23 @@ static void exp_i_small(double d, double *cs, double *sn) {
 
 /* One pass over the nodes: sum[2k], sum[2k+1] = integral over piece k of
  * e^(i (theta_t + psi)), G their total. On the first pass (e_known false)
- * e^(i theta) is computed by sin and cos at every node; later ones turn
- * the stored e by the change of psi (coefficients dcp), which is small.
- * With jk, d G / d c is accumulated too, into J and into each piece's
- * window of jk. Coefficients are padded by three zeros each side, so that
- * every node reads its four basis functions without a test (basis_at). */
+ * e^(i theta) is computed at every node; later ones turn the stored e by
+ * the change of psi (coefficients dcp), which is small. With J, d G / d c
+ * is accumulated too. Coefficients are padded by three zeros each side, so
+ * that every node reads its four basis functions without a test
+ * (basis_at). */
 static void frame_pass(const km__frame_plan *p, double t, double theta0,
                        const double *cp, const double *dcp, bool e_known,
-                       double *sum, double *e, double *jk, double G[2],
-                       double J[2][NF]) {
+                       double *sum, double *e, double G[2], double J[2][NF]) {
   double al = 1 - t, be = t, Jp[2][NF + 6];
-  if (jk) memset(Jp, 0, sizeof Jp);
+  if (J) memset(Jp, 0, sizeof Jp);
   G[0] = G[1] = 0.0;
+  /* nodes mostly share their basis functions with the previous one: the
+   * Jacobian is summed in registers while they do */
+  int run = -1;
+  double ax[4] = {0, 0, 0, 0}, ay[4] = {0, 0, 0, 0};
   for (size_t k = 0; k < p->np; k++) {
     double sx = 0.0, sy = 0.0;
-    double *jx = jk ? jk + p->joff[k] - p->jlo[k] : NULL;
-    double *jy = jk ? jx + p->jw[k] : NULL;
-    if (jk)
-      for (int q = 0; q < p->jw[k]; q++) jx[p->jlo[k] + q] = jy[p->jlo[k] + q] = 0.0;
-    int run = -1;
-    double ax[4] = {0, 0, 0, 0}, ay[4] = {0, 0, 0, 0};
     for (size_t j = p->first[k]; j < p->first[k + 1]; j++) {
       const gnode *nd = &p->node[j];
       const double *bv = nd->bv;
@@ -792,14 +760,12 @@ static void frame_pass(const km__frame_plan *p, double t, double theta0,
       double wc = nd->w * cs, ws = nd->w * sn;
       sx += wc;
       sy += ws;
-      if (jk) {
-        /* nodes of a piece mostly share their basis functions: sum in
-         * registers while they do */
+      if (J) {
         if (o != run) {
           if (run >= 0)
             for (int q = 0; q < 4; q++) {
-              jx[run + q] += ax[q];
-              jy[run + q] += ay[q];
+              Jp[0][run + q] += ax[q];
+              Jp[1][run + q] += ay[q];
             }
           run = o;
           for (int q = 0; q < 4; q++) ax[q] = ay[q] = 0.0;
@@ -810,23 +776,40 @@ static void frame_pass(const km__frame_plan *p, double t, double theta0,
         }
       }
     }
-    if (jk && run >= 0)
-      for (int q = 0; q < 4; q++) {
-        jx[run + q] += ax[q];
-        jy[run + q] += ay[q];
-      }
-    if (jk)
-      for (int q = p->jlo[k]; q < p->jlo[k] + p->jw[k]; q++) {
-        Jp[0][q] += jx[q];
-        Jp[1][q] += jy[q];
-      }
     sum[2 * k] = sx;
     sum[2 * k + 1] = sy;
     G[0] += sx;
     G[1] += sy;
   }
-  if (jk)
+  if (J) {
+    if (run >= 0)
+      for (int q = 0; q < 4; q++) {
+        Jp[0][run + q] += ax[q];
+        Jp[1][run + q] += ay[q];
+      }
     for (int r = 0; r < 2; r++) memcpy(J[r], Jp[r] + 3, sizeof J[r]);
+  }
+}
+
+/* The pieces' sums moved to first order by a step of psi (padded
+ * coefficients dcp) from where e was stored: sum_k += integral over piece
+ * k of i e^(i theta) dpsi. */
+static void linear_finish(const km__frame_plan *p, const double *dcp,
+                          const double *e, double *sum) {
+  for (size_t k = 0; k < p->np; k++) {
+    double dx = 0.0, dy = 0.0;
+    for (size_t j = p->first[k]; j < p->first[k + 1]; j++) {
+      const gnode *nd = &p->node[j];
+      const double *bv = nd->bv;
+      int o = nd->bi + 3;
+      double d = nd->w * (dcp[o] * bv[0] + dcp[o + 1] * bv[1] +
+                          dcp[o + 2] * bv[2] + dcp[o + 3] * bv[3]);
+      dx -= e[2 * j + 1] * d;
+      dy += e[2 * j] * d;
+    }
+    sum[2 * k] += dx;
+    sum[2 * k + 1] += dy;
+  }
 }
 
 /* Y = M^-1 J^T (rows) and S = J M^-1 J^T for the closure metric M: what
@@ -864,7 +847,7 @@ static double max_abs(const double *v, int n) {
 /* theta_t plus the closure correction psi (coefficients c, started from
  * c), integrated over every piece: sum[2k], sum[2k+1] = integral of
  * e^(i theta) dr over piece k. scratch: e^(i theta) at the nodes (2 per
- * node), then the pieces' Jacobian windows (jtotal).
+ * node).
  *
  * The lsq closure solves G(c) = 0 for the least change of curvature: a
  * projection onto the linearised constraints (the minimum-norm point of
@@ -877,19 +860,20 @@ static double max_abs(const double *v, int n) {
  * <= |a - b|, and |psi change| <= max|dc| since the basis sums to at most
  * one), |R| <= max|dc1|^2 / 2 (the Taylor remainder of e^(i d), the
  * weights summing to one). Below 1e-11 the pieces' sums take the linear
- * change J_k dc1 (each within its share of the same bound) and the frame
- * is closed to 1e-11 of its length, as by a further pass. Otherwise Newton steps
- * with fresh Jacobians follow, which converge quadratically. */
+ * change (linear_finish, each within its share of the same bound) and the
+ * frame is closed to 1e-11 of its length, as by a further pass. Otherwise
+ * Newton steps with fresh Jacobians follow, which converge quadratically,
+ * and end the same way once max|dc|^2 / 2 is below 1e-11. */
 static km_status close_frame(const km__frame_plan *p, double t, double theta0,
                              bool close_lsq, double *c, double *sum,
                              double *scratch) {
   double Lt = (1 - t) * p->La + t * p->Lb;
   bool lsq = close_lsq && p->closed;
-  double *e = scratch, *jk = lsq ? scratch + 2 * p->nn : NULL;
+  double *e = scratch;
   double cp[NF + 6] = {0}, dcp[NF + 6] = {0}, dc[NF], G[2], J[2][NF];
   double Y[2][NF], S[4];
   memcpy(cp + 3, c, sizeof dc);
-  frame_pass(p, t, theta0, cp, NULL, false, sum, e, jk, G, J);
+  frame_pass(p, t, theta0, cp, NULL, false, sum, e, G, lsq ? J : NULL);
   if (!lsq || Lt * hypot(G[0], G[1]) <= 1e-11 * Lt) return KM_OK;
   /* projection */
   metric_rows(p, J, Y, S);
@@ -904,41 +888,29 @@ static km_status close_frame(const km__frame_plan *p, double t, double theta0,
   }
   double dc0 = max_abs(dc, NF);
   memcpy(dcp + 3, dc, sizeof dc);
-  frame_pass(p, t, theta0, cp, dcp, true, sum, e, NULL, G, NULL);
+  frame_pass(p, t, theta0, cp, dcp, true, sum, e, G, NULL);
   if (Lt * hypot(G[0], G[1]) <= 1e-11 * Lt) return KM_OK;
   /* chord step with the projection's Jacobian */
   double r2[2] = {-G[0], -G[1]};
   if (!metric_step(Y, S, r2, dc)) return KM_ENOCONVERGE;
   double dc1 = max_abs(dc, NF), cross = 0.0;
   for (int i = 0; i < NF; i++) cross += fabs(dc[i]) * p->wb[i];
-  if (dc0 * cross + 0.5 * dc1 * dc1 <= 1e-11 && isfinite(dc1)) {
-    for (int i = 0; i < NF; i++) c[i] += dc[i];
-    for (size_t k = 0; k < p->np; k++) {
-      const double *jx = jk + p->joff[k], *jy = jx + p->jw[k];
-      double dx = 0.0, dy = 0.0;
-      for (int q = 0; q < p->jw[k]; q++) {
-        int i = p->jlo[k] + q - 3;
-        if (i < 0 || i >= NF) continue;
-        dx += jx[q] * dc[i];
-        dy += jy[q] * dc[i];
-      }
-      sum[2 * k] += dx;
-      sum[2 * k + 1] += dy;
-    }
-    return KM_OK;
-  }
-  /* Newton with fresh Jacobians from the chord's point */
-  for (int i = 0; i < NF; i++) c[i] += dc[i];
-  memcpy(dcp + 3, dc, sizeof dc);
   for (int it = 0;; it++) {
-    frame_pass(p, t, theta0, cp, dcp, true, sum, e, jk, G, J);
+    for (int i = 0; i < NF; i++) c[i] += dc[i];
+    memcpy(dcp + 3, dc, sizeof dc);
+    if (dc0 * cross + 0.5 * dc1 * dc1 <= 1e-11 && isfinite(dc1)) {
+      linear_finish(p, dcp, e, sum);
+      return KM_OK;
+    }
+    /* Newton with a fresh Jacobian: the bound loses its cross term */
+    frame_pass(p, t, theta0, cp, dcp, true, sum, e, G, J);
     if (Lt * hypot(G[0], G[1]) <= 1e-11 * Lt) return KM_OK;
     if (it == 40) return KM_ENOCONVERGE;
     metric_rows(p, J, Y, S);
     double r3[2] = {-G[0], -G[1]};
     if (!metric_step(Y, S, r3, dc)) return KM_ENOCONVERGE;
-    for (int i = 0; i < NF; i++) c[i] += dc[i];
-    memcpy(dcp + 3, dc, sizeof dc);
+    dc0 = 0.0;
+    dc1 = max_abs(dc, NF);
   }
 }
 
