@@ -477,6 +477,18 @@ void km__bspan_eval_u(const km__bspan *sp, double u, double pos[2],
                       double der_u[2]) {
   int p = sp->degree;
   double v = 1.0 - u;
+  if (!sp->rational && p == 3) {
+    /* cubics (every SVG curve): the same de Casteljau steps, unrolled */
+    for (int q = 0; q < 2; q++) {
+      double a = v * sp->h[0][q] + u * sp->h[1][q];
+      double b = v * sp->h[1][q] + u * sp->h[2][q];
+      double c = v * sp->h[2][q] + u * sp->h[3][q];
+      double d = v * a + u * b, e = v * b + u * c;
+      pos[q] = v * d + u * e;
+      der_u[q] = 3.0 * (e - d);
+    }
+    return;
+  }
   if (!sp->rational) { /* weights 1: two coordinates, no quotient */
     double e[KM__BSPAN_MAX][2];
     for (int j = 0; j <= p; j++) {

@@ -6,6 +6,10 @@
  * with Ta, Tb the inputs' tangent angles less their start angles over the
  * normalised arc length r, and L_t = (1 - t) La + t Lb. Everything a frame
  * needs that does not depend on t is computed here once per morph:
+ *   - The inputs' theta pieces merged where one polynomial of degree 7
+ *     stays within a tenth of the tolerance over L of them (km__pp_merge:
+ *     a bound from Bernstein coefficients), so that breaks at knots where
+ *     nothing happens cost no nodes.
  *   - The output pieces: cubic Hermite pieces in r. The derivatives of
  *     theta_t are convex combinations of the inputs', so the larger of the
  *     two inputs' bounds holds for every t (and L_t <= max(La, Lb)); the
@@ -17,10 +21,10 @@
  *     bound, K_n h^(2n+1) max|f^(2n)| with |d^m e^(i theta)| <= B_m(|theta'|,
  *     ..., |theta^(m)|) (complete Bell polynomial), meets its share of the
  *     tolerance: smooth inputs need two or three nodes a piece, not eight.
- * A frame is then one pass of sin/cos over the nodes per Gauss-Newton step
- * of the lsq closure (two or three steps) and the Hermite control points:
- * no piecewise-polynomial blending, no planning, no allocation but the
- * output. The closure is the one of morph.c (close_lsq): interior uniform
+ * A frame is then a pass of sin/cos over the nodes, a pass turning them by
+ * the closure's first change, a bounded first-order finish (close_frame)
+ * and the Hermite control points: no piecewise-polynomial blending, no
+ * planning, no allocation but the output. The closure is the one of morph.c (close_lsq): interior uniform
  * cubic B-splines psi added to theta, minimum-norm steps in the metric
  * integral psi'^2 (the Gram matrix of their derivatives is Toeplitz with
  * entries 2/3, -1/8, -1/5, -1/120), so the seam stays G2.
