@@ -92,6 +92,7 @@ struct km_morph {
   km_curve lin[2]; /* compatible curves (linear method) */
   km__frame_plan *plan; /* frames planned once (morph_plan.c), or NULL */
   bool close_by_corners; /* lsq closure by the frames' corners */
+  double kmax;           /* the inputs' largest |kappa|: the frames' bound */
 };
 
 static void input_free(input *in) {
@@ -676,8 +677,8 @@ static km_status prepare_input(input *in, const km_morph_input *src,
 static km_status blend_signature(const km_morph *m, double t,
                                  km_signature *out, km_error *err);
 static km_status close_lsq(const km_signature *sig, bool by_corners,
-                           km_signature *out, double *gap0, bool *used_corners,
-                           km_error *err);
+                           const double *weights, km_signature *out,
+                           double *gap0, bool *used_corners, km_error *err);
 
 /* Whether the lsq closure goes by the frames' corners: so if it can at
  * t = 1/4, 1/2 and 3/4, for every frame of the morph (a sequence must not
@@ -690,7 +691,7 @@ static bool corners_close(const km_morph *m) {
     double gap;
     bool used = false;
     bool ok = blend_signature(m, k / 4.0, &blended, NULL) == KM_OK &&
-              close_lsq(&blended, true, &closed, &gap, &used, NULL) == KM_OK;
+              close_lsq(&blended, true, NULL, &closed, &gap, &used, NULL) == KM_OK;
     km_signature_free(&blended);
     km_signature_free(&closed);
     if (!ok || !used) return false;
@@ -889,6 +890,7 @@ static km_status create_impl(km_morph **out, const km_morph_input *from,
                                     &m->lin[1], err);
     if (st) goto fail;
   }
+  m->kmax = fmax(km_signature_max_abs_kappa(&a->sig), km_signature_max_abs_kappa(&b->sig));
   /* Frames of the default morph (turning blend, no matches, cubic output)
    * are planned once: see morph_plan.c. Others are blended piece by piece
    * and reconstructed frame by frame. */
@@ -1429,15 +1431,16 @@ static km_status closure_nodes(const km_pp *kp, const km_pp *tp, double h,
   return KM_OK;
 }
 
-/* Closed curve nearest in curvature (L2) to sig: see the DESIGN note. With
+/* Closed curve nearest in curvature (L2, weighted by weights[iv] on the
+ * basis interval iv when given) to sig: see the DESIGN note. With
  * by_corners, the interior corners take the whole correction when they can
  * (km__close_by_corners: the smooth curvature keeps its bound, straight
  * edges stay straight; *used_corners then true), else the smooth curvature
  * does. On success *out is the corrected signature and *gap0 the gap
  * before. */
 static km_status close_lsq(const km_signature *sig, bool by_corners,
-                           km_signature *out, double *gap0, bool *used_corners,
-                           km_error *err) {
+                           const double *weights, km_signature *out,
+                           double *gap0, bool *used_corners, km_error *err) {
   enum { NB = LSQ_INTERVALS, NF = LSQ_INTERVALS - 3 };
   double L = sig->length, h = L / NB;
   km_pp kp, tp, dpsi, kt;
@@ -1514,7 +1517,10 @@ static km_status close_lsq(const km_signature *sig, bool by_corners,
   /* the metric: Gram matrix of the basis derivatives in s (see
    * morph_plan.c) */
   double M[NF * NF];
-  km__closure_metric(M);
+  if (weights)
+    km__closure_metric_weighted(weights, M);
+  else
+    km__closure_metric(M);
   for (int i = 0; i < NF * NF; i++) M[i] /= h;
   for (int it = 0;; it++) {
     double G[2] = {0, 0}, J[2][NF];
@@ -1863,6 +1869,79 @@ done:
   return st;
 }
 
+/* Largest |kappa| over each basis interval of the closure (a bound from
+ * the pieces' Bernstein coefficients). */
+static void interval_max(const km_fn *kappa, double L, double *out) {
+  enum { NB = LSQ_INTERVALS };
+  for (int iv = 0; iv < NB; iv++) out[iv] = 0.0;
+  km_pp p;
+  km__pp_init(&p);
+  if (km__pp_from_fn(&p, kappa)) {
+    double k = km_fn_max_abs(kappa); /* no memory: one bound for all */
+    for (int iv = 0; iv < NB; iv++) out[iv] = k;
+    return;
+  }
+  double h = L / NB;
+  int d = p.degree;
+  for (size_t i = 0; i < p.m; i++) {
+    double a = p.x[i], b = p.x[i + 1], w = b - a;
+    if (!(w > 0)) continue;
+    int iv0 = (int)floor(a / h), iv1 = (int)floor(b / h);
+    for (int iv = iv0 < 0 ? 0 : iv0; iv <= iv1 && iv < NB; iv++) {
+      double lo = fmax(a, iv * h), hi = fmin(b, (iv + 1) * h), r[KM_MAX_FN_DEGREE + 2];
+      if (!(hi > lo)) continue;
+      km__bern_restrict(p.c + i * (size_t)(d + 1), d, (lo - a) / w, (hi - a) / w, r);
+      out[iv] = fmax(out[iv], km__bern_abs_bound(r, d));
+    }
+  }
+  km__pp_free(&p);
+}
+
+/* The lsq closure of a blended frame, kept within the inputs' largest
+ * |kappa| where the least change would cross it. The blend is a convex
+ * combination, so the bound holds before closing; a matched frame can
+ * leave a large gap, and its least L2 change of curvature may push past
+ * the bound where the blend is already close to it. Then the change is
+ * weighted away from there: by 1 / margin^2 on each basis interval, the
+ * margin being how far the blend stays below the bound there, and by a
+ * hundred times more wherever the result still crosses it, for a few
+ * rounds. The closure keeps closing the frame to the same precision; only
+ * where the curvature changes moves. Frames without matches change too
+ * little to need this (and their planned form must agree with this one). */
+static km_status close_within_bound(const km_morph *m, const km_signature *blended,
+                                    km_signature *out, double *gap, km_error *err) {
+  enum { NB = LSQ_INTERVALS };
+  bool used = false;
+  km_status st = close_lsq(blended, m->close_by_corners, NULL, out, gap, &used, err);
+  double bound = m->kmax * (1 + 1e-9);
+  if (st || used || m->nuser == 0 || km_signature_max_abs_kappa(out) <= bound) return st;
+  double w[NB], kb[NB], best = km_signature_max_abs_kappa(out);
+  interval_max(&blended->kappa, blended->length, kb);
+  for (int iv = 0; iv < NB; iv++) {
+    double margin = fmax((m->kmax - kb[iv]) / m->kmax, 1e-3);
+    w[iv] = 1.0 / (margin * margin);
+  }
+  for (int round = 0; round < 6; round++) {
+    km_signature trial;
+    double g;
+    km_signature_init(&trial);
+    if (close_lsq(blended, false, w, &trial, &g, NULL, NULL) != KM_OK) break;
+    double k = km_signature_max_abs_kappa(&trial);
+    interval_max(&trial.kappa, trial.length, kb);
+    for (int iv = 0; iv < NB; iv++)
+      if (kb[iv] > bound) w[iv] *= 100.0;
+    if (k < best) {
+      best = k;
+      km_signature_free(out);
+      *out = trial;
+      if (k <= bound) return KM_OK;
+    } else {
+      km_signature_free(&trial);
+    }
+  }
+  return KM_OK; /* the closed frame nearest to the bound */
+}
+
 km_status km_morph_frame(const km_morph *m, double t, km_curve *out,
                          km_frame_metrics *metrics, km_signature *sig_out,
                          km_error *err) {
@@ -1885,7 +1964,7 @@ km_status km_morph_frame(const km_morph *m, double t, km_curve *out,
   if (st) goto done;
   if (m->closed && how == KM_CLOSURE_LSQ) {
     /* close_lsq measures the gap itself (its first residual) */
-    st = close_lsq(&blended, m->close_by_corners, &closed, &gap, NULL, err);
+    st = close_within_bound(m, &blended, &closed, &gap, err);
     if (st) goto done;
     use = &closed;
   } else if (m->closed) {

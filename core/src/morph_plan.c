@@ -120,6 +120,15 @@ static void bell(const double *x, int mmax, double *B) {
   }
 }
 
+static double bspline3_d(double u) {
+  if (u <= 0 || u >= 4) return 0.0;
+  if (u < 1) return u * u / 2.0;
+  if (u < 2) return (-9 * u * u + 24 * u - 12) / 6.0;
+  if (u < 3) return (9 * u * u - 48 * u + 60) / 6.0;
+  double v = 4 - u;
+  return -v * v / 2.0;
+}
+
 static double bspline3(double u) {
   if (u <= 0 || u >= 4) return 0.0;
   if (u < 1) return u * u * u / 6.0;
@@ -151,6 +160,23 @@ static double psi_at_break(const km__frame_plan *p, const double *c, size_t k) {
   for (int q = 0; q < 4; q++)
     if (b->bi + q >= 0 && b->bi + q < NF) v += c[b->bi + q] * b->bv[q];
   return v;
+}
+
+void km__closure_metric_weighted(const double *w, double *M) {
+  /* per interval the four basis derivatives are quadratics: three Gauss
+   * points integrate their products exactly */
+  static const double X[3] = {0.11270166537925831, 0.5, 0.88729833462074169};
+  static const double W[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
+  memset(M, 0, NF * NF * sizeof(double));
+  for (int iv = 0; iv < NB; iv++)
+    for (int g = 0; g < 3; g++) {
+      double u = iv + X[g], d[NF];
+      for (int i = 0; i < NF; i++) d[i] = bspline3_d(u - i);
+      for (int i = 0; i < NF; i++) {
+        if (d[i] == 0.0) continue;
+        for (int j = 0; j < NF; j++) M[i * NF + j] += w[iv] * W[g] * d[i] * d[j];
+      }
+    }
 }
 
 void km__closure_metric(double *M) {

@@ -40,6 +40,9 @@ bool km__frame_plan_by_corners(const km__frame_plan *p);
  * functions in the variable of unit knot spacing ((KM__CLOSURE_INTERVALS -
  * 3)^2 values, exact). */
 void km__closure_metric(double *M);
+/* The same Gram matrix with the weight w[iv] on basis interval iv
+ * (KM__CLOSURE_INTERVALS of them): integral of w psi_i' psi_j'. */
+void km__closure_metric_weighted(const double *w, double *M);
 
 /* The frame at t as a cubic B-spline in its arc length, starting at the
  * origin with tangent angle theta0. close_lsq: closes a closed pair by the

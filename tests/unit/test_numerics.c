@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "../../core/src/internal.h"
+#include "../../core/src/morph_plan.h"
 #include "testutil.h"
 
 #define PI 3.14159265358979323846
@@ -98,6 +99,41 @@ static void sincos_agrees_with_libm(void **state) {
   assert_true(s == sin(3e7) && c == cos(3e7));
   km__sincos(0.0, &s, &c);
   assert_true(s == 0.0 && c == 1.0);
+}
+
+/* ---- the closure's metric ---------------------------------------------- */
+
+static void weighted_closure_metric_is_the_gram_matrix(void **state) {
+  (void)state;
+  enum { NB = KM__CLOSURE_INTERVALS, NF = KM__CLOSURE_INTERVALS - 3 };
+  double M[NF * NF], W[NF * NF], w[NB];
+  /* unit weights: the Toeplitz band 2/3, -1/8, -1/5, -1/120 */
+  for (int i = 0; i < NB; i++) w[i] = 1.0;
+  km__closure_metric(M);
+  km__closure_metric_weighted(w, W);
+  for (int i = 0; i < NF * NF; i++) assert_close(W[i], M[i], 1e-15);
+  assert_close(M[0], 2.0 / 3.0, 1e-15);
+  assert_close(M[1], -1.0 / 8.0, 1e-15);
+  /* a weight on one interval only: the integral of psi_i' psi_j' there,
+   * by a fine midpoint rule on the derivative of the cubic B-spline */
+  for (int i = 0; i < NB; i++) w[i] = i == 7 ? 3.0 : 0.0;
+  km__closure_metric_weighted(w, W);
+  for (int i = 0; i < NF; i++)
+    for (int j = 0; j < NF; j++) {
+      double sum = 0.0;
+      const int n = 20000;
+      for (int k = 0; k < n; k++) {
+        double u = 7.0 + (k + 0.5) / n, di, dj;
+        double a = u - i, b = u - j;
+        /* derivative of the uniform cubic B-spline on [0, 4] */
+        di = a <= 0 || a >= 4 ? 0 : a < 1 ? a * a / 2 : a < 2 ? (-9 * a * a + 24 * a - 12) / 6
+             : a < 3 ? (9 * a * a - 48 * a + 60) / 6 : -(4 - a) * (4 - a) / 2;
+        dj = b <= 0 || b >= 4 ? 0 : b < 1 ? b * b / 2 : b < 2 ? (-9 * b * b + 24 * b - 12) / 6
+             : b < 3 ? (9 * b * b - 48 * b + 60) / 6 : -(4 - b) * (4 - b) / 2;
+        sum += di * dj / n;
+      }
+      assert_close(W[i * NF + j], 3.0 * sum, 1e-8);
+    }
 }
 
 /* ---- merging pieces ---------------------------------------------------- */
@@ -261,6 +297,7 @@ int main(void) {
       cmocka_unit_test(cheb_cumulative_of_exp_is_spectrally_accurate),
       cmocka_unit_test(bern_eval_is_within_its_rounding_bound),
       cmocka_unit_test(sincos_agrees_with_libm),
+      cmocka_unit_test(weighted_closure_metric_is_the_gram_matrix),
       cmocka_unit_test(merge_of_one_polynomial_is_one_piece),
       cmocka_unit_test(merge_stays_within_delta_across_a_kink),
       cmocka_unit_test(merge_never_crosses_a_jump),
