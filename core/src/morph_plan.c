@@ -882,18 +882,19 @@ static double max_abs(const double *v, int n) {
  * The lsq closure solves G(c) = 0 for the least change of curvature: a
  * projection onto the linearised constraints (the minimum-norm point of
  * J c = J c_old - G in the metric integral psi'^2, whose Gram matrix is
- * Toeplitz with entries 2/3, -1/8, -1/5, -1/120), then a chord step with
- * the same J: dc1 = M^-1 J^T lambda, J dc1 = -G(c1). Its result needs no
- * further pass when a bound on what is left says so:
- *   G(c1 + dc1) = (J(c1) - J(c0)) dc1 + R,
- * |J(c1) - J(c0)| dc1 <= max|dc0| sum_i |dc1_i| wb_i (|e^(i a) - e^(i b)|
- * <= |a - b|, and |psi change| <= max|dc| since the basis sums to at most
- * one), |R| <= max|dc1|^2 / 2 (the Taylor remainder of e^(i d), the
- * weights summing to one). Below 1e-11 the pieces' sums take the linear
- * change (linear_finish, each within its share of the same bound) and the
- * frame is closed to 1e-11 of its length, as by a further pass. Otherwise
- * Newton steps with fresh Jacobians follow, which converge quadratically,
- * and end the same way once max|dc|^2 / 2 is below 1e-11. */
+ * Toeplitz with entries 2/3, -1/8, -1/5, -1/120), then steps dc =
+ * M^-1 J^T lambda with J dc = -G: with the projection's J (a chord step)
+ * when the projection moved c by at most 1e-3, else Newton steps with
+ * fresh Jacobians, which converge quadratically. No pass follows the last
+ * step when a bound on what it leaves says so:
+ *   G(c + dc) = (J(c) - J(c0)) dc + R,
+ * |J(c) - J(c0)| dc <= max|dc0| sum_i |dc_i| wb_i for the chord (|e^(i a)
+ * - e^(i b)| <= |a - b|, and |psi change| <= max|dc| since the basis sums
+ * to at most one; nothing for Newton), |R| <= max|dc|^2 / 2 (the Taylor
+ * remainder of e^(i d), the weights summing to one). Below 1e-11 the
+ * pieces' sums take the linear change (linear_finish, each within its
+ * share of the same bound) and the frame is closed to 1e-11 of its
+ * length, as by a further pass. */
 static km_status close_frame(const km__frame_plan *p, double t, double theta0,
                              bool close_lsq, double *c, double *sum,
                              double *scratch) {
@@ -916,31 +917,29 @@ static km_status close_frame(const km__frame_plan *p, double t, double theta0,
     dc[i] = ci - c[i];
     c[i] = ci;
   }
+  /* A small first change leaves so little that a chord step with this
+   * Jacobian finishes (the bound below); a large one needs Newton steps
+   * with fresh Jacobians, which converge quadratically. */
   double dc0 = max_abs(dc, NF);
-  memcpy(dcp + 3, dc, sizeof dc);
-  frame_pass(p, t, theta0, cp, dcp, true, sum, e, G, NULL);
-  if (Lt * hypot(G[0], G[1]) <= 1e-11 * Lt) return KM_OK;
-  /* chord step with the projection's Jacobian */
-  double r2[2] = {-G[0], -G[1]};
-  if (!metric_step(Y, S, r2, dc)) return KM_ENOCONVERGE;
-  double dc1 = max_abs(dc, NF), cross = 0.0;
-  for (int i = 0; i < NF; i++) cross += fabs(dc[i]) * p->wb[i];
+  bool chord = dc0 <= 1e-3;
   for (int it = 0;; it++) {
-    for (int i = 0; i < NF; i++) c[i] += dc[i];
     memcpy(dcp + 3, dc, sizeof dc);
-    if (dc0 * cross + 0.5 * dc1 * dc1 <= 1e-11 && isfinite(dc1)) {
+    frame_pass(p, t, theta0, cp, dcp, true, sum, e, G, chord ? NULL : J);
+    if (Lt * hypot(G[0], G[1]) <= 1e-11 * Lt) return KM_OK;
+    if (it == 40) return KM_ENOCONVERGE;
+    if (!chord) metric_rows(p, J, Y, S);
+    double r[2] = {-G[0], -G[1]}, cross = 0.0;
+    if (!metric_step(Y, S, r, dc)) return KM_ENOCONVERGE;
+    if (chord)
+      for (int i = 0; i < NF; i++) cross += fabs(dc[i]) * p->wb[i];
+    for (int i = 0; i < NF; i++) c[i] += dc[i];
+    double d = max_abs(dc, NF);
+    if (dc0 * cross + 0.5 * d * d <= 1e-11 && isfinite(d)) {
+      memcpy(dcp + 3, dc, sizeof dc);
       linear_finish(p, dcp, e, sum);
       return KM_OK;
     }
-    /* Newton with a fresh Jacobian: the bound loses its cross term */
-    frame_pass(p, t, theta0, cp, dcp, true, sum, e, G, J);
-    if (Lt * hypot(G[0], G[1]) <= 1e-11 * Lt) return KM_OK;
-    if (it == 40) return KM_ENOCONVERGE;
-    metric_rows(p, J, Y, S);
-    double r3[2] = {-G[0], -G[1]};
-    if (!metric_step(Y, S, r3, dc)) return KM_ENOCONVERGE;
-    dc0 = 0.0;
-    dc1 = max_abs(dc, NF);
+    chord = false; /* from here on, Newton */
   }
 }
 
