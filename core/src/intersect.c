@@ -438,6 +438,7 @@ long km_curve_self_intersections(const km_curve *c, double tol) {
   for (size_t i = 0; i < x.nseg && !x.oom; i++)
     for (size_t j = i + 1; j < x.nseg && !x.oom; j++) {
       if (order[j]->xmin > order[i]->xmax + x.tol) break;
+      if (!boxes_overlap(order[i], order[j], x.tol)) continue;
       if (consecutive_same_way(&x, order[i], order[j])) continue;
       pair(&x, order[i], order[j], 0);
     }

@@ -903,11 +903,14 @@ fail:
   return st;
 }
 
-static long preview_crossings(const km_morph *m) {
+/* Self-crossings of five frames (t = 1/6 .. 5/6), counted until they
+ * reach cap: a candidate that has as many as the best one so far loses. */
+static long preview_crossings(const km_morph *m, long cap) {
   long total = 0;
-  for (int k = 1; k <= 5; k++) {
+  static const double T[5] = {3 / 6.0, 2 / 6.0, 4 / 6.0, 1 / 6.0, 5 / 6.0};
+  for (int k = 0; k < 5 && total < cap; k++) {
     km_curve c;
-    if (km_morph_frame(m, k / 6.0, &c, NULL, NULL, NULL) != KM_OK) return LONG_MAX;
+    if (km_morph_frame(m, T[k], &c, NULL, NULL, NULL) != KM_OK) return LONG_MAX;
     long x = km_curve_self_intersections(&c, m->tol);
     km_curve_free(&c);
     if (x > 0) total += x;
@@ -927,12 +930,12 @@ km_status km_morph_create(km_morph **out, const km_morph_input *from,
    * cross themselves: preview five frames of the best and, only if they
    * cross, of the next candidates. */
   if (ncand > 1 && opt->method == KM_METHOD_CURVATURE) {
-    long best = preview_crossings(m);
+    long best = preview_crossings(m, LONG_MAX);
     for (size_t i = 1; i < ncand && best > 0; i++) {
       km_morph *alt = NULL;
       double d = cand[i] - cand[0];
       if (morph_shifted(m, d < 0 ? d + 1.0 : d, &alt, NULL) != KM_OK) continue;
-      long x = preview_crossings(alt);
+      long x = preview_crossings(alt, best);
       if (x < best) {
         km_morph_free(m);
         m = alt;
