@@ -15,6 +15,7 @@
  * one), and the tangents are transversal. Roots found twice (a crossing on
  * a piece boundary, or on the seam) are merged by parameter.
  */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -51,6 +52,7 @@ typedef struct ctx {
   const km__hcurve *bz; /* Bezier form, dim 3 */
   double t0, t1;        /* curve domain */
   double tol, flat, size, eps_t;
+  double mag; /* largest |coordinate| of the control points */
   bool closed;
   seg *segs;
   size_t nseg, capseg;
@@ -253,7 +255,13 @@ static void refine(ctx *x, size_t ka, double ua, size_t kb, double ub) {
   ub = bub;
   eval_piece(x, ka, ua, Pa, Da);
   eval_piece(x, kb, ub, Pb, Db);
-  if (!(hypot(Pa[0] - Pb[0], Pa[1] - Pb[1]) <= x->tol)) return;
+  /* A crossing is a root: Newton, quadratic there, meets it to the
+   * rounding of the coordinates. Two branches that only come within tol
+   * (round a sharp tip, where a degenerate control leg puts curvature in
+   * the hundreds) leave Newton wandering, and its best iterate there is no
+   * crossing however close. */
+  double reach = fmax(1e-10 * x->size, 256 * DBL_EPSILON * x->mag);
+  if (!(hypot(Pa[0] - Pb[0], Pa[1] - Pb[1]) <= fmin(x->tol, reach))) return;
   double ta = piece_t(x, ka, ua), tb = piece_t(x, kb, ub);
   if (x->closed) {
     /* the seam is one point of a closed curve */
@@ -411,6 +419,7 @@ long km_curve_self_intersections(const km_curve *c, double tol) {
     ymax = fmax(ymax, c->cp[2 * i + 1]);
   }
   x.size = hypot(xmax - xmin, ymax - ymin);
+  x.mag = fmax(fmax(fabs(xmin), fabs(xmax)), fmax(fabs(ymin), fabs(ymax)));
   if (!(x.size > 0) || !isfinite(x.size)) {
     result = 0;
     goto cleanup;
