@@ -46,6 +46,7 @@
  */
 #include <limits.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -927,23 +928,34 @@ km_status km_morph_create(km_morph **out, const km_morph_input *from,
   km_status st = create_impl(&m, from, to, opt, cand, &ncand, err);
   if (st) return st;
   /* Among starts that align about as well, prefer one whose frames do not
-   * cross themselves: preview five frames of the best and, only if they
-   * cross, of the next candidates. */
+   * cross themselves: the first candidate, in order of alignment, none of
+   * whose five preview frames crosses (each stops at its first crossing);
+   * failing that the one with the fewest crossings, the better aligned
+   * among equals. */
   if (ncand > 1 && opt->method == KM_METHOD_CURVATURE) {
-    long best = preview_crossings(m, LONG_MAX);
-    for (size_t i = 1; i < ncand && best > 0; i++) {
+    km_morph *alts[SHIFT_CANDIDATES] = {m};
+    size_t n = 1, pick = SIZE_MAX;
+    if (preview_crossings(m, 1) == 0) pick = 0;
+    for (size_t i = 1; i < ncand && pick == SIZE_MAX; i++) {
       km_morph *alt = NULL;
       double d = cand[i] - cand[0];
       if (morph_shifted(m, d < 0 ? d + 1.0 : d, &alt, NULL) != KM_OK) continue;
-      long x = preview_crossings(alt, best);
-      if (x < best) {
-        km_morph_free(m);
-        m = alt;
-        best = x;
-      } else {
-        km_morph_free(alt);
+      alts[n++] = alt;
+      if (preview_crossings(alt, 1) == 0) pick = n - 1;
+    }
+    if (pick == SIZE_MAX) {
+      long best = LONG_MAX;
+      for (size_t k = 0; k < n; k++) {
+        long x = preview_crossings(alts[k], best);
+        if (x < best || pick == SIZE_MAX) {
+          best = x;
+          pick = k;
+        }
       }
     }
+    for (size_t k = 0; k < n; k++)
+      if (k != pick) km_morph_free(alts[k]);
+    m = alts[pick];
   }
   *out = m;
   return KM_OK;
