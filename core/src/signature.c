@@ -760,6 +760,8 @@ km_status km_signature_compute(const km_curve *c, double tol,
    * twice its length, and all such pieces together may cost a twentieth
    * of the tolerance. */
   b.free_len = 0.05 * tol;
+  double point_len = 0.25 * tol; /* twice the length of spans taken as
+                                    points, see below */
   b.tol = tol;
   b.tol_theta = fmin(0.25 * tol / L, 1e-3);
 
@@ -774,9 +776,26 @@ km_status km_signature_compute(const km_curve *c, double tol,
     if (!(len > 1e-15 * L)) continue; /* a span that is a single point */
     km__bspan_make(&b.span, c, i);
     /* or one whose length is its rounding error: equal control points
-     * far from the origin; the turn across it is checked as a corner */
+     * far from the origin; the turn across it is checked as a corner.
+     * Each such span is lost from the pieces (up to its length in
+     * position) and its length then stretches the others (as much
+     * again), so together they may cost a quarter of the tolerance;
+     * past that the spans are a real curve whose shape its coordinates
+     * do not carry, refused rather than taken for a point. */
     double noise = span_noise(&b.span);
-    if (!(len > noise)) continue;
+    if (!(len > noise)) {
+      if (2.0 * len <= point_len) {
+        point_len -= 2.0 * len;
+        continue;
+      }
+      st = km__fail(err, KM_ERANGE, KM_FIELD_CONTROL_POINTS, -1, ua,
+                    "the spans near parameter t = %g are no longer than "
+                    "the rounding of their coordinates (%g, up to %g): "
+                    "move the curve nearer the origin or use fewer, "
+                    "longer spans",
+                    ua, noise, extent);
+      goto cleanup;
+    }
     b.span_t = ub - ua;
     b.span_speed = len / (ub - ua);
     b.span_len = len;
