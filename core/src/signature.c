@@ -422,6 +422,63 @@ void km__cheb_cumulative15(const double *f, double *F) {
   }
 }
 
+/* Bernstein coefficients of theta on a piece of length h from its values
+ * th at the arc lengths s of the nodes (from the piece's start): the
+ * degree-7 interpolant of the even points if it meets the odd ones within
+ * tol_here, else theta linear in s if that meets every point. False if
+ * neither does. */
+static bool fit_theta(const double *th, const double *s, double h,
+                      double tol_here, double *coef) {
+  double A[(THETA_DEGREE + 1) * (THETA_DEGREE + 1)];
+  for (int j = 0; j <= THETA_DEGREE; j++) {
+    double u = (s[2 * j] - s[0]) / h;
+    km__bernstein_basis(u, THETA_DEGREE, A + j * (THETA_DEGREE + 1));
+    coef[j] = th[2 * j];
+  }
+  bool ok = km__solve_dense(A, coef, THETA_DEGREE + 1);
+  /* pin the ends exactly so theta is continuous across pieces */
+  if (ok) {
+    coef[0] = th[0];
+    coef[THETA_DEGREE] = th[NPTS - 1];
+  }
+  /* A strongly varying speed (rational spans with unequal weights)
+   * crowds the nodes' images in s, and the interpolant can swing far
+   * between them while meeting every check point: its coefficient hull,
+   * which bounds it, must stay near the data's range. */
+  if (ok) {
+    double dlo = th[0], dhi = th[0], clo = coef[0], chi = coef[0];
+    for (int k = 1; k < NPTS; k++) {
+      dlo = fmin(dlo, th[k]);
+      dhi = fmax(dhi, th[k]);
+    }
+    for (int j = 1; j <= THETA_DEGREE; j++) {
+      clo = fmin(clo, coef[j]);
+      chi = fmax(chi, coef[j]);
+    }
+    if (chi - clo > 1.001 * (dhi - dlo) + 4 * tol_here) ok = false;
+  }
+  for (int k = 1; ok && k < NPTS; k += 2) {
+    double u = (s[k] - s[0]) / h;
+    if (fabs(km__bern_eval(coef, THETA_DEGREE, u) - th[k]) > tol_here)
+      ok = false;
+  }
+  if (!ok) {
+    /* Where theta moves less than its rounding noise (a speed near zero,
+     * coordinates far from the origin) the interpolant through noisy
+     * values swings and bisecting only samples more noise: theta linear
+     * in s is accepted when it meets every node and check point. */
+    bool lin = true;
+    for (int k = 1; lin && k < NPTS - 1; k++)
+      lin = fabs(th[0] + (th[NPTS - 1] - th[0]) * ((s[k] - s[0]) / h) - th[k]) <=
+            tol_here;
+    if (lin) {
+      linear_theta(th[0], th[NPTS - 1], coef);
+      ok = true;
+    }
+  }
+  return ok;
+}
+
 /* Interpolate theta on the piece [ua, ub] of the current span; bisect in t
  * until the check points agree. *s_at is the arc length at ua on entry
  * and at ub on exit; *theta is the unwrapped angle at ua on entry (whose
@@ -517,17 +574,13 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
                     "to full precision",
                     ua);
   /* the lengths agree to their rounding: the speed's, deriv_noise, over
-   * the piece, and a few ulps */
-  if (fabs(h - ref) > 1e-12 * ref + 1e-16 * b->L + b->deriv_noise * (ub - ua)) {
-    /* the speed is not resolved by the nodes (near-degenerate leg) */
-    for (int k = 1; k < NPTS; k++)
-      s[k] = s[k - 1] + span_length(b, t[k - 1], t[k]);
-    if (isnan(s[NPTS - 1]))
-      return km__fail(b->err, KM_ENOCONVERGE, KM_FIELD_CONTROL_POINTS, -1, ua,
-                      "the arc length near parameter t = %g cannot be "
-                      "computed to full precision",
-                      ua);
-  }
+   * the piece, and a few ulps; otherwise the speed is not resolved by the
+   * nodes (a near-degenerate leg, a sharp tip) and their positions are
+   * only approximate until measured one by one, below */
+  bool nodes_exact =
+      fabs(h - ref) <= 1e-12 * ref + 1e-16 * b->L + b->deriv_noise * (ub - ua);
+  if (!nodes_exact && h > 0)
+    for (int k = 1; k < NPTS - 1; k++) s[k] *= ref / h;
   s[NPTS - 1] = ref;
   h = ref;
   /* the noise allowance may not cost more than a twentieth of the
@@ -573,55 +626,23 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
                     "curve is not regular there",
                     mid);
   double coef[THETA_DEGREE + 1];
-  bool ok = !coarse;
-  if (ok) {
-    double A[(THETA_DEGREE + 1) * (THETA_DEGREE + 1)];
-    for (int j = 0; j <= THETA_DEGREE; j++) {
-      double u = (s[2 * j] - s[0]) / h;
-      km__bernstein_basis(u, THETA_DEGREE, A + j * (THETA_DEGREE + 1));
-      coef[j] = th[2 * j];
-    }
-    ok = km__solve_dense(A, coef, THETA_DEGREE + 1);
-    /* pin the ends exactly so theta is continuous across pieces */
-    if (ok) {
-      coef[0] = th[0];
-      coef[THETA_DEGREE] = th[NPTS - 1];
-    }
-    /* A strongly varying speed (rational spans with unequal weights)
-     * crowds the nodes' images in s, and the interpolant can swing far
-     * between them while meeting every check point: its coefficient hull,
-     * which bounds it, must stay near the data's range. */
-    if (ok) {
-      double dlo = th[0], dhi = th[0], clo = coef[0], chi = coef[0];
-      for (int k = 1; k < NPTS; k++) {
-        dlo = fmin(dlo, th[k]);
-        dhi = fmax(dhi, th[k]);
-      }
-      for (int j = 1; j <= THETA_DEGREE; j++) {
-        clo = fmin(clo, coef[j]);
-        chi = fmax(chi, coef[j]);
-      }
-      if (chi - clo > 1.001 * (dhi - dlo) + 4 * tol_here) ok = false;
-    }
-    for (int k = 1; ok && k < NPTS; k += 2) {
-      double u = (s[k] - s[0]) / h;
-      if (fabs(km__bern_eval(coef, THETA_DEGREE, u) - th[k]) > tol_here)
-        ok = false;
-    }
-  }
-  if (!ok && !coarse) {
-    /* Where theta moves less than its rounding noise (a speed near zero,
-     * coordinates far from the origin) the interpolant through noisy
-     * values swings and bisecting only samples more noise: theta linear
-     * in s is accepted when it meets every node and check point. */
-    bool lin = true;
-    for (int k = 1; lin && k < NPTS - 1; k++)
-      lin = fabs(th[0] + (th[NPTS - 1] - th[0]) * ((s[k] - s[0]) / h) - th[k]) <=
-            tol_here;
-    if (lin) {
-      linear_theta(th[0], th[NPTS - 1], coef);
-      ok = true;
-    }
+  bool ok = !coarse && fit_theta(th, s, h, tol_here, coef);
+  /* Measuring the nodes one by one costs fourteen adaptive quadratures: a
+   * piece whose theta fails at their approximate positions is bisected
+   * without them (where the speed is unresolved theta nearly always is,
+   * and halves resolve both). A piece about to be taken, or that cannot
+   * be bisected, or whose directions are noise, is judged at the exact
+   * positions. */
+  if (!nodes_exact && !coarse &&
+      (ok || noise >= 0.1 || depth >= KM_MAX_REFINE_DEPTH || tiny_t)) {
+    for (int k = 1; k < NPTS - 1; k++)
+      s[k] = s[k - 1] + span_length(b, t[k - 1], t[k]);
+    if (isnan(s[NPTS - 2]))
+      return km__fail(b->err, KM_ENOCONVERGE, KM_FIELD_CONTROL_POINTS, -1, ua,
+                      "the arc length near parameter t = %g cannot be "
+                      "computed to full precision",
+                      ua);
+    ok = fit_theta(th, s, h, tol_here, coef);
   }
   if (!ok && noise >= 0.1 && big_step < KM_PI - 0.5 &&
       2.0 * h <= b->free_len) {
