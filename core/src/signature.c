@@ -353,15 +353,15 @@ static double counted_length(const km__bspan *sp, double u0, double u1,
   return len;
 }
 
-/* Arc length of a whole span by the 16-point Gauss-Legendre rule: exact to
- * rounding for a span whose speed is smooth, which is checked (fit_piece)
- * before it is used as the length. */
-static double gl16_length(const km__bspan *sp) {
-  double len = 0.0;
+/* Arc length of a span over [u0, u1] of its variable by the 16-point
+ * Gauss-Legendre rule: exact to rounding where the speed is smooth, which
+ * is checked (fit_piece) before it is used as the length. */
+static double gl16_length(const km__bspan *sp, double u0, double u1) {
+  double len = 0.0, mid = 0.5 * (u0 + u1), half = 0.5 * (u1 - u0);
   for (int k = 0; k < 16; k++) {
     double pos[2], d[2];
-    km__bspan_eval_u(sp, 0.5 + 0.5 * km__gl16_x[k], pos, d);
-    len += 0.5 * km__gl16_w[k] * sqrt(d[0] * d[0] + d[1] * d[1]);
+    km__bspan_eval_u(sp, mid + half * km__gl16_x[k], pos, d);
+    len += half * km__gl16_w[k] * sqrt(d[0] * d[0] + d[1] * d[1]);
   }
   return len;
 }
@@ -557,14 +557,18 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
   for (int k = 0; k < NPTS; k++) s[k] = half * F[k];
   double h = s[NPTS - 1] - s[0];
   /* A whole span comes with its length by 16-point Gauss-Legendre
-   * (known_len): where the spectral length at these 15 other nodes agrees
-   * to 1e-13 both rules have resolved the speed, and that is the length;
-   * elsewhere it is measured adaptively, for the span too. */
-  double ref;
-  if (known_len > 0 &&
-      fabs(h - known_len) <= 1e-13 * known_len + b->deriv_noise * (ub - ua)) {
-    ref = known_len;
-  } else {
+   * (known_len), and a piece inside it is measured by the same rule:
+   * where the spectral length at these 15 other nodes agrees to 1e-13
+   * both rules have resolved the speed, and that is the length; elsewhere
+   * it is measured adaptively, for the span too. */
+  double ref = known_len;
+  if (!(known_len > 0)) {
+    double w = b->span.b - b->span.a;
+    ref = gl16_length(&b->span, (ua - b->span.a) / w, (ub - b->span.a) / w);
+    b->work -= 16;
+    b->span_work -= 16;
+  }
+  if (!(fabs(h - ref) <= 1e-13 * ref + b->deriv_noise * (ub - ua))) {
     ref = span_length(b, ua, ub);
     if (known_len > 0) b->span_len = ref;
   }
@@ -729,7 +733,7 @@ km_status km_signature_compute(const km_curve *c, double tol,
       km__bspan sp;
       km__bspan_make(&sp, c, i);
       long evals = 0;
-      double est = gl16_length(&sp);
+      double est = gl16_length(&sp, 0.0, 1.0);
       b.work -= 16;
       if (!(est > 1e-9 * poly) || !(est > 1e6 * span_noise(&sp)))
         est = counted_length(&sp, 0.0, 1.0, 1e-15 * poly, &evals);
