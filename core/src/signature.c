@@ -422,6 +422,15 @@ void km__cheb_cumulative15(const double *f, double *F) {
   }
 }
 
+/* The allowed |theta - theta~| on a piece of length h whose directions
+ * carry a relative rounding error noise: the noise allowance may not cost
+ * more than a twentieth of the tolerance in position (|dC| <= h
+ * |d theta|). */
+static double theta_tol(const builder *b, double noise, double h) {
+  return b->tol_theta +
+         fmin(2.0 * noise, 0.05 * 4.0 * b->tol_theta * b->L / fmax(h, 1e-300));
+}
+
 /* Bernstein coefficients of theta on a piece of length h from its values
  * th at the arc lengths s of the nodes (from the piece's start): the
  * degree-7 interpolant of the even points if it meets the odd ones within
@@ -537,7 +546,6 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
   for (int k = 0; k < NPTS; k++)
     if (speed[k] > 0) noise = fmax(noise, b->deriv_noise / speed[k]);
   if (noise > 0.1) noise = 0.1;
-  double tol_here = b->tol_theta; /* widened for noise once h is known */
   /* unwrap, watching for steps too large to interpolate */
   bool coarse = false;
   double big_step = 0.0;
@@ -568,7 +576,27 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
     b->work -= 16;
     b->span_work -= 16;
   }
-  if (!(fabs(h - ref) <= 1e-13 * ref + b->deriv_noise * (ub - ua))) {
+  bool agree = fabs(h - ref) <= 1e-13 * ref + b->deriv_noise * (ub - ua);
+  bool tiny_t = (ub - ua) < 1e-13 * b->span_t;
+  /* Where they disagree the speed is not resolved over the piece, and
+   * theta seldom is: a piece inside the span that fails with the 16-point
+   * length and the nodes' spectral positions is bisected before adaptive
+   * quadrature measures it (work its halves would repeat). Only a piece
+   * that could be taken is measured: not one that cannot be bisected, has
+   * noisy directions, or may be of zero length. */
+  if (!agree && !(known_len > 0) && depth < KM_MAX_REFINE_DEPTH && !tiny_t &&
+      noise < 0.1 && fmin(h, ref) > 1e-12 * b->L) {
+    double sa[NPTS], ca[THETA_DEGREE + 1];
+    for (int k = 0; k < NPTS; k++) sa[k] = s[k] * (ref / h);
+    if (coarse || !fit_theta(th, sa, ref, theta_tol(b, noise, ref), ca)) {
+      double dm[2] = {dir[NPTS / 2][0], dir[NPTS / 2][1]};
+      km_status st =
+          fit_piece(b, ua, mid, 0.0, s_at, theta, dir_a, dm, depth + 1);
+      if (st) return st;
+      return fit_piece(b, mid, ub, 0.0, s_at, theta, dm, dir_b, depth + 1);
+    }
+  }
+  if (!agree) {
     ref = span_length(b, ua, ub);
     if (known_len > 0) b->span_len = ref;
   }
@@ -587,10 +615,7 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
     for (int k = 1; k < NPTS - 1; k++) s[k] *= ref / h;
   s[NPTS - 1] = ref;
   h = ref;
-  /* the noise allowance may not cost more than a twentieth of the
-   * tolerance in position (|dC| <= h |d theta|) */
-  tol_here += fmin(2.0 * noise, 0.05 * 4.0 * b->tol_theta * b->L / fmax(h, 1e-300));
-  bool tiny_t = (ub - ua) < 1e-13 * b->span_t;
+  double tol_here = theta_tol(b, noise, h);
   if (!(h > 1e-15 * b->L)) {
     /* a piece of (numerically) zero length: whatever turn it hides acts
      * as a corner at this point */
