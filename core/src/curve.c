@@ -509,8 +509,11 @@ void km__bspan_eval_u(const km__bspan *sp, double u, double pos[2],
   double d[KM__BSPAN_MAX][3];
   memcpy(d, sp->h, sizeof(double) * 3 * (size_t)(p + 1));
   for (int r = 1; r < p; r++)
-    for (int j = 0; j <= p - r; j++)
-      for (int q = 0; q < 3; q++) d[j][q] = v * d[j][q] + u * d[j + 1][q];
+    for (int j = 0; j <= p - r; j++) {
+      d[j][0] = v * d[j][0] + u * d[j + 1][0];
+      d[j][1] = v * d[j][1] + u * d[j + 1][1];
+      d[j][2] = v * d[j][2] + u * d[j + 1][2];
+    }
   /* The last step joins two points P0, P1 of weights w0, w1: C = (v w0 P0
    * + u w1 P1) / w and C' = p w0 w1 / w^2 (P1 - P0), with w = v w0 + u w1.
    * Unlike the quotient rule (H' - C w') / w, no large terms cancel, so

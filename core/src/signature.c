@@ -353,17 +353,17 @@ static double counted_length(const km__bspan *sp, double u0, double u1,
   return len;
 }
 
-/* Arc length of a span over [u0, u1] of its own variable by the 16-point
+/* Arc length of a span over [u0, u1] of its variable by the 16-point
  * Gauss-Legendre rule: exact to rounding where the speed is smooth, which
  * is checked (fit_piece) before it is used as the length. */
 static double gl16_length(const km__bspan *sp, double u0, double u1) {
-  double len = 0.0, m = 0.5 * (u0 + u1), hw = 0.5 * (u1 - u0);
+  double len = 0.0, mid = 0.5 * (u0 + u1), half = 0.5 * (u1 - u0);
   for (int k = 0; k < 16; k++) {
     double pos[2], d[2];
-    km__bspan_eval_u(sp, m + hw * km__gl16_x[k], pos, d);
-    len += km__gl16_w[k] * sqrt(d[0] * d[0] + d[1] * d[1]);
+    km__bspan_eval_u(sp, mid + half * km__gl16_x[k], pos, d);
+    len += half * km__gl16_w[k] * sqrt(d[0] * d[0] + d[1] * d[1]);
   }
-  return len * hw;
+  return len;
 }
 
 /* arc length inside the current span, in its own variable u */
@@ -420,6 +420,72 @@ void km__cheb_cumulative15(const double *f, double *F) {
     for (int j = 0; j < NPTS; j++) v += CHEB_CUMULATIVE[k][j] * f[j];
     F[k] = v;
   }
+}
+
+/* The allowed |theta - theta~| on a piece of length h whose directions
+ * carry a relative rounding error noise: the noise allowance may not cost
+ * more than a twentieth of the tolerance in position (|dC| <= h
+ * |d theta|). */
+static double theta_tol(const builder *b, double noise, double h) {
+  return b->tol_theta +
+         fmin(2.0 * noise, 0.05 * 4.0 * b->tol_theta * b->L / fmax(h, 1e-300));
+}
+
+/* Bernstein coefficients of theta on a piece of length h from its values
+ * th at the arc lengths s of the nodes (from the piece's start): the
+ * degree-7 interpolant of the even points if it meets the odd ones within
+ * tol_here, else theta linear in s if that meets every point. False if
+ * neither does. */
+static bool fit_theta(const double *th, const double *s, double h,
+                      double tol_here, double *coef) {
+  double A[(THETA_DEGREE + 1) * (THETA_DEGREE + 1)];
+  for (int j = 0; j <= THETA_DEGREE; j++) {
+    double u = (s[2 * j] - s[0]) / h;
+    km__bernstein_basis(u, THETA_DEGREE, A + j * (THETA_DEGREE + 1));
+    coef[j] = th[2 * j];
+  }
+  bool ok = km__solve_dense(A, coef, THETA_DEGREE + 1);
+  /* pin the ends exactly so theta is continuous across pieces */
+  if (ok) {
+    coef[0] = th[0];
+    coef[THETA_DEGREE] = th[NPTS - 1];
+  }
+  /* A strongly varying speed (rational spans with unequal weights)
+   * crowds the nodes' images in s, and the interpolant can swing far
+   * between them while meeting every check point: its coefficient hull,
+   * which bounds it, must stay near the data's range. */
+  if (ok) {
+    double dlo = th[0], dhi = th[0], clo = coef[0], chi = coef[0];
+    for (int k = 1; k < NPTS; k++) {
+      dlo = fmin(dlo, th[k]);
+      dhi = fmax(dhi, th[k]);
+    }
+    for (int j = 1; j <= THETA_DEGREE; j++) {
+      clo = fmin(clo, coef[j]);
+      chi = fmax(chi, coef[j]);
+    }
+    if (chi - clo > 1.001 * (dhi - dlo) + 4 * tol_here) ok = false;
+  }
+  for (int k = 1; ok && k < NPTS; k += 2) {
+    double u = (s[k] - s[0]) / h;
+    if (fabs(km__bern_eval(coef, THETA_DEGREE, u) - th[k]) > tol_here)
+      ok = false;
+  }
+  if (!ok) {
+    /* Where theta moves less than its rounding noise (a speed near zero,
+     * coordinates far from the origin) the interpolant through noisy
+     * values swings and bisecting only samples more noise: theta linear
+     * in s is accepted when it meets every node and check point. */
+    bool lin = true;
+    for (int k = 1; lin && k < NPTS - 1; k++)
+      lin = fabs(th[0] + (th[NPTS - 1] - th[0]) * ((s[k] - s[0]) / h) - th[k]) <=
+            tol_here;
+    if (lin) {
+      linear_theta(th[0], th[NPTS - 1], coef);
+      ok = true;
+    }
+  }
+  return ok;
 }
 
 /* Interpolate theta on the piece [ua, ub] of the current span; bisect in t
@@ -480,7 +546,6 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
   for (int k = 0; k < NPTS; k++)
     if (speed[k] > 0) noise = fmax(noise, b->deriv_noise / speed[k]);
   if (noise > 0.1) noise = 0.1;
-  double tol_here = b->tol_theta; /* widened for noise once h is known */
   /* unwrap, watching for steps too large to interpolate */
   bool coarse = false;
   double big_step = 0.0;
@@ -499,20 +564,39 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
    * can be shorter than the rounding unit of the absolute arc length */
   for (int k = 0; k < NPTS; k++) s[k] = half * F[k];
   double h = s[NPTS - 1] - s[0];
-  /* The length by 16-point Gauss-Legendre (a whole span comes with it,
-   * known_len): where the spectral length at these 15 other nodes agrees
-   * to 1e-13 both rules have resolved the speed, and that is the length;
-   * elsewhere it is measured adaptively (for the span too). */
-  double ref, est = known_len;
-  if (!(est > 0)) {
-    double a = b->span.a, w = b->span.b - a;
-    est = gl16_length(&b->span, (ua - a) / w, (ub - a) / w);
+  /* A whole span comes with its length by 16-point Gauss-Legendre
+   * (known_len), and a piece inside it is measured by the same rule:
+   * where the spectral length at these 15 other nodes agrees to 1e-13
+   * both rules have resolved the speed, and that is the length; elsewhere
+   * it is measured adaptively, for the span too. */
+  double ref = known_len;
+  if (!(known_len > 0)) {
+    double w = b->span.b - b->span.a;
+    ref = gl16_length(&b->span, (ua - b->span.a) / w, (ub - b->span.a) / w);
     b->work -= 16;
     b->span_work -= 16;
   }
-  if (est > 0 && fabs(h - est) <= 1e-13 * est + b->deriv_noise * (ub - ua)) {
-    ref = est;
-  } else {
+  bool agree = fabs(h - ref) <= 1e-13 * ref + b->deriv_noise * (ub - ua);
+  bool tiny_t = (ub - ua) < 1e-13 * b->span_t;
+  /* Where they disagree the speed is not resolved over the piece, and
+   * theta seldom is: a piece inside the span that fails with the 16-point
+   * length and the nodes' spectral positions is bisected before adaptive
+   * quadrature measures it (work its halves would repeat). Only a piece
+   * that could be taken is measured: not one that cannot be bisected, has
+   * noisy directions, or may be of zero length. */
+  if (!agree && !(known_len > 0) && depth < KM_MAX_REFINE_DEPTH && !tiny_t &&
+      noise < 0.1 && fmin(h, ref) > 1e-12 * b->L) {
+    double sa[NPTS], ca[THETA_DEGREE + 1];
+    for (int k = 0; k < NPTS; k++) sa[k] = s[k] * (ref / h);
+    if (coarse || !fit_theta(th, sa, ref, theta_tol(b, noise, ref), ca)) {
+      double dm[2] = {dir[NPTS / 2][0], dir[NPTS / 2][1]};
+      km_status st =
+          fit_piece(b, ua, mid, 0.0, s_at, theta, dir_a, dm, depth + 1);
+      if (st) return st;
+      return fit_piece(b, mid, ub, 0.0, s_at, theta, dm, dir_b, depth + 1);
+    }
+  }
+  if (!agree) {
     ref = span_length(b, ua, ub);
     if (known_len > 0) b->span_len = ref;
   }
@@ -522,23 +606,16 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
                     "to full precision",
                     ua);
   /* the lengths agree to their rounding: the speed's, deriv_noise, over
-   * the piece, and a few ulps */
-  if (fabs(h - ref) > 1e-12 * ref + 1e-16 * b->L + b->deriv_noise * (ub - ua)) {
-    /* the speed is not resolved by the nodes (near-degenerate leg) */
-    for (int k = 1; k < NPTS; k++)
-      s[k] = s[k - 1] + span_length(b, t[k - 1], t[k]);
-    if (isnan(s[NPTS - 1]))
-      return km__fail(b->err, KM_ENOCONVERGE, KM_FIELD_CONTROL_POINTS, -1, ua,
-                      "the arc length near parameter t = %g cannot be "
-                      "computed to full precision",
-                      ua);
-  }
+   * the piece, and a few ulps; otherwise the speed is not resolved by the
+   * nodes (a near-degenerate leg, a sharp tip) and their positions are
+   * only approximate until measured one by one, below */
+  bool nodes_exact =
+      fabs(h - ref) <= 1e-12 * ref + 1e-16 * b->L + b->deriv_noise * (ub - ua);
+  if (!nodes_exact && h > 0)
+    for (int k = 1; k < NPTS - 1; k++) s[k] *= ref / h;
   s[NPTS - 1] = ref;
   h = ref;
-  /* the noise allowance may not cost more than a twentieth of the
-   * tolerance in position (|dC| <= h |d theta|) */
-  tol_here += fmin(2.0 * noise, 0.05 * 4.0 * b->tol_theta * b->L / fmax(h, 1e-300));
-  bool tiny_t = (ub - ua) < 1e-13 * b->span_t;
+  double tol_here = theta_tol(b, noise, h);
   if (!(h > 1e-15 * b->L)) {
     /* a piece of (numerically) zero length: whatever turn it hides acts
      * as a corner at this point */
@@ -578,55 +655,23 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
                     "curve is not regular there",
                     mid);
   double coef[THETA_DEGREE + 1];
-  bool ok = !coarse;
-  if (ok) {
-    double A[(THETA_DEGREE + 1) * (THETA_DEGREE + 1)];
-    for (int j = 0; j <= THETA_DEGREE; j++) {
-      double u = (s[2 * j] - s[0]) / h;
-      km__bernstein_basis(u, THETA_DEGREE, A + j * (THETA_DEGREE + 1));
-      coef[j] = th[2 * j];
-    }
-    ok = km__solve_dense(A, coef, THETA_DEGREE + 1);
-    /* pin the ends exactly so theta is continuous across pieces */
-    if (ok) {
-      coef[0] = th[0];
-      coef[THETA_DEGREE] = th[NPTS - 1];
-    }
-    /* A strongly varying speed (rational spans with unequal weights)
-     * crowds the nodes' images in s, and the interpolant can swing far
-     * between them while meeting every check point: its coefficient hull,
-     * which bounds it, must stay near the data's range. */
-    if (ok) {
-      double dlo = th[0], dhi = th[0], clo = coef[0], chi = coef[0];
-      for (int k = 1; k < NPTS; k++) {
-        dlo = fmin(dlo, th[k]);
-        dhi = fmax(dhi, th[k]);
-      }
-      for (int j = 1; j <= THETA_DEGREE; j++) {
-        clo = fmin(clo, coef[j]);
-        chi = fmax(chi, coef[j]);
-      }
-      if (chi - clo > 1.001 * (dhi - dlo) + 4 * tol_here) ok = false;
-    }
-    for (int k = 1; ok && k < NPTS; k += 2) {
-      double u = (s[k] - s[0]) / h;
-      if (fabs(km__bern_eval(coef, THETA_DEGREE, u) - th[k]) > tol_here)
-        ok = false;
-    }
-  }
-  if (!ok && !coarse) {
-    /* Where theta moves less than its rounding noise (a speed near zero,
-     * coordinates far from the origin) the interpolant through noisy
-     * values swings and bisecting only samples more noise: theta linear
-     * in s is accepted when it meets every node and check point. */
-    bool lin = true;
-    for (int k = 1; lin && k < NPTS - 1; k++)
-      lin = fabs(th[0] + (th[NPTS - 1] - th[0]) * ((s[k] - s[0]) / h) - th[k]) <=
-            tol_here;
-    if (lin) {
-      linear_theta(th[0], th[NPTS - 1], coef);
-      ok = true;
-    }
+  bool ok = !coarse && fit_theta(th, s, h, tol_here, coef);
+  /* Measuring the nodes one by one costs fourteen adaptive quadratures: a
+   * piece whose theta fails at their approximate positions is bisected
+   * without them (where the speed is unresolved theta nearly always is,
+   * and halves resolve both). A piece about to be taken, or that cannot
+   * be bisected, or whose directions are noise, is judged at the exact
+   * positions. */
+  if (!nodes_exact && !coarse &&
+      (ok || noise >= 0.1 || depth >= KM_MAX_REFINE_DEPTH || tiny_t)) {
+    for (int k = 1; k < NPTS - 1; k++)
+      s[k] = s[k - 1] + span_length(b, t[k - 1], t[k]);
+    if (isnan(s[NPTS - 2]))
+      return km__fail(b->err, KM_ENOCONVERGE, KM_FIELD_CONTROL_POINTS, -1, ua,
+                      "the arc length near parameter t = %g cannot be "
+                      "computed to full precision",
+                      ua);
+    ok = fit_theta(th, s, h, tol_here, coef);
   }
   if (!ok && noise >= 0.1 && big_step < KM_PI - 0.5 &&
       2.0 * h <= b->free_len) {
@@ -770,6 +815,8 @@ km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
    * twice its length, and all such pieces together may cost a twentieth
    * of the tolerance. */
   b.free_len = 0.05 * tol;
+  double point_len = 0.25 * tol; /* twice the length of spans taken as
+                                    points, see below */
   b.tol = tol;
   b.tol_theta = fmin(0.25 * tol / L, 1e-3);
 
@@ -784,9 +831,26 @@ km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
     if (!(len > 1e-15 * L)) continue; /* a span that is a single point */
     km__bspan_make(&b.span, c, i);
     /* or one whose length is its rounding error: equal control points
-     * far from the origin; the turn across it is checked as a corner */
+     * far from the origin; the turn across it is checked as a corner.
+     * Each such span is lost from the pieces (up to its length in
+     * position) and its length then stretches the others (as much
+     * again), so together they may cost a quarter of the tolerance;
+     * past that the spans are a real curve whose shape its coordinates
+     * do not carry, refused rather than taken for a point. */
     double noise = span_noise(&b.span);
-    if (!(len > noise)) continue;
+    if (!(len > noise)) {
+      if (2.0 * len <= point_len) {
+        point_len -= 2.0 * len;
+        continue;
+      }
+      st = km__fail(err, KM_ERANGE, KM_FIELD_CONTROL_POINTS, -1, ua,
+                    "the spans near parameter t = %g are no longer than "
+                    "the rounding of their coordinates (%g, up to %g): "
+                    "move the curve nearer the origin or use fewer, "
+                    "longer spans",
+                    ua, noise, extent);
+      goto cleanup;
+    }
     b.span_t = ub - ua;
     b.span_speed = len / (ub - ua);
     b.span_len = len;

@@ -859,6 +859,44 @@ static void curve_far_from_the_origin_keeps_to_its_rounding(void **state) {
   km_curve_free(&c);
 }
 
+static void spans_below_their_rounding_are_traced_or_refused(void **state) {
+  (void)state;
+  /* A polyline at (1e9, 1e9): 400 legs of 1e-6 along +x, each shorter
+   * than the rounding of its own speed there (8 ulps of 1e9), then one of
+   * 4e-4 up. Asked for 1e-4, a quarter of either stretch, a signature
+   * must end at the last point within that, or refuse: taking every short
+   * leg for a point leaves a line straight up, 4e-4 off the end. */
+  enum { SHORT = 400, N = SHORT + 2 };
+  double cp[2 * N], kn[N + 2];
+  for (int i = 0; i <= SHORT; i++) {
+    cp[2 * i] = 1e9 + 1e-6 * i;
+    cp[2 * i + 1] = 1e9;
+  }
+  cp[2 * (N - 1)] = cp[2 * SHORT];
+  cp[2 * (N - 1) + 1] = 1e9 + 4e-4;
+  kn[0] = 0;
+  for (int i = 1; i <= N; i++) kn[i] = i - 1;
+  kn[N + 1] = N - 1;
+  km_curve c;
+  make_curve(&c, 1, N, kn, cp, NULL, false);
+  const double tol = 1e-4;
+  km_signature sig;
+  km_error err;
+  km_signature_init(&sig);
+  km_status st = km_signature_compute(&c, tol, &sig, &err);
+  if (st == KM_OK) {
+    double end[2];
+    signature_end(&sig, end);
+    assert_true(hypot(end[0] - cp[2 * (N - 1)], end[1] - cp[2 * N - 1]) <=
+                tol);
+    km_signature_free(&sig);
+  } else {
+    assert_status(st, KM_ERANGE);
+    assert_int_equal(err.field, KM_FIELD_CONTROL_POINTS);
+  }
+  km_curve_free(&c);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(circle_has_constant_curvature_one_over_r),
@@ -882,6 +920,7 @@ int main(void) {
           high_order_degenerate_ends_take_the_first_distinct_point),
       cmocka_unit_test(closed_rational_curve_with_a_tiny_span_closes),
       cmocka_unit_test(curve_far_from_the_origin_keeps_to_its_rounding),
+      cmocka_unit_test(spans_below_their_rounding_are_traced_or_refused),
   };
   return cmocka_run_group_tests_name("signature", tests, NULL, NULL);
 }
