@@ -874,6 +874,9 @@ km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
       st = check_turn(&b, turn, ua, s_at);
       if (st) goto cleanup;
       theta += turn;
+      /* a turn handed on from before the knot starts the next piece after
+       * the knot's corner, which is counted as a corner, not again there */
+      if (fabs(turn) > CORNER_NOISE && !isnan(b.pending_start)) b.pending_start += turn;
     }
     size_t m0 = b.m, c0 = b.ncorners;
     b.span_first = m0;
@@ -900,6 +903,19 @@ km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
     }
     prev_dir[0] = db[0];
     prev_dir[1] = db[1];
+  }
+  if (!isnan(b.pending_start) && b.m > 0) {
+    /* a turn handed on to a next piece that never came (a piece below
+     * resolution at the curve's very end): it is a corner at the end,
+     * where its position costs nothing - the pieces must end on the
+     * direction the curve ends with, or a closed curve's turning is off */
+    double end = b.th[(b.m - 1) * (THETA_DEGREE + 1) + THETA_DEGREE];
+    double turn = km__wrap_angle(theta - end);
+    if (fabs(turn) > CORNER_NOISE) {
+      st = push_corner(&b, s_at, turn, t1);
+      if (st) goto cleanup;
+    }
+    b.pending_start = NAN;
   }
   if (b.m == 0) {
     st = km__fail(err, KM_EDEGENERATE, KM_FIELD_CONTROL_POINTS, -1, NAN,

@@ -897,6 +897,32 @@ static void spans_below_their_rounding_are_traced_or_refused(void **state) {
   km_curve_free(&c);
 }
 
+static void closed_curve_ending_below_resolution_turns_whole_turns(void **state) {
+  (void)state;
+  /* A closed rational cubic 0.01 across at (1e9, 1e9), weights over three
+   * decades: its last piece ends in a stretch below the resolution of its
+   * directions, whose turn was handed on to a next piece that never came,
+   * and the signature turned by -0.486 rad. A closed curve's tangent
+   * comes back to itself: the turning is a whole number of turns. */
+  const double cp[12] = {999999999.9900002, 1000000000.0098441, 999999999.9911841, 1000000000.0039104, 1000000000.0087808, 1000000000.0029039, 1000000000.0071814, 1000000000.00604, 999999999.9923563, 999999999.9920048, 999999999.9900002, 1000000000.0098441};
+  const double w[6] = {1, 3.1622776601683795, 0.31622776601683794, 0.03162277660168379, 0.01, 10};
+  const double kn[10] = {0.0, 0.0, 0.0, 0.0, 1.0, 3.0, 4.0, 4.0, 4.0, 4.0};
+  km_curve c;
+  make_curve(&c, 3, 6, kn, cp, w, true);
+  km_signature sig;
+  km_error err;
+  km_signature_init(&sig);
+  km_status st = km_signature_compute(&c, 1e-4, &sig, &err);
+  if (st == KM_OK) {
+    double turns = sig.turning / (2 * M_PI);
+    assert_close(turns, nearbyint(turns), 1e-9);
+    km_signature_free(&sig);
+  } else {
+    assert_status(st, KM_ERANGE);
+  }
+  km_curve_free(&c);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(circle_has_constant_curvature_one_over_r),
@@ -921,6 +947,7 @@ int main(void) {
       cmocka_unit_test(closed_rational_curve_with_a_tiny_span_closes),
       cmocka_unit_test(curve_far_from_the_origin_keeps_to_its_rounding),
       cmocka_unit_test(spans_below_their_rounding_are_traced_or_refused),
+      cmocka_unit_test(closed_curve_ending_below_resolution_turns_whole_turns),
   };
   return cmocka_run_group_tests_name("signature", tests, NULL, NULL);
 }
