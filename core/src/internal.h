@@ -11,6 +11,7 @@
 
 #include "km/curve.h"
 #include "km/fn.h"
+#include "km/limits.h"
 #include "km/status.h"
 
 #define KM_PI 3.14159265358979323846
@@ -141,6 +142,8 @@ km_status km__pp_alloc(km_pp *p, int degree, size_t m);
 km_status km__pp_from_fn(km_pp *out, const km_fn *f);
 /* Pieces -> B-spline function (breaks of multiplicity degree+1). */
 km_status km__pp_to_fn(km_fn *out, const km_pp *p);
+/* C(d, j) for d <= KM_MAX_FN_DEGREE + 1 (pp.c). */
+extern const double km__binomial[KM_MAX_FN_DEGREE + 2][KM_MAX_FN_DEGREE + 2];
 /* Value of a Bernstein polynomial of degree d at u in [0,1]. */
 double km__bern_eval(const double *c, int d, double u);
 /* Coefficients over the sub-interval [u0, u1] of [0, 1]. */

@@ -35,7 +35,7 @@ km_status km__pp_alloc(km_pp *p, int degree, size_t m) {
 
 /* Binomial coefficients C(d, j), d <= KM_MAX_FN_DEGREE + 1 (Pascal's
  * triangle; every entry is exact in double). */
-static const double BINOM[KM_MAX_FN_DEGREE + 2][KM_MAX_FN_DEGREE + 2] = {
+const double km__binomial[KM_MAX_FN_DEGREE + 2][KM_MAX_FN_DEGREE + 2] = {
     {1},
     {1, 1},
     {1, 2, 1},
@@ -67,7 +67,7 @@ double km__bern_eval(const double *c, int d, double u) {
    * sum |c_j| B_j(u) (Schumaker and Volk), at O(d) instead of O(d^2): this
    * is the innermost call of signatures, tables and plans. */
   if (d == 0) return c[0];
-  const double *bn = BINOM[d];
+  const double *bn = km__binomial[d];
   double v = 1.0 - u, acc, f = 1.0;
   if (u <= 0.5) {
     double s = u / v;

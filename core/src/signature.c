@@ -507,8 +507,10 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
                     "work ran out near parameter t = %g): loosen the "
                     "tolerance",
                     b->tol, ua);
-  b->work -= NPTS;
-  b->span_work -= NPTS;
+  /* the nodes' evaluations, and the fit, which costs about as much again
+   * (an 8 x 8 solve, the checks, an arc tangent a node) */
+  b->work -= 2 * NPTS;
+  b->span_work -= 2 * NPTS;
   double t[NPTS], th[NPTS], s[NPTS], dir[NPTS][2];
   double mid = 0.5 * (ua + ub), half = 0.5 * (ub - ua);
   for (int k = 0; k < NPTS; k++)

@@ -14,6 +14,7 @@
 
 #include "../../core/src/internal.h"
 #include "../../core/src/morph_plan.h"
+#include "km/curve.h"
 #include "testutil.h"
 
 #define PI 3.14159265358979323846
@@ -72,6 +73,49 @@ static void bern_eval_is_within_its_rounding_bound(void **state) {
       if (trial == 0) assert_true(got == c[0]);
       if (trial == 1) assert_true(got == c[d]);
     }
+}
+
+/* ---- spans in Bezier form ---------------------------------------------- */
+
+static void bezier_span_evaluation_agrees_with_de_boor(void **state) {
+  (void)state;
+  /* every degree, with and without weights, far from the origin too:
+   * position and derivative of a span in Bezier form against de Boor's
+   * algorithm on the B-spline (km_curve_eval) */
+  uint64_t rng = 4242;
+  for (int p = 1; p <= 9; p++)
+    for (int rational = 0; rational < 2; rational++)
+      for (int far = 0; far < 2; far++) {
+        enum { N = 14 };
+        double cp[2 * N], w[N], kn[N + 10];
+        double off = far ? 1e6 : 0.0;
+        for (int i = 0; i < N; i++) {
+          cp[2 * i] = off + tu_uniform(&rng, -1, 1);
+          cp[2 * i + 1] = off + tu_uniform(&rng, -1, 1);
+          w[i] = tu_uniform(&rng, 0.3, 3.0);
+        }
+        size_t nk = N + (size_t)p + 1;
+        for (size_t i = 0; i < nk; i++)
+          kn[i] = i <= (size_t)p ? 0.0 : i >= N ? (double)(N - p) : (double)(i - (size_t)p);
+        km_curve c;
+        km_curve_init(&c);
+        assert_status(km_curve_create(&c, p, N, kn, cp, rational ? w : NULL, false, NULL), KM_OK);
+        for (size_t i = (size_t)p; i < N; i++) {
+          km__bspan sp;
+          km__bspan_make(&sp, &c, i);
+          for (int k = 0; k <= 10; k++) {
+            double t = kn[i] + (kn[i + 1] - kn[i]) * k / 10.0, pos[2], der[2], d[2][2];
+            km__bspan_eval(&sp, t, pos, der);
+            km_curve_eval_side(&c, t, k == 10 ? -1 : 1, 1, d);
+            double scale = 1 + off;
+            for (int q = 0; q < 2; q++) {
+              assert_true(fabs(pos[q] - d[0][q]) <= 1e-13 * scale);
+              assert_true(fabs(der[q] - d[1][q]) <= 1e-9 * (1 + fabs(d[1][q])) * scale);
+            }
+          }
+        }
+        km_curve_free(&c);
+      }
 }
 
 /* ---- sin and cos ------------------------------------------------------- */
@@ -296,6 +340,7 @@ int main(void) {
       cmocka_unit_test(cheb_cumulative_integrates_monomials_exactly),
       cmocka_unit_test(cheb_cumulative_of_exp_is_spectrally_accurate),
       cmocka_unit_test(bern_eval_is_within_its_rounding_bound),
+      cmocka_unit_test(bezier_span_evaluation_agrees_with_de_boor),
       cmocka_unit_test(sincos_agrees_with_libm),
       cmocka_unit_test(weighted_closure_metric_is_the_gram_matrix),
       cmocka_unit_test(merge_of_one_polynomial_is_one_piece),

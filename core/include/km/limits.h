@@ -37,16 +37,18 @@
 #define KM_MAX_PIECES 2000000
 
 /* Work of one signature, in evaluations of the curve and its derivative
- * (0.05 to 0.15 us each at -O2, 0.2 to 0.4 us under AddressSanitizer).
- * Legitimate curves at the smallest tolerance need up to some hundreds
- * per span on long curves and up to 80,000 in one span (bisecting toward a
- * cusp or a degenerate end); 660,000 was the most a whole curve of the
- * fuzz corpus needed. A span whose directions are not resolved in double
- * precision at the asked tolerance would need ever more: it is refused
- * after its own share, so that refusal comes within a tenth of a second
- * whatever the rest of the curve. */
-#define KM_SIGNATURE_WORK_BASE 500000L
-#define KM_SIGNATURE_WORK_PER_POINT 5000L
+ * (a piece's fit counts as many again as its nodes): 0.03 to 0.1 us each
+ * at -O2, some 1 to 2 us in the fuzzing build (AddressSanitizer and
+ * coverage). Legitimate curves at the default tolerance need about 60 a
+ * span; at the smallest tolerances some hundreds per span on long curves
+ * and up to 80,000 in one span (bisecting toward a cusp or a degenerate
+ * end). A span whose directions are not resolved in double precision at
+ * the asked tolerance would need ever more: it is refused after its own
+ * share, and a curve after the whole budget, so that a refusal comes
+ * within a few hundredths of a second at -O2 (under a second fuzzed)
+ * whatever the curve. */
+#define KM_SIGNATURE_WORK_BASE 300000L
+#define KM_SIGNATURE_WORK_PER_POINT 1000L
 #define KM_SIGNATURE_WORK_PER_SPAN 250000L
 
 /* Bisection depth when refining toward a singular point (a degenerate
