@@ -40,9 +40,11 @@
  * (a piece's fit counts as many again as its nodes): 0.03 to 0.1 us each
  * at -O2, some 1 to 2 us in the fuzzing build (AddressSanitizer and
  * coverage). Legitimate curves at the default tolerance need about 60 a
- * span; at the smallest tolerances some hundreds per span on long curves
- * and up to 80,000 in one span (bisecting toward a cusp or a degenerate
- * end). A span whose directions are not resolved in double precision at
+ * span, up to about 550 a control point with a degenerate leg at every
+ * joint (an outline of 200 cubics; 800 at 1e-7 of its length, 1,600 at
+ * 2e-10, which is refused), up to 80,000 in one span (bisecting toward a
+ * cusp or a degenerate end). The budget is what a second of the fuzzing
+ * build affords, some 70 ms at -O2. A span whose directions are not resolved in double precision at
  * the asked tolerance would need ever more: it is refused after its own
  * share, and a curve after the whole budget, so that a refusal comes
  * within a few hundredths of a second at -O2 (under a second fuzzed)
