@@ -1372,25 +1372,6 @@ done:
   return st;
 }
 
-/* uniform cubic B-spline on [0, 4] and its derivative */
-static double bspline3(double u) {
-  if (u <= 0 || u >= 4) return 0.0;
-  if (u < 1) return u * u * u / 6.0;
-  if (u < 2) return (-3 * u * u * u + 12 * u * u - 12 * u + 4) / 6.0;
-  if (u < 3) return (3 * u * u * u - 24 * u * u + 60 * u - 44) / 6.0;
-  double v = 4 - u;
-  return v * v * v / 6.0;
-}
-
-static double bspline3_d(double u) {
-  if (u <= 0 || u >= 4) return 0.0;
-  if (u < 1) return u * u / 2.0;
-  if (u < 2) return (-9 * u * u + 24 * u - 12) / 6.0;
-  if (u < 3) return (9 * u * u - 48 * u + 60) / 6.0;
-  double v = 4 - u;
-  return -v * v / 2.0;
-}
-
 typedef struct qnode {
   double s, w, theta;
 } qnode;
@@ -1546,7 +1527,7 @@ static km_status close_lsq(const km_signature *sig, bool by_corners,
       double bv[4];
       for (int k = 0; k < 4; k++) {
         int i = i0 + k;
-        bv[k] = (i >= 0 && i < NF) ? bspline3(u - i) : 0.0;
+        bv[k] = (i >= 0 && i < NF) ? km__bspline3(u - i) : 0.0;
         th += (i >= 0 && i < NF) ? c[i] * bv[k] : 0.0;
       }
       double cs = cos(th), sn = sin(th);
@@ -1602,7 +1583,7 @@ static km_status close_lsq(const km_signature *sig, bool by_corners,
     double f[3];
     for (int k = 0; k < 3; k++) {
       double u = iv + 0.5 * k, v = 0.0;
-      for (int i = 0; i < NF; i++) v += c[i] * bspline3_d(u - i);
+      for (int i = 0; i < NF; i++) v += c[i] * km__bspline3_d(u - i);
       f[k] = v / h;
     }
     double *bc = dpsi.c + (size_t)iv * 3;

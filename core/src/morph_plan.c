@@ -120,7 +120,7 @@ static void bell(const double *x, int mmax, double *B) {
   }
 }
 
-static double bspline3_d(double u) {
+double km__bspline3_d(double u) {
   if (u <= 0 || u >= 4) return 0.0;
   if (u < 1) return u * u / 2.0;
   if (u < 2) return (-9 * u * u + 24 * u - 12) / 6.0;
@@ -129,7 +129,7 @@ static double bspline3_d(double u) {
   return -v * v / 2.0;
 }
 
-static double bspline3(double u) {
+double km__bspline3(double u) {
   if (u <= 0 || u >= 4) return 0.0;
   if (u < 1) return u * u * u / 6.0;
   if (u < 2) return (-3 * u * u * u + 12 * u * u - 12 * u + 4) / 6.0;
@@ -148,7 +148,7 @@ static void basis_at(double r, int *bi, double bv[4]) {
   int i0 = iv - 3;
   for (int k = 0; k < 4; k++) {
     int i = i0 + k;
-    bv[k] = (i >= 0 && i < NF) ? bspline3(u - i) : 0.0;
+    bv[k] = (i >= 0 && i < NF) ? km__bspline3(u - i) : 0.0;
   }
   *bi = i0;
 }
@@ -171,7 +171,7 @@ void km__closure_metric_weighted(const double *w, double *M) {
   for (int iv = 0; iv < NB; iv++)
     for (int g = 0; g < 3; g++) {
       double u = iv + X[g], d[NF];
-      for (int i = 0; i < NF; i++) d[i] = bspline3_d(u - i);
+      for (int i = 0; i < NF; i++) d[i] = km__bspline3_d(u - i);
       for (int i = 0; i < NF; i++) {
         if (d[i] == 0.0) continue;
         for (int j = 0; j < NF; j++) M[i * NF + j] += w[iv] * W[g] * d[i] * d[j];

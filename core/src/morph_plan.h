@@ -36,6 +36,11 @@ const double *km__frame_plan_breaks(const km__frame_plan *p);
  * (decided once per morph, see morph_plan.c). */
 bool km__frame_plan_by_corners(const km__frame_plan *p);
 
+/* The uniform cubic B-spline on [0, 4] (the closure's basis function) and
+ * its derivative. */
+double km__bspline3(double u);
+double km__bspline3_d(double u);
+
 /* The lsq closure's metric: Gram matrix of the derivatives of its basis
  * functions in the variable of unit knot spacing ((KM__CLOSURE_INTERVALS -
  * 3)^2 values, exact). */
