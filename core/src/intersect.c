@@ -39,6 +39,17 @@
  * piece is far below any loop that matters; 2^-60 is below resolution. */
 #define MONO_DEPTH 24
 #define PAIR_DEPTH 60
+/* Work bounds: pair subdivisions and Newton starts per count. Two branches
+ * that run within the flatness of each other for a long stretch (a
+ * hairpin folded almost onto itself) keep every pair of their sub-curves
+ * overlapping; past these bounds pairs are seeded where they stand and
+ * then no longer refined, so the count is what was found by then. Smooth
+ * frames of a few hundred pieces need some thousands of each. */
+#define PAIR_BUDGET 50000L
+#define SEED_BUDGET 5000L
+/* Sub-curves per count: a piece split toward every wiggle would need 2^24
+ * of them; past this the rest are taken as they are. */
+#define MAX_SEGS 65536
 
 typedef struct seg {
   size_t piece;
@@ -53,6 +64,7 @@ typedef struct ctx {
   double t0, t1;        /* curve domain */
   double tol, flat, size, eps_t;
   double mag; /* largest |coordinate| of the control points */
+  long pairs_left, seeds_left; /* work bounds (PAIR_BUDGET, SEED_BUDGET) */
   bool closed;
   seg *segs;
   size_t nseg, capseg;
@@ -142,7 +154,10 @@ static void push_seg(ctx *x, const seg *s) {
 
 static void collect(ctx *x, const seg *s, int depth) {
   if (x->oom) return;
-  if (depth >= MONO_DEPTH || monotone(s, x->p, 1e-15 * x->size)) {
+  /* monotone up to the rounding of the coordinates: far from the origin
+   * that rounding wiggles every control polygon, however small */
+  double eps = fmax(1e-15 * x->size, 64 * DBL_EPSILON * x->mag);
+  if (depth >= MONO_DEPTH || x->nseg >= MAX_SEGS || monotone(s, x->p, eps)) {
     push_seg(x, s);
     return;
   }
@@ -299,6 +314,7 @@ static bool boxes_overlap(const seg *a, const seg *b, double m) {
  * window is a little wider than [0, 1] because a flat chord is only
  * tol-close to its curve; duplicates from neighbours are merged later. */
 static void chord_seed(ctx *x, const seg *A, const seg *B) {
+  if (x->seeds_left <= 0) return;
   int p = x->p;
   double a0[2], a1[2], b0[2], b1[2];
   cart(A->h[0], a0);
@@ -317,6 +333,7 @@ static void chord_seed(ctx *x, const seg *A, const seg *B) {
   if (s < -w || s > 1 + w || t < -w || t > 1 + w) return;
   s = fmin(1, fmax(0, s));
   t = fmin(1, fmax(0, t));
+  x->seeds_left--;
   refine(x, A->piece, A->u0 + s * (A->u1 - A->u0), B->piece,
          B->u0 + t * (B->u1 - B->u0));
 }
@@ -325,7 +342,7 @@ static void pair(ctx *x, const seg *A, const seg *B, int depth) {
   if (x->oom || !boxes_overlap(A, B, x->tol)) return;
   int p = x->p;
   bool fa = flatness(A, p) <= x->flat, fb = flatness(B, p) <= x->flat;
-  if ((fa && fb) || depth >= PAIR_DEPTH) {
+  if ((fa && fb) || depth >= PAIR_DEPTH || --x->pairs_left <= 0) {
     chord_seed(x, A, B);
     return;
   }
@@ -393,7 +410,9 @@ static int by_xmin(const void *a, const void *b) {
  * closed curve, the shared ends of adjacent pieces, the ends of an open
  * curve and tangential touches are not crossings; overlapping (collinear
  * or coincident) stretches are not counted. Returns -1 for an invalid
- * curve or when memory runs out. Thread-safe; allocates only scratch. */
+ * curve or when memory runs out. Work is bounded (PAIR_BUDGET): a curve
+ * folded almost onto itself over a long stretch gets the crossings found
+ * within it. Thread-safe; allocates only scratch. */
 long km_curve_self_intersections(const km_curve *c, double tol) {
   if (!c || !c->knots || !c->cp || c->degree < KM_MIN_DEGREE ||
       c->degree > KM_MAX_DEGREE || c->n < (size_t)c->degree + 1)
@@ -428,6 +447,8 @@ long km_curve_self_intersections(const km_curve *c, double tol) {
   x.tol = (tol > 0 && isfinite(tol)) ? fmax(tol, floor_tol) : 1e-9 * x.size;
   x.flat = fmax(x.tol, 1e-7 * x.size);
   x.eps_t = 1e-8 * (x.t1 - x.t0);
+  x.pairs_left = PAIR_BUDGET;
+  x.seeds_left = SEED_BUDGET;
   size_t pieces = (bz.n - 1) / (size_t)p;
   for (size_t k = 0; k < pieces && !x.oom; k++) {
     seg s;

@@ -87,7 +87,9 @@ size_t km_morph_matches_used(const km_morph *m, double *pairs, size_t cap);
 /* Turning numbers and lengths of the two prepared inputs. */
 void km_morph_inputs(const km_morph *m, double length[2], double turning[2]);
 
-/* Count proper self-crossings of a curve (exact to the tolerance tol). */
+/* Count proper self-crossings of a curve (exact to the tolerance tol; a
+ * curve folded almost onto itself over a long stretch gets the crossings
+ * found within a bounded amount of work: see intersect.c). */
 long km_curve_self_intersections(const km_curve *c, double tol);
 
 #endif
