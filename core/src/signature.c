@@ -38,6 +38,7 @@
 #define THETA_DEGREE 7               /* kappa pieces are of degree 6 */
 #define NPTS (2 * THETA_DEGREE + 1)  /* nodes and check points */
 #define CORNER_NOISE 1e-11           /* turns below this are rounding */
+#define SPAN_CACHE 20000             /* spans kept in Bezier form */
 /* |turn| > pi - this: a cusp. Tangent estimates beside a cusp are good to
  * about 1e-7 rad, so a hairpin must turn back within 1e-5 rad of pi to be
  * taken for a cusp. */
@@ -766,6 +767,9 @@ km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
   double *span_len = malloc(c->n * sizeof(double));
   if (!span_len)
     return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  /* the spans in Bezier form, made once for both passes (a few hundred
+   * bytes each: kept for curves of up to SPAN_CACHE control points) */
+  km__bspan *spans = c->n <= SPAN_CACHE ? malloc(c->n * sizeof *spans) : NULL;
   double poly = 0.0;
   for (size_t i = 1; i < c->n; i++)
     poly += hypot(c->cp[2 * i] - c->cp[2 * i - 2],
@@ -778,8 +782,9 @@ km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
   for (size_t i = 0; i < c->n; i++) span_len[i] = 0.0;
   for (size_t i = (size_t)c->degree; i < c->n && poly > 0; i++) {
     if (c->knots[i + 1] > c->knots[i]) {
-      km__bspan sp;
-      km__bspan_make(&sp, c, i);
+      km__bspan local, *spp = spans ? &spans[i] : &local;
+      km__bspan_make(spp, c, i);
+      const km__bspan sp = *spp;
       long evals = 0;
       double est = gl16_length(&sp, 0.0, 1.0);
       b.work -= 16;
@@ -847,7 +852,10 @@ km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
     if (!(ub > ua)) continue;
     double len = span_len[i];
     if (!(len > 1e-15 * L)) continue; /* a span that is a single point */
-    km__bspan_make(&b.span, c, i);
+    if (spans)
+      b.span = spans[i];
+    else
+      km__bspan_make(&b.span, c, i);
     /* or one whose length is its rounding error: equal control points
      * far from the origin; the turn across it is checked as a corner.
      * Each such span is lost from the pieces (up to its length in
@@ -988,6 +996,7 @@ km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
 cleanup:
   km__pp_free(&kp);
   free(span_len);
+  free(spans);
   free(b.s);
   free(b.th);
   free(b.corners);
