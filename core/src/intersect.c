@@ -63,7 +63,8 @@ typedef struct ctx {
   const km__hcurve *bz; /* Bezier form, dim 3 */
   double t0, t1;        /* curve domain */
   double tol, flat, size, eps_t;
-  double mag; /* largest |coordinate| of the control points */
+  double mag;    /* largest |coordinate| of the control points */
+  double margin; /* rounding of the coordinates: the boxes' margin */
   long pairs_left, seeds_left; /* work bounds (PAIR_BUDGET, SEED_BUDGET) */
   bool closed;
   seg *segs;
@@ -339,7 +340,7 @@ static void chord_seed(ctx *x, const seg *A, const seg *B) {
 }
 
 static void pair(ctx *x, const seg *A, const seg *B, int depth) {
-  if (x->oom || !boxes_overlap(A, B, x->tol)) return;
+  if (x->oom || !boxes_overlap(A, B, x->margin)) return;
   int p = x->p;
   bool fa = flatness(A, p) <= x->flat, fb = flatness(B, p) <= x->flat;
   if ((fa && fb) || depth >= PAIR_DEPTH || --x->pairs_left <= 0) {
@@ -445,7 +446,13 @@ long km_curve_self_intersections(const km_curve *c, double tol) {
   }
   double floor_tol = KM_MIN_RELATIVE_TOLERANCE * x.size;
   x.tol = (tol > 0 && isfinite(tol)) ? fmax(tol, floor_tol) : 1e-9 * x.size;
-  x.flat = fmax(x.tol, 1e-7 * x.size);
+  /* Flat enough to seed Newton: within the tolerance, but no coarser than
+   * 1e-4 of the size, whatever tolerance is asked (a seed must lie near
+   * its root). A sub-curve lies inside the box of its control points, so
+   * boxes need no margin beyond the rounding of the coordinates: a loose
+   * tolerance must not make every pair of a small curve overlap. */
+  x.flat = fmax(fmin(x.tol, 1e-4 * x.size), 1e-7 * x.size);
+  x.margin = 256 * DBL_EPSILON * fmax(x.mag, x.size);
   x.eps_t = 1e-8 * (x.t1 - x.t0);
   x.pairs_left = PAIR_BUDGET;
   x.seeds_left = SEED_BUDGET;
@@ -467,8 +474,8 @@ long km_curve_self_intersections(const km_curve *c, double tol) {
   qsort(order, x.nseg, sizeof *order, by_xmin);
   for (size_t i = 0; i < x.nseg && !x.oom; i++)
     for (size_t j = i + 1; j < x.nseg && !x.oom; j++) {
-      if (order[j]->xmin > order[i]->xmax + x.tol) break;
-      if (!boxes_overlap(order[i], order[j], x.tol)) continue;
+      if (order[j]->xmin > order[i]->xmax + x.margin) break;
+      if (!boxes_overlap(order[i], order[j], x.margin)) continue;
       if (consecutive_same_way(&x, order[i], order[j])) continue;
       pair(&x, order[i], order[j], 0);
     }
