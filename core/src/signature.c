@@ -249,22 +249,6 @@ static km_status push_corner(builder *b, double s, double turn, double t) {
  * chord. Returns false if no direction exists (a point curve). */
 static bool tangent_limit(const builder *b, double t, int side,
                           double dir[2]) {
-  /* At an end of the current span its Bezier form gives the direction
-   * exactly: C'(0) = p (w1 / w0) (P1 - P0), where the first leg is well
-   * above the rounding of the points (at a degenerate leg it is not, and
-   * the derivatives below decide). */
-  const km__bspan *sb = &b->span;
-  if ((side > 0 && t == sb->a) || (side < 0 && t == sb->b)) {
-    int e = side > 0 ? 0 : sb->degree, f = e + (side > 0 ? 1 : -1);
-    double vx = (sb->h[f][0] / sb->h[f][2] - sb->h[e][0] / sb->h[e][2]) * side;
-    double vy = (sb->h[f][1] / sb->h[f][2] - sb->h[e][1] / sb->h[e][2]) * side;
-    double n = hypot(vx, vy);
-    if (n > 1e6 * b->deriv_noise * (sb->b - sb->a) && n > 1e-6 * b->span_speed * (sb->b - sb->a)) {
-      dir[0] = vx / n;
-      dir[1] = vy / n;
-      return true;
-    }
-  }
   double d[4][2];
   km_curve_eval_side(b->c, t, side, 3, d);
   double scale = b->span_speed;
