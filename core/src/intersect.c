@@ -47,9 +47,10 @@
  * frames of a few hundred pieces need some thousands of each. */
 #define PAIR_BUDGET 50000L
 #define SEED_BUDGET 5000L
-/* Sub-curves per count: a piece split toward every wiggle would need 2^24
- * of them; past this the rest are taken as they are. */
-#define MAX_SEGS 65536
+/* Sub-curves per count (frames of the fixtures have some hundreds): a
+ * piece split toward every wiggle would need 2^24 of them; past this the
+ * rest are taken as they are. */
+#define MAX_SEGS 8192
 
 typedef struct seg {
   size_t piece;
@@ -155,9 +156,11 @@ static void push_seg(ctx *x, const seg *s) {
 
 static void collect(ctx *x, const seg *s, int depth) {
   if (x->oom) return;
-  /* monotone up to the rounding of the coordinates: far from the origin
-   * that rounding wiggles every control polygon, however small */
-  double eps = fmax(1e-15 * x->size, 64 * DBL_EPSILON * x->mag);
+  /* monotone up to the rounding of the coordinates (far from the origin
+   * that rounding wiggles every control polygon, however small) and up to
+   * a tenth of the tolerance: a sub-curve monotone but for steps back of
+   * that size can only loop within it, below what the count resolves */
+  double eps = fmax(fmax(1e-15 * x->size, 64 * DBL_EPSILON * x->mag), 0.1 * x->tol);
   if (depth >= MONO_DEPTH || x->nseg >= MAX_SEGS || monotone(s, x->p, eps)) {
     push_seg(x, s);
     return;

@@ -931,8 +931,10 @@ km_status km_morph_create(km_morph **out, const km_morph_input *from,
    * cross themselves: the first candidate, in order of alignment, none of
    * whose five preview frames crosses (each stops at its first crossing);
    * failing that the one with the fewest crossings, the better aligned
-   * among equals. */
-  if (ncand > 1 && opt->method == KM_METHOD_CURVATURE) {
+   * among equals. Only planned morphs preview (the default: turning
+   * blend, cubic output): a frame of any other costs a blend and a
+   * reconstruction, twenty of them more than the whole morph. */
+  if (ncand > 1 && opt->method == KM_METHOD_CURVATURE && m->plan) {
     km_morph *alts[SHIFT_CANDIDATES] = {m};
     size_t n = 1, pick = SIZE_MAX;
     if (preview_crossings(m, 1) == 0) pick = 0;

@@ -178,6 +178,7 @@ typedef struct builder {
   double span_t;    /* width in t of the span being processed */
   double span_speed; /* its mean speed: the scale of |C'| there */
   double span_len;  /* its arc length: estimated, then confirmed */
+  double span_weight_ratio; /* largest over smallest weight (1 without) */
   /* pieces of theta: breaks s[0..m], coefficients th[m*(P+1)] */
   double *s, *th;
   size_t m, cap;
@@ -579,7 +580,18 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
     b->work -= 16;
     b->span_work -= 16;
   }
-  bool agree = fabs(h - ref) <= 1e-13 * ref + b->deriv_noise * (ub - ua);
+  /* Two rules can agree and both miss a feature narrower than their nodes'
+   * spacing: a speed that dips toward zero between nodes (a near-cusp,
+   * a degenerate leg) or peaks (weights varying by decades). The
+   * agreement counts only where the speed is of one scale over the nodes
+   * and the weights are too. */
+  double smin = INFINITY, smax = 0.0;
+  for (int k = 0; k < NPTS; k++) {
+    smin = fmin(smin, speed[k]);
+    smax = fmax(smax, speed[k]);
+  }
+  bool agree = smax <= 4.0 * smin && b->span_weight_ratio <= 2.0 &&
+               fabs(h - ref) <= 1e-13 * ref + b->deriv_noise * (ub - ua);
   bool tiny_t = (ub - ua) < 1e-13 * b->span_t;
   /* Where they disagree the speed is not resolved over the piece, and
    * theta seldom is: a piece inside the span that fails with the 16-point
@@ -863,6 +875,14 @@ km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
     }
     b.span_t = ub - ua;
     b.span_speed = len / (ub - ua);
+    {
+      double wlo = INFINITY, whi = 0.0;
+      for (int q = 0; q <= b.span.degree; q++) {
+        wlo = fmin(wlo, b.span.h[q][2]);
+        whi = fmax(whi, b.span.h[q][2]);
+      }
+      b.span_weight_ratio = b.span.rational && wlo > 0 ? whi / wlo : 1.0;
+    }
     b.span_len = len;
     b.deriv_noise = noise / (ub - ua); /* of |C'| */
     b.span_work = KM_SIGNATURE_WORK_PER_SPAN;
