@@ -49,7 +49,7 @@
  * share, and a curve after the whole budget, so that a refusal comes
  * within a few hundredths of a second at -O2 (under a second fuzzed)
  * whatever the curve. */
-#define KM_SIGNATURE_WORK_BASE 300000L
+#define KM_SIGNATURE_WORK_BASE 200000L
 #define KM_SIGNATURE_WORK_PER_POINT 1000L
 #define KM_SIGNATURE_WORK_PER_SPAN 250000L
 
