@@ -182,9 +182,11 @@ typedef struct out_piece {
 typedef struct plan {
   out_piece *p;
   size_t n, cap;
+  size_t limit; /* pieces allowed (KM_MAX_OUTPUT_PIECES beyond the input's) */
 } plan;
 
 static km_status plan_push(plan *pl, out_piece op) {
+  if (pl->n >= pl->limit) return KM_ELIMIT;
   if (pl->n == pl->cap) {
     size_t cap = pl->cap ? 2 * pl->cap : 64;
     if (cap > KM_MAX_PIECES) return KM_ELIMIT;
@@ -304,21 +306,24 @@ km_status km_reconstruct(const km_signature *sig, int degree, double tol,
   if (!(tol > 0) || !isfinite(tol)) tol = 1e-5 * L;
   if (tol < KM_MIN_RELATIVE_TOLERANCE * L) tol = KM_MIN_RELATIVE_TOLERANCE * L;
   theta_pieces tp;
-  plan pl = {NULL, 0, 0};
+  plan pl = {NULL, 0, 0, 0};
   double *pos = NULL;
   km_curve c;
   km_curve_init(&c);
   km_status st = km__build_theta(sig, &tp.kappa, &tp.theta);
   if (st) return km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
   int dk = tp.kappa.degree, dt = dk + 1;
+  pl.limit = KM_MAX_OUTPUT_PIECES + 2 * tp.theta.m;
+  if (pl.limit > KM_MAX_PIECES) pl.limit = KM_MAX_PIECES;
   for (size_t i = 0; i < tp.theta.m; i++) {
     st = plan_range(&pl, &tp, i, 0.0, 1.0, degree, 0.9 * tol, 0);
     if (st) {
       st = km__fail(err, st, KM_FIELD_TOLERANCE, -1, NAN,
-                    st == KM_ELIMIT ? "the tolerance needs more than %d "
-                                      "pieces: loosen it"
+                    st == KM_ELIMIT ? "the curve needs more than %zu pieces "
+                                      "at this tolerance (it turns %g "
+                                      "times): loosen the tolerance"
                                     : "out of memory",
-                    KM_MAX_PIECES);
+                    pl.limit, fabs(sig->turning) / (2 * KM_PI));
       goto cleanup;
     }
   }

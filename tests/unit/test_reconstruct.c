@@ -519,6 +519,44 @@ static void corner_one_ulp_before_a_curvature_break_keeps_its_turn(
   km_signature_free(&sig);
 }
 
+/* kappa from 666,660 down to -2 over 4 units: the curve turns 212,204
+ * times, and at 2e-3 its reconstruction would take some 85,000 quintic
+ * pieces (400,000 control points, seconds). It is refused at once with
+ * the tolerance named; a tolerance that needs few pieces is served. */
+static void reconstruction_that_turns_without_end_is_refused(void **state) {
+  (void)state;
+  km_fn kappa;
+  km_error err;
+  km_fn_init(&kappa);
+  const double kn[4] = {0, 0, 4, 4}, co[2] = {666660, -2};
+  assert_status(km_fn_create(&kappa, 1, 2, kn, co, &err), KM_OK);
+  const double start[2] = {0, 0};
+  km_signature sig;
+  km_signature_init(&sig);
+  assert_status(km_signature_create(&sig, 4.0, start, 0.0, &kappa, NULL, 0, false, &err),
+                KM_OK);
+  assert_close(sig.turning / (2 * M_PI), (666660.0 - 2.0) / 2 * 4 / (2 * M_PI), 1e-6);
+  km_curve r;
+  km_curve_init(&r);
+  assert_status(km_reconstruct(&sig, 5, 2.1e-3, &r, NULL, &err), KM_ELIMIT);
+  assert_int_equal(err.field, KM_FIELD_TOLERANCE);
+  assert_null(r.cp);
+  km_fn_free(&kappa);
+  km_signature_free(&sig);
+  /* kappa = 1 over 4 units needs a handful */
+  km_fn_init(&kappa);
+  assert_status(km_fn_constant(&kappa, 0.0, 4.0, 1.0, &err), KM_OK);
+  km_signature_init(&sig);
+  assert_status(km_signature_create(&sig, 4.0, start, 0.0, &kappa, NULL, 0, false, &err),
+                KM_OK);
+  double bound;
+  assert_status(km_reconstruct(&sig, 5, 2.1e-3, &r, &bound, &err), KM_OK);
+  assert_true(r.n < 100 && bound <= 2.1e-3);
+  km_curve_free(&r);
+  km_fn_free(&kappa);
+  km_signature_free(&sig);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(unit_circle_is_reconstructed_within_each_tolerance),
@@ -531,6 +569,7 @@ int main(void) {
       cmocka_unit_test(fixture_outlines_survive_a_round_trip),
       cmocka_unit_test(repeated_control_point_survives_a_round_trip),
       cmocka_unit_test(reconstruct_rejects_other_degrees),
+      cmocka_unit_test(reconstruction_that_turns_without_end_is_refused),
       cmocka_unit_test(corner_one_ulp_before_a_curvature_break_keeps_its_turn),
   };
   return cmocka_run_group_tests_name("reconstruct", tests, NULL, NULL);

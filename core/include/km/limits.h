@@ -36,6 +36,13 @@
  * and time for adversarial input (~100 bytes a piece). */
 #define KM_MAX_PIECES 2000000
 
+/* Output pieces of one reconstruction beyond two per piece of its
+ * signature: a curve that turns hundreds of thousands of times (kappa in
+ * the hundreds of thousands over a few units) would otherwise come back
+ * as a B-spline of 400,000 control points, seconds to build and larger
+ * than any input the service takes. */
+#define KM_MAX_OUTPUT_PIECES 20000
+
 /* Work of one signature, in evaluations of the curve and its derivative
  * (a piece's fit counts as many again as its nodes): 0.03 to 0.1 us each
  * at -O2, some 1 to 2 us in the fuzzing build (AddressSanitizer and
