@@ -355,7 +355,7 @@ static km_status rotate_start(input *in, double s0, km_error *err) {
   return input_tables(in, on_table);
 }
 
-/* The signature of the same curve traced backwards, exactly:
+/* The signature of the same closed curve traced backwards, exactly:
  * kappa_r(s) = -kappa(L - s) (knots mirrored, coefficients reversed and
  * negated), a corner at s turning by tau becomes one at L - s turning by
  * -tau (the seam's, at L, stays there), the start is the old end and the
@@ -390,13 +390,11 @@ static km_status reverse_signature(const km_signature *sig, km_signature *out,
       cr[m].turn = -sig->corners[i].turn;
       m++;
     }
-  double start[2] = {sig->start[0], sig->start[1]};
-  km_status st = KM_OK;
-  if (!sig->closed && km_signature_point(sig, L, start, NULL) != KM_OK)
-    st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  /* only closed inputs are reversed: the old end is the start */
+  const double *start = sig->start;
   km_fn kr;
   km_fn_init(&kr);
-  if (!st) st = km_fn_create(&kr, f->degree, n, knots, coef, err);
+  km_status st = km_fn_create(&kr, f->degree, n, knots, coef, err);
   if (!st)
     st = km_signature_create(out, L, start, km__wrap_angle(end_angle + KM_PI), &kr,
                              cr, m, sig->closed, err);
