@@ -47,6 +47,13 @@
  * frames of the fixtures and of icon morphs need under 200 and under 10. */
 #define PAIR_BUDGET 50000L
 #define SEED_BUDGET 5000L
+/* Newton iterations per count: a seed converges in under ten, a touch
+ * wanders up to a hundred; 5,000 seeds of a hundred would be 10^6
+ * evaluations (a spiral wound 200 times took 0.4 s a frame). */
+#define NEWTON_BUDGET 50000L
+/* Box tests of the sweep per count: a curve wound tightly on itself puts
+ * every sub-curve's box over every other's (8,192^2 / 2 tests). */
+#define SWEEP_BUDGET 4000000L
 /* Sub-curves per count (frames of the fixtures have some hundreds): a
  * piece split toward every wiggle would need 2^24 of them; past this the
  * rest are taken as they are. */
@@ -66,7 +73,7 @@ typedef struct ctx {
   double tol, flat, size, eps_t;
   double mag;    /* largest |coordinate| of the control points */
   double margin; /* rounding of the coordinates: the boxes' margin */
-  long pairs_left, seeds_left; /* work bounds (PAIR_BUDGET, SEED_BUDGET) */
+  long pairs_left, seeds_left, newton_left; /* work bounds (*_BUDGET) */
   bool closed;
   seg *segs;
   size_t nseg, capseg;
@@ -247,7 +254,7 @@ static void refine(ctx *x, size_t ka, double ua, size_t kb, double ub) {
    * ends up wandering in rounding noise, and the best point there is the
    * one whose tangents are closest to parallel */
   double best = INFINITY, bua = ua, bub = ub;
-  for (int it = 0; it < 100; it++) {
+  for (int it = 0; it < 100 && x->newton_left > 0; it++, x->newton_left--) {
     eval_piece(x, ka, ua, Pa, Da);
     eval_piece(x, kb, ub, Pb, Db);
     double fx = Pa[0] - Pb[0], fy = Pa[1] - Pb[1], f = hypot(fx, fy);
@@ -345,8 +352,12 @@ static void chord_seed(ctx *x, const seg *A, const seg *B) {
 static void pair(ctx *x, const seg *A, const seg *B, int depth) {
   if (x->oom || !boxes_overlap(A, B, x->margin)) return;
   int p = x->p;
+  if (--x->pairs_left <= 0) {
+    chord_seed(x, A, B);
+    return;
+  }
   bool fa = flatness(A, p) <= x->flat, fb = flatness(B, p) <= x->flat;
-  if ((fa && fb) || depth >= PAIR_DEPTH || --x->pairs_left <= 0) {
+  if ((fa && fb) || depth >= PAIR_DEPTH) {
     chord_seed(x, A, B);
     return;
   }
@@ -459,6 +470,7 @@ long km_curve_self_intersections(const km_curve *c, double tol) {
   x.eps_t = 1e-8 * (x.t1 - x.t0);
   x.pairs_left = PAIR_BUDGET;
   x.seeds_left = SEED_BUDGET;
+  x.newton_left = NEWTON_BUDGET;
   size_t pieces = (bz.n - 1) / (size_t)p;
   for (size_t k = 0; k < pieces && !x.oom; k++) {
     seg s;
@@ -475,13 +487,17 @@ long km_curve_self_intersections(const km_curve *c, double tol) {
   if (!order) goto cleanup;
   for (size_t i = 0; i < x.nseg; i++) order[i] = &x.segs[i];
   qsort(order, x.nseg, sizeof *order, by_xmin);
-  for (size_t i = 0; i < x.nseg && !x.oom; i++)
-    for (size_t j = i + 1; j < x.nseg && !x.oom; j++) {
+  long sweep_left = SWEEP_BUDGET;
+  for (size_t i = 0; i < x.nseg && !x.oom; i++) {
+    /* past every bound nothing more can be found */
+    if (x.pairs_left <= 0 && (x.seeds_left <= 0 || x.newton_left <= 0)) break;
+    for (size_t j = i + 1; j < x.nseg && !x.oom && sweep_left-- > 0; j++) {
       if (order[j]->xmin > order[i]->xmax + x.margin) break;
       if (!boxes_overlap(order[i], order[j], x.margin)) continue;
       if (consecutive_same_way(&x, order[i], order[j])) continue;
       pair(&x, order[i], order[j], 0);
     }
+  }
   if (x.oom) goto cleanup;
   result = (long)x.nhit;
 cleanup:

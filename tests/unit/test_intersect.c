@@ -9,6 +9,7 @@
  */
 #include "testutil.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 #include "km/curve.h"
@@ -169,6 +170,39 @@ static void polygons_count_like_by_hand(void **state) {
   km_curve_free(&c);
 }
 
+/* The regular star polygon {p/q} (p prime, q < p/2) crosses itself
+ * p (q - 1) times: every edge meets the 2 (q - 1) edges whose ends
+ * separate its own on the circle. Thousands of genuine crossings stay
+ * within the count's work bounds. */
+static void star_polygons_cross_p_times_q_minus_one(void **state) {
+  (void)state;
+  const int stars[][2] = {{7, 2}, {7, 3}, {31, 15}, {61, 30}};
+  for (size_t k = 0; k < sizeof stars / sizeof *stars; k++) {
+    int p = stars[k][0], q = stars[k][1];
+    double *pts = malloc(2 * (size_t)(p + 1) * sizeof(double));
+    double *knots = malloc((size_t)(p + 3) * sizeof(double));
+    assert_non_null(pts);
+    assert_non_null(knots);
+    for (int i = 0; i <= p; i++) {
+      double a = 0.3 + 2 * M_PI * (double)((i * q) % p) / p;
+      pts[2 * i] = cos(a);
+      pts[2 * i + 1] = sin(a);
+    }
+    pts[2 * p] = pts[0];
+    pts[2 * p + 1] = pts[1];
+    knots[0] = 0;
+    for (int i = 0; i <= p; i++) knots[i + 1] = i;
+    knots[p + 2] = p;
+    km_curve c = make(1, (size_t)p + 1, knots, pts, NULL, true);
+    long n = km_curve_self_intersections(&c, 1e-10);
+    if (n != (long)p * (q - 1)) print_error("{%d/%d}: %ld crossings\n", p, q, n);
+    assert_int_equal(n, (long)p * (q - 1));
+    km_curve_free(&c);
+    free(pts);
+    free(knots);
+  }
+}
+
 static void crossing_at_a_piece_boundary_counts_once(void **state) {
   (void)state;
   /* the vertical leg passes through the joint (0, 0) of the first two
@@ -226,6 +260,7 @@ int main(void) {
       cmocka_unit_test(tangential_touch_is_not_a_crossing),
       cmocka_unit_test(curve_crossing_itself_twice),
       cmocka_unit_test(polygons_count_like_by_hand),
+      cmocka_unit_test(star_polygons_cross_p_times_q_minus_one),
       cmocka_unit_test(crossing_at_a_piece_boundary_counts_once),
       cmocka_unit_test(crossing_at_the_seam_counts_once),
       cmocka_unit_test(count_is_invariant_under_rigid_motion),
