@@ -468,6 +468,8 @@ int api_morph_prepare(const api_config *cfg, const api_request *req,
   if (pl->tol <= 0)
     pl->tol = 1e-5 * fmax(pl->from.length, pl->to.length);
   pl->opt.tolerance = pl->tol;
+  /* frames are curves of the answer: held to the limit on curves */
+  pl->opt.max_points = pl->cfg.max_control_points;
   if (pl->opt.method == KM_METHOD_CURVATURE &&
       (!input_signature(&ctx, &pl->from, "/from", pl->tol) ||
        !input_signature(&ctx, &pl->to, "/to", pl->tol)))

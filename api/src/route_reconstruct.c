@@ -36,7 +36,10 @@ int api__route_reconstruct(api_ctx *ctx, const api_request *req,
   if ((js = api__require(ctx, root, "", "signature")) == NULL ||
       !api__parse_signature(ctx, js, "/signature", &sig))
     goto fail;
-  st = km_reconstruct(&sig, (int)degree, tol, &curve, &bound, &err);
+  /* the answer's curve is held to the limit on curves, as inputs are */
+  st = km_reconstruct_within(&sig, (int)degree, tol,
+                             ctx->cfg->max_control_points, &curve, &bound,
+                             &err);
   if (st != KM_OK) {
     api__core_fail(ctx, st, &err, "/signature", API_KIND_SIGNATURE);
     goto fail;

@@ -115,9 +115,11 @@ void km_morph_free(km_morph *m) {
   free(m);
 }
 
-static km_status ensure_curve(input *in, double tol, km_error *err) {
+static km_status ensure_curve(input *in, double tol, size_t max_points,
+                              km_error *err) {
   if (in->has_curve) return KM_OK;
-  km_status st = km_reconstruct(&in->sig, 3, tol, &in->curve, NULL, err);
+  km_status st = km_reconstruct_within(&in->sig, 3, tol, max_points,
+                                       &in->curve, NULL, err);
   if (!st) in->has_curve = true;
   return st;
 }
@@ -715,8 +717,16 @@ static km_status plan_frames(km_morph *m, km_error *err) {
   const km_pp tp[2] = {a->theta, b->theta};
   double len[2] = {a->sig.length, b->sig.length};
   double ang[2] = {a->sig.angle, b->sig.angle};
+  /* a planned frame has two control points a piece (a corner one more) */
+  size_t max_pieces = m->opt.max_points / 2;
   km_status st = km__frame_plan_build(&m->plan, tp, len, ang, m->closed,
-                                      m->tol, err);
+                                      m->tol, max_pieces, err);
+  if (st == KM_ELIMIT && max_pieces > 0)
+    return km__fail(err, KM_ELIMIT, KM_FIELD_TOLERANCE, -1, NAN,
+                    "the frames need more than %zu control points at this "
+                    "tolerance, the most allowed a curve: loosen the "
+                    "tolerance",
+                    m->opt.max_points);
   if (!st) m->close_by_corners = lsq && km__frame_plan_by_corners(m->plan);
   return st;
 }
@@ -882,8 +892,8 @@ static km_status create_impl(km_morph **out, const km_morph_input *from,
   m->nk = nm + 2;
   m->nuser = nm;
   if (opt->method == KM_METHOD_LINEAR) {
-    st = ensure_curve(a, 0.1 * tol, err);
-    if (!st) st = ensure_curve(b, 0.1 * tol, err);
+    st = ensure_curve(a, 0.1 * tol, opt->max_points, err);
+    if (!st) st = ensure_curve(b, 0.1 * tol, opt->max_points, err);
     if (!st)
       st = km_curve_make_compatible(&a->curve, &b->curve, &m->lin[0],
                                     &m->lin[1], err);
@@ -1969,7 +1979,8 @@ km_status km_morph_frame(const km_morph *m, double t, km_curve *out,
     if (st) goto done;
     gap = hypot(end[0] - blended.start[0], end[1] - blended.start[1]);
   }
-  st = km_reconstruct(use, m->opt.degree, 0.9 * m->tol, &f, &bound, err);
+  st = km_reconstruct_within(use, m->opt.degree, 0.9 * m->tol,
+                             m->opt.max_points, &f, &bound, err);
   if (st) goto done;
   if (m->closed && !f.closed && how != KM_CLOSURE_NONE && how != KM_CLOSURE_LSQ)
     close_polygon(&f, how);

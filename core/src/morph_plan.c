@@ -333,13 +333,14 @@ static void both_bounds(const side sd[2], double r0, double r1, int nd,
 static km_status plan_interval(vec *atoms, const side sd[2], double r0,
                                double r1, size_t iv, const double *D,
                                double tolp, double j2, double j3,
-                               bool corner) {
+                               bool corner, size_t max_atoms) {
   double h = r1 - r0, e = pow(h, 4) / 384.0 * m4_of(D);
   int parts = 1;
   if (e > tolp) {
     double p = ceil(pow(e / tolp, 0.25) * 1.05);
     parts = p > 1e6 ? 1000000 : (int)p;
   }
+  if (max_atoms > 0 && atoms->n + (size_t)parts > max_atoms) return KM_ELIMIT;
   for (int k = 0; k < parts; k++) {
     double a = r0 + h * k / parts, b = k + 1 == parts ? r1 : r0 + h * (k + 1) / parts;
     atom at = {a, b, 0.0, k ? 0.0 : j2, k ? 0.0 : j3, k ? false : corner, iv,
@@ -391,7 +392,7 @@ static bool corner_closure(const km__frame_plan *p, double t, double *sum,
 
 km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const double length[2],
                                const double angle[2], bool closed, double tol,
-                               km_error *err) {
+                               size_t max_pieces, km_error *err) {
   km_status st = KM_OK;
   double *br = NULL, *Dall = NULL;
   vec atoms = {NULL, 0, 0, sizeof(atom)}, nodes = {NULL, 0, 0, sizeof(gnode)};
@@ -483,7 +484,7 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
       }
     }
     st = plan_interval(&atoms, sd, br[i], br[i + 1], i, Dall + i * (NDER + 1),
-                       tolp, j2, j3, corner);
+                       tolp, j2, j3, corner, 2 * max_pieces);
     if (st) goto fail;
   }
   /* merge atoms greedily into output pieces while the bound holds */
@@ -515,6 +516,11 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
       k = e;
     }
     start[np] = na;
+  }
+  if (max_pieces > 0 && np > max_pieces) {
+    free(start);
+    st = KM_ELIMIT;
+    goto fail;
   }
   p->np = np;
   p->x = malloc((np + 1) * sizeof(double));

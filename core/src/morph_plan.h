@@ -23,10 +23,13 @@ typedef struct km__frame_plan km__frame_plan;
  * length (km__build_theta), with lengths and start angles. Every frame
  * built from the plan is within tol of the exact frame (tol: the frame
  * tolerance; a half goes to the Hermite pieces, a tenth to the quadrature
- * and a tenth to merging the inputs' pieces). */
+ * and a tenth to merging the inputs' pieces). More than max_pieces pieces
+ * a frame (0: no bound but memory) fails with KM_ELIMIT, early: the
+ * uniform splits are refused past twice that before their bounds are
+ * taken. */
 km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const double length[2],
                                const double angle[2], bool closed, double tol,
-                               km_error *err);
+                               size_t max_pieces, km_error *err);
 void km__frame_plan_free(km__frame_plan *p);
 size_t km__frame_plan_pieces(const km__frame_plan *p);
 size_t km__frame_plan_nodes(const km__frame_plan *p);

@@ -299,6 +299,12 @@ static void merge_cubic(plan *pl, const theta_pieces *tp, double tol) {
 
 km_status km_reconstruct(const km_signature *sig, int degree, double tol,
                          km_curve *out, double *error_bound, km_error *err) {
+  return km_reconstruct_within(sig, degree, tol, 0, out, error_bound, err);
+}
+
+km_status km_reconstruct_within(const km_signature *sig, int degree, double tol,
+                                size_t max_points, km_curve *out,
+                                double *error_bound, km_error *err) {
   if (degree != 3 && degree != 5)
     return km__fail(err, KM_EDEGREE, KM_FIELD_DEGREE, -1, NAN,
                     "reconstruction degree must be 3 or 5, not %d", degree);
@@ -315,15 +321,18 @@ km_status km_reconstruct(const km_signature *sig, int degree, double tol,
   int dk = tp.kappa.degree, dt = dk + 1;
   pl.limit = KM_MAX_OUTPUT_PIECES + 2 * tp.theta.m;
   if (pl.limit > KM_MAX_PIECES) pl.limit = KM_MAX_PIECES;
+  /* a piece adds at most `degree` control points (a corner on each side) */
+  if (max_points > 0 && max_points / (size_t)degree < pl.limit)
+    pl.limit = max_points / (size_t)degree;
   for (size_t i = 0; i < tp.theta.m; i++) {
     st = plan_range(&pl, &tp, i, 0.0, 1.0, degree, 0.9 * tol, 0);
     if (st) {
       st = km__fail(err, st, KM_FIELD_TOLERANCE, -1, NAN,
                     st == KM_ELIMIT ? "the curve needs more than %zu pieces "
-                                      "at this tolerance (it turns %g "
-                                      "times): loosen the tolerance"
+                                      "of degree %d at this tolerance (it "
+                                      "turns %g times): loosen the tolerance"
                                     : "out of memory",
-                    pl.limit, fabs(sig->turning) / (2 * KM_PI));
+                    pl.limit, degree, fabs(sig->turning) / (2 * KM_PI));
       goto cleanup;
     }
   }

@@ -113,6 +113,19 @@ km_status km_signature_create(km_signature *out, double length,
       return km__fail(err, KM_EINVAL, KM_FIELD_CORNERS, (long)i, NAN,
                       "corners must be sorted by s (corner %zu)", i);
   }
+  /* a bound on the integral of |kappa| plus |turn| at the corners */
+  double abs_turning = 0.0;
+  int p = kappa->degree;
+  for (size_t i = 0; i < kappa->n; i++)
+    abs_turning += fabs(kappa->coef[i]) *
+                   (kappa->knots[i + (size_t)p + 1] - kappa->knots[i]) / (p + 1);
+  for (size_t i = 0; i < ncorners; i++) abs_turning += fabs(corners[i].turn);
+  double max_turns = KM_MAX_SIGNATURE_TURNS + 0.25 * (double)kappa->n;
+  if (!(abs_turning <= 2 * KM_PI * max_turns))
+    return km__fail(err, KM_ELIMIT, KM_FIELD_KAPPA_COEFFICIENTS, -1, NAN,
+                    "the curve would turn up to %g times (|kappa| "
+                    "integrates to %g rad); at most %g turns are traced",
+                    abs_turning / (2 * KM_PI), abs_turning, max_turns);
   km_signature r;
   km_signature_init(&r);
   km_status st = km_fn_copy(&r.kappa, kappa, err);

@@ -47,7 +47,7 @@ static const opt_def OPTS[] = {
     {"max-body", "KMORPH_MAX_BODY", OPT_SIZE, F(max_body), 0, 1, 1e12,
      "request body bytes (larger: 413)"},
     {"max-points", "KMORPH_MAX_POINTS", OPT_SIZE, F(max_points), 0, 1, 1e9,
-     "control points per curve"},
+     "control points per curve, given or returned"},
     {"max-frames", "KMORPH_MAX_FRAMES", OPT_SIZE, F(max_frames), 0, 1, 1e9,
      "frames per POST /v1/morph"},
     {"max-job-frames", "KMORPH_MAX_JOB_FRAMES", OPT_SIZE, F(max_job_frames),

@@ -311,6 +311,52 @@ static void control_points_above_the_limit_are_422(void **state) {
   cJSON_Delete(j);
 }
 
+/* Answers are held to the limit on curves too, and a signature to the
+ * turns it may make: the unit circle at 1e-9 needs some 250 cubic pieces
+ * (h = (384 tol)^(1/4) = 0.025), 500 control points; kappa falling from
+ * 1e5 to -2 over 4 units turns (1e5 - 2) 2 / (2 pi) = 31,830 times. */
+#define UNIT_CIRCLE_SIG                                                    \
+  "{\"length\":6.283185307179586,\"start\":{\"point\":[1,0],"              \
+  "\"angle\":1.5707963267948966},\"kappa\":{\"degree\":0,\"knots\":[0,"     \
+  "6.283185307179586],\"coefficients\":[1]},\"closed\":true}"
+static void answers_and_turns_above_the_limits_are_422(void **state) {
+  (void)state;
+  api_config cfg;
+  api_config_default(&cfg);
+  cfg.max_control_points = 400;
+  cJSON *j = at_expect_problem_cfg(
+      &cfg, API_ROUTE_RECONSTRUCT,
+      "{\"signature\":" UNIT_CIRCLE_SIG ",\"tolerance\":1e-9}", 422,
+      "/tolerance");
+  assert_string_equal(cJSON_GetObjectItemCaseSensitive(j, "type")->valuestring,
+                      "/problems/limit-exceeded");
+  cJSON_Delete(j);
+  cfg.max_control_points = 2000;
+  api_response res;
+  j = NULL;
+  const char *ok = "{\"signature\":" UNIT_CIRCLE_SIG ",\"tolerance\":1e-9}";
+  assert_int_equal(at_call_cfg(&cfg, API_ROUTE_RECONSTRUCT, ok, strlen(ok), &res, &j),
+                   200);
+  const cJSON *cp = cJSON_GetObjectItemCaseSensitive(
+      cJSON_GetObjectItemCaseSensitive(j, "curve"), "control_points");
+  assert_true(cJSON_GetArraySize(cp) >= 500 && cJSON_GetArraySize(cp) <= 2000);
+  cJSON_Delete(j);
+  api_response_free(&res);
+  /* a morph's frames likewise, refused before any frame is made */
+  cfg.max_control_points = 400;
+  cJSON_Delete(at_expect_problem_cfg(
+      &cfg, API_ROUTE_MORPH,
+      "{\"from\":{\"type\":\"signature\",\"signature\":" UNIT_CIRCLE_SIG
+      "},\"to\":{\"type\":\"signature\",\"signature\":" UNIT_CIRCLE_SIG
+      "},\"tolerance\":1e-9,\"frames\":3}",
+      422, "/tolerance"));
+  at_problem(API_ROUTE_RECONSTRUCT,
+             "{\"signature\":{\"length\":4,\"start\":{\"point\":[0,0],"
+             "\"angle\":0},\"kappa\":{\"degree\":1,\"knots\":[0,0,4,4],"
+             "\"coefficients\":[1e5,-2]},\"closed\":false}}",
+             422, "/signature/kappa/coefficients");
+}
+
 static void bad_tolerance_and_samples_are_named(void **state) {
   (void)state;
   at_problem(SIG, CURVE_HEAD GOOD_KNOTS "," GOOD_CP "},\"tolerance\":0}", 422,
@@ -439,6 +485,7 @@ int main(void) {
       cmocka_unit_test(closed_curve_that_does_not_close_is_named),
       cmocka_unit_test(cusp_is_422_invalid_curve),
       cmocka_unit_test(control_points_above_the_limit_are_422),
+      cmocka_unit_test(answers_and_turns_above_the_limits_are_422),
       cmocka_unit_test(bad_tolerance_and_samples_are_named),
       cmocka_unit_test(signature_errors_are_named),
       cmocka_unit_test(reconstruct_degree_must_be_3_or_5),

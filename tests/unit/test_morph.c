@@ -284,6 +284,52 @@ static void spiral_curvature_frames_never_exceed_the_inputs_curvature(void **sta
   km_signature_free(&sb);
 }
 
+/* Frames are held to max_points control points: within it, or refused on
+ * the tolerance (when the morph is made for planned frames, when the frame
+ * is made for the paper's blend). At 1e-10 the spiral kappa = s on [0, 4],
+ * frame 0, has cubic pieces no longer than h(s) = (384 tol / s^3)^(1/4)
+ * where they lie (the a-priori bound takes the largest |C''''| >= kappa^3
+ * over a piece): the integral of ds / h is 4^(7/4) / (7/4) / (384
+ * tol)^(1/4) = 462 pieces at least, two control points each. */
+static void frames_hold_to_a_number_of_points(void **state) {
+  (void)state;
+  km_signature sa, sb;
+  spiral_inputs(&sa, &sb);
+  km_morph_input A = {NULL, &sa}, B = {NULL, &sb};
+  for (int blend = 0; blend < 2; blend++) {
+    const size_t limits[] = {100000, 5000, 40};
+    for (size_t k = 0; k < 3; k++) {
+      km_morph_options o;
+      km_morph_options_default(&o);
+      o.blend = blend ? KM_BLEND_PAPER : KM_BLEND_TURNING;
+      o.tolerance = 1e-10;
+      o.max_points = limits[k];
+      km_morph *m = NULL;
+      km_error err;
+      km_status st = km_morph_create(&m, &A, &B, &o, &err);
+      for (int i = 0; i <= 4 && st == KM_OK; i++) {
+        km_curve c;
+        km_curve_init(&c);
+        st = km_morph_frame(m, i / 4.0, &c, NULL, NULL, &err);
+        if (st == KM_OK) {
+          assert_true(c.n <= limits[k]);
+          if (i == 0) assert_true(c.n >= 2 * 462);
+        }
+        km_curve_free(&c);
+      }
+      km_morph_free(m);
+      if (limits[k] >= 5000) {
+        assert_status(st, KM_OK);
+      } else {
+        assert_status(st, KM_ELIMIT);
+        assert_int_equal(err.field, KM_FIELD_TOLERANCE);
+      }
+    }
+  }
+  km_signature_free(&sa);
+  km_signature_free(&sb);
+}
+
 static void spiral_linear_baseline_exceeds_the_inputs_curvature(void **state) {
   (void)state;
   km_signature sa, sb;
@@ -1193,6 +1239,7 @@ static void times_outside_the_unit_interval_are_rejected(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(spiral_curvature_frames_never_exceed_the_inputs_curvature),
+      cmocka_unit_test(frames_hold_to_a_number_of_points),
       cmocka_unit_test(spiral_linear_baseline_exceeds_the_inputs_curvature),
       cmocka_unit_test(spiral_end_frames_are_the_exact_spirals),
       cmocka_unit_test(planned_spiral_frames_are_the_exact_blended_spirals),

@@ -523,36 +523,90 @@ static void corner_one_ulp_before_a_curvature_break_keeps_its_turn(
  * times, and at 2e-3 its reconstruction would take some 85,000 quintic
  * pieces (400,000 control points, seconds). It is refused at once with
  * the tolerance named; a tolerance that needs few pieces is served. */
+/* kappa falling linearly from k0 to -2 over 4 units: sum |c_i| h_i / 2 =
+ * 2 (k0 + 2) bounds the integral of |kappa|, and the curve turns
+ * (k0 - 2) 2 / (2 pi) times. */
+static km_status falling_kappa(km_signature *sig, double k0, km_error *err) {
+  km_fn kappa;
+  km_fn_init(&kappa);
+  const double kn[4] = {0, 0, 4, 4}, co[2] = {k0, -2};
+  assert_status(km_fn_create(&kappa, 1, 2, kn, co, err), KM_OK);
+  const double start[2] = {0, 0};
+  km_signature_init(sig);
+  km_status st = km_signature_create(sig, 4.0, start, 0.0, &kappa, NULL, 0, false, err);
+  km_fn_free(&kappa);
+  return st;
+}
+
 static void reconstruction_that_turns_without_end_is_refused(void **state) {
   (void)state;
-  km_fn kappa;
   km_error err;
-  km_fn_init(&kappa);
-  const double kn[4] = {0, 0, 4, 4}, co[2] = {666660, -2};
-  assert_status(km_fn_create(&kappa, 1, 2, kn, co, &err), KM_OK);
-  const double start[2] = {0, 0};
   km_signature sig;
-  km_signature_init(&sig);
-  assert_status(km_signature_create(&sig, 4.0, start, 0.0, &kappa, NULL, 0, false, &err),
-                KM_OK);
-  assert_close(sig.turning / (2 * M_PI), (666660.0 - 2.0) / 2 * 4 / (2 * M_PI), 1e-6);
+  /* 212,204 turns: past the 2,000 (+ 1/4 a coefficient) any signature may
+   * make, refused where it is given, naming kappa */
+  assert_status(falling_kappa(&sig, 666660, &err), KM_ELIMIT);
+  assert_int_equal(err.field, KM_FIELD_KAPPA_COEFFICIENTS);
+  assert_null(sig.kappa.coef);
+  /* the bound 2 (k0 + 2) against 2 pi 2000.5: k0 = 6282.8 is the edge */
+  assert_status(falling_kappa(&sig, 6300, &err), KM_ELIMIT);
+  assert_status(falling_kappa(&sig, 6250, &err), KM_OK);
+  assert_close(sig.turning / (2 * M_PI), (6250.0 - 2.0) * 2 / (2 * M_PI), 1e-9);
+  /* 1,989 turns at 1e-12: quintic pieces of h = (46080 tol / kappa^5)^(1/6)
+   * number K^(5/6) 4 (6/11) / (46080 tol)^(1/6) ~ 53,000, past the 20,000
+   * beyond the input's: refused on the tolerance before any is built */
   km_curve r;
   km_curve_init(&r);
-  assert_status(km_reconstruct(&sig, 5, 2.1e-3, &r, NULL, &err), KM_ELIMIT);
+  assert_status(km_reconstruct(&sig, 5, 1e-12, &r, NULL, &err), KM_ELIMIT);
   assert_int_equal(err.field, KM_FIELD_TOLERANCE);
   assert_null(r.cp);
-  km_fn_free(&kappa);
   km_signature_free(&sig);
   /* kappa = 1 over 4 units needs a handful */
+  km_fn kappa;
   km_fn_init(&kappa);
   assert_status(km_fn_constant(&kappa, 0.0, 4.0, 1.0, &err), KM_OK);
   km_signature_init(&sig);
+  const double start[2] = {0, 0};
   assert_status(km_signature_create(&sig, 4.0, start, 0.0, &kappa, NULL, 0, false, &err),
                 KM_OK);
   double bound;
   assert_status(km_reconstruct(&sig, 5, 2.1e-3, &r, &bound, &err), KM_OK);
   assert_true(r.n < 100 && bound <= 2.1e-3);
   km_curve_free(&r);
+  km_fn_free(&kappa);
+  km_signature_free(&sig);
+}
+
+/* The answer's curve is held to a number of control points: within it or
+ * refused on the tolerance, never larger. The unit circle at 1e-9 needs
+ * cubic pieces of h = (384 tol)^(1/4) = 0.0249, some 250 of them, two
+ * control points each (a piece is allowed three: a corner adds one). */
+static void reconstruction_holds_to_a_number_of_points(void **state) {
+  (void)state;
+  km_error err;
+  km_signature sig;
+  km_fn kappa;
+  km_fn_init(&kappa);
+  assert_status(km_fn_constant(&kappa, 0.0, 2 * M_PI, 1.0, &err), KM_OK);
+  const double start[2] = {1, 0};
+  assert_status(km_signature_create(&sig, 2 * M_PI, start, M_PI / 2, &kappa, NULL, 0, true,
+                                    &err),
+                KM_OK);
+  km_curve r;
+  km_curve_init(&r);
+  const size_t limits[] = {2000, 1000, 700, 400, 100, 3};
+  for (size_t k = 0; k < sizeof limits / sizeof *limits; k++) {
+    km_status st = km_reconstruct_within(&sig, 3, 1e-9, limits[k], &r, NULL, &err);
+    if (limits[k] >= 1000) assert_status(st, KM_OK);
+    if (limits[k] <= 700) {
+      assert_status(st, KM_ELIMIT);
+      assert_int_equal(err.field, KM_FIELD_TOLERANCE);
+    }
+    if (st == KM_OK) {
+      assert_true(r.n <= limits[k]);
+      assert_true(r.n >= 2 * 250);
+    }
+    km_curve_free(&r);
+  }
   km_fn_free(&kappa);
   km_signature_free(&sig);
 }
@@ -570,6 +624,7 @@ int main(void) {
       cmocka_unit_test(repeated_control_point_survives_a_round_trip),
       cmocka_unit_test(reconstruct_rejects_other_degrees),
       cmocka_unit_test(reconstruction_that_turns_without_end_is_refused),
+      cmocka_unit_test(reconstruction_holds_to_a_number_of_points),
       cmocka_unit_test(corner_one_ulp_before_a_curvature_break_keeps_its_turn),
   };
   return cmocka_run_group_tests_name("reconstruct", tests, NULL, NULL);

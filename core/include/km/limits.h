@@ -43,6 +43,18 @@
  * than any input the service takes. */
 #define KM_MAX_OUTPUT_PIECES 20000
 
+/* Turns a signature given as input may make: at most this many plus one
+ * for every four coefficients of kappa, counted as sum |c_i| (t_(i+p+1) -
+ * t_i) / (p + 1) plus the corners' |turn|, over 2 pi (a bound on the
+ * integral of |kappa|). Tracing a curve costs some 16 evaluations of theta
+ * a radian it turns (reconstruction, a morph's tables and plan), whatever
+ * the tolerance: a curve of length 4 whose kappa falls from 666,660 to -2
+ * turns 212,204 times and took seconds at a tolerance that wanted only
+ * 12,800 pieces. A span of degree p turns fewer than p times, so
+ * signatures of curves stay well inside; 2,000 turns cost a morph some
+ * 0.3 s to prepare in the fuzzing build (20 ms at -O2). */
+#define KM_MAX_SIGNATURE_TURNS 2000.0
+
 /* Work of one signature, in evaluations of the curve and its derivative
  * (a piece's fit counts as many again as its nodes): 0.03 to 0.1 us each
  * at -O2, some 1 to 2 us in the fuzzing build (AddressSanitizer and

@@ -40,6 +40,8 @@ typedef struct km_morph_options {
   const double *matches;  /* nmatches pairs (r_from, r_to), borrowed */
   size_t nmatches;
   bool auto_matches;      /* matches: "auto" */
+  size_t max_points;      /* control points a frame may have; 0: the core's
+                             own bound (KM_MAX_OUTPUT_PIECES) */
 } km_morph_options;
 
 void km_morph_options_default(km_morph_options *o);

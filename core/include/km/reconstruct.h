@@ -24,6 +24,14 @@
 km_status km_reconstruct(const km_signature *sig, int degree, double tol,
                          km_curve *out, double *error_bound, km_error *err);
 
+/* km_reconstruct with at most max_points control points in the result
+ * (0: the core's own bound, KM_MAX_OUTPUT_PIECES beyond two pieces per
+ * piece of sig): more fails with KM_ELIMIT on the tolerance before the
+ * curve is built. The service holds answers to its limit on curves. */
+km_status km_reconstruct_within(const km_signature *sig, int degree, double tol,
+                                size_t max_points, km_curve *out,
+                                double *error_bound, km_error *err);
+
 /* Exact curve point at arc length s (numerical quadrature to ~1e-15 L):
  * used by tests and metrics. pos and tangent angle. */
 km_status km_signature_point(const km_signature *sig, double s,
