@@ -9,7 +9,7 @@ bounded in time.
             RSS_BOUND_MB; afterwards descriptors back to baseline.
   faults    clients that leave mid-request and mid-response, slow-body
             and slow-read clients, many idle connections opened and
-            dropped (IDLE_CONNECTIONS: 3,000; 10,000 long), while a
+            dropped (IDLE_CONNECTIONS: 10,000), while a
             well-behaved client keeps being served quickly; afterwards
             descriptors and memory back to baseline, /healthz fine.
   sigterm   SIGTERM while 32 clients and 8 jobs are busy: exit 0 within
@@ -38,8 +38,7 @@ import kmreq  # noqa: E402
 
 LONG = os.environ.get("HARDENING_LONG") == "1"
 LOAD_SECONDS = float(os.environ.get("LOAD_SECONDS", 120 if LONG else 20))
-IDLE_CONNECTIONS = int(os.environ.get("IDLE_CONNECTIONS",
-                                      10000 if LONG else 3000))
+IDLE_CONNECTIONS = int(os.environ.get("IDLE_CONNECTIONS", 10000))
 CLIENTS = 64
 RSS_BOUND_MB = 512
 DAEMON = os.environ.get("KMORPHD", os.path.join(hlib.ROOT, "build",
@@ -471,10 +470,13 @@ def part_faults(ck):
                                                    probe.fail[:5]))
         # While a batch of idle connections fills the connection limit a
         # new client waits for the oldest to reach the idle timeout (3 s
-        # here), so that plus half a second of compute is the bound; work
-        # for clients that left (up to 5 s before it was skipped) breaks it.
-        ck.check(max(probe.lat or [0]) < 3.5, "and never waited longer than "
-                 "the idle timeout (max %.2f s, bound 3.5 s)"
+        # here); on top of that it may wait for its own compute and for a
+        # machine busy with the test's thousands of sockets (up to 1.7 s
+        # seen on 2 shared vCPUs), so the bound is 3 + 2.5 s. Work for
+        # clients that left (up to 5 s a request before it was skipped)
+        # would make it 8 s and more.
+        ck.check(max(probe.lat or [0]) < 5.5, "and never waited much longer "
+                 "than the idle timeout (max %.2f s, bound 3 + 2.5 s)"
                  % max(probe.lat or [0]))
         ck.check(opened >= IDLE_CONNECTIONS and served_during > 0,
                  "%d idle connections opened and dropped while serving "
