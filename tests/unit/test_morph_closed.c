@@ -800,6 +800,52 @@ static void fixture_pairs_end_frames_length_and_closure(void **state) {
   }
 }
 
+/* Frames move smoothly with t, the middle one too: exact frames are smooth
+ * in t, so the second difference of three frames delta apart, at equal
+ * fractions of their length, is delta^2 times a second derivative of the
+ * size of the shape (1e-6 of it at delta = 1e-3) plus the three frames'
+ * tolerances. The lsq closure has many closed solutions and frames start
+ * it from the one found at t = 1/2: the middle frame must take the same
+ * branch as its neighbours, not stop at its start (measured: 4.4e-3 on
+ * U_to_S, 6e-6 of its size, against a bound of 0.035). */
+static void frames_move_smoothly_through_the_middle(void **state) {
+  (void)state;
+  for (int p = 0; p < 6; p++) {
+    km_curve a, b;
+    shape_curve(PAIRS[p], 'a', &a);
+    shape_curve(PAIRS[p], 'b', &b);
+    km_morph_input A = {&a, NULL}, B = {&b, NULL};
+    km_morph_options o;
+    km_morph_options_default(&o);
+    km_morph *m = morph_new(&A, &B, &o);
+    double La = km_curve_length(&a), Lb = km_curve_length(&b);
+    double tol = 1e-5 * fmax(La, Lb), L = fmax(La, Lb);
+    const double delta = 1e-3;
+    frame f[3];
+    for (int k = 0; k < 3; k++) frame_get(m, 0.5 + (k - 1) * delta, &f[k]);
+    double worst = 0.0;
+    for (int j = 0; j <= 400; j++) {
+      double q[3][1][2];
+      for (int k = 0; k < 3; k++) {
+        double t0, t1;
+        km_curve_domain(&f[k].c, &t0, &t1);
+        km_curve_eval(&f[k].c, t0 + (t1 - t0) * j / 400.0, 0, q[k]);
+      }
+      worst = fmax(worst, hypot(q[0][0][0] - 2 * q[1][0][0] + q[2][0][0],
+                                q[0][0][1] - 2 * q[1][0][1] + q[2][0][1]));
+    }
+    double bound = 4 * tol + 10 * delta * delta * L;
+    if (worst > bound)
+      print_error("%s: second difference %.3g at t = 1/2 (bound %.3g)\n", PAIRS[p],
+                  worst, bound);
+    assert_le(worst, bound);
+    for (int k = 0; k < 3; k++) frame_free(&f[k]);
+    km_morph_free(m);
+    km_curve_free(&a);
+    km_curve_free(&b);
+  }
+}
+
 /* The same pairs with matches "auto", with degree-5 frames, and with the
  * linear baseline: end frames are the inputs, closed pairs give closed
  * frames, and curvature frames keep the length law. */
@@ -1238,6 +1284,7 @@ int main(void) {
       cmocka_unit_test(planned_default_frames_of_the_fixture_pairs),
       cmocka_unit_test(planned_and_reconstructed_frames_agree),
       cmocka_unit_test(congruent_shapes_morph_through_congruent_frames),
+      cmocka_unit_test(frames_move_smoothly_through_the_middle),
       cmocka_unit_test(reversed_copy_morphs_through_the_shape_itself),
       cmocka_unit_test(sharp_tips_are_not_counted_as_crossings),
       cmocka_unit_test(a_curve_looping_twice_is_rejected_against_a_circle),
