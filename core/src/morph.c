@@ -94,6 +94,10 @@ struct km_morph {
   km__frame_plan *plan; /* frames planned once (morph_plan.c), or NULL */
   bool close_by_corners; /* lsq closure by the frames' corners */
   double kmax;           /* the inputs' largest |kappa|: the frames' bound */
+  /* placement targets of planned frames: the inputs' points at the plan's
+   * breaks (x, y of a, then of b), their weights, and weighted means */
+  double (*place_ab)[4];
+  double place_w_sum, place_qa[2], place_qb[2];
 };
 
 static void input_free(input *in) {
@@ -112,6 +116,7 @@ void km_morph_free(km_morph *m) {
   free(m->ra);
   free(m->rb);
   km__frame_plan_free(m->plan);
+  free(m->place_ab);
   free(m);
 }
 
@@ -672,6 +677,37 @@ static km_status prepare_input(input *in, const km_morph_input *src,
   return input_tables(in, false);
 }
 
+static void table_at(const input *in, double r, double out[2]);
+
+/* A planned frame is placed by its pieces' ends, at the plan's breaks x_k
+ * of normalised arc length with trapezoid weights: the same fractions of
+ * both inputs whatever t (no matches), so their points A_k, B_k and means
+ * are taken once here, and "fit" needs per frame only sums over the
+ * frame's own points (see planned_placement). */
+static km_status plan_placement(km_morph *m, km_error *err) {
+  size_t nb = km__frame_plan_pieces(m->plan) + 1;
+  const double *x = km__frame_plan_breaks(m->plan);
+  m->place_ab = malloc(nb * sizeof *m->place_ab);
+  if (!m->place_ab) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  double W = 0.0, qa[2] = {0, 0}, qb[2] = {0, 0};
+  for (size_t k = 0; k < nb; k++) {
+    double w = 0.5 * ((k + 1 < nb ? x[k + 1] : x[k]) - (k > 0 ? x[k - 1] : x[k]));
+    table_at(&m->in[0], x[k], m->place_ab[k]);
+    table_at(&m->in[1], x[k], m->place_ab[k] + 2);
+    for (int c = 0; c < 2; c++) {
+      qa[c] += w * m->place_ab[k][c];
+      qb[c] += w * m->place_ab[k][2 + c];
+    }
+    W += w;
+  }
+  m->place_w_sum = W;
+  for (int c = 0; c < 2; c++) {
+    m->place_qa[c] = qa[c] / W;
+    m->place_qb[c] = qb[c] / W;
+  }
+  return KM_OK;
+}
+
 /* Frames of the default morph (turning blend, no matches, cubic output)
  * are planned once: see morph_plan.c. Others are blended piece by piece
  * and reconstructed frame by frame. */
@@ -728,6 +764,7 @@ static km_status plan_frames(km_morph *m, km_error *err) {
                     "tolerance",
                     m->opt.max_points);
   if (!st) m->close_by_corners = lsq && km__frame_plan_by_corners(m->plan);
+  if (!st) st = plan_placement(m, err);
   return st;
 }
 
@@ -768,6 +805,7 @@ static km_status morph_shifted(const km_morph *base, double dshift,
   m->opt = base->opt;
   m->tol = base->tol;
   m->closed = base->closed;
+  m->kmax = base->kmax;
   m->ra = malloc(2 * sizeof(double));
   m->rb = malloc(2 * sizeof(double));
   km_status st = m->ra && m->rb ? KM_OK
@@ -1838,18 +1876,60 @@ static km_status linear_frame(const km_morph *m, double t, km_curve *out,
   return KM_OK;
 }
 
+/* place_samples for a planned frame given by its points F at the plan's
+ * breaks: the targets Q_k = (1 - t) A_k + t B_k are linear in t, so the
+ * fit's sums split into a part of each input. */
+static void planned_placement(const km_morph *m, double t, const double (*F)[2],
+                              size_t nb, double *rot, double T[2]) {
+  const input *a = &m->in[0], *b = &m->in[1];
+  *rot = 0.0;
+  T[0] = (1 - t) * a->sig.start[0] + t * b->sig.start[0];
+  T[1] = (1 - t) * a->sig.start[1] + t * b->sig.start[1];
+  if (t == 0.0 || t == 1.0 || m->opt.anchor == KM_ANCHOR_START) return;
+  const double *x = km__frame_plan_breaks(m->plan);
+  double fc[2] = {0, 0};
+  for (size_t k = 0; k < nb; k++) {
+    double w = 0.5 * ((k + 1 < nb ? x[k + 1] : x[k]) - (k > 0 ? x[k - 1] : x[k]));
+    fc[0] += w * F[k][0];
+    fc[1] += w * F[k][1];
+  }
+  fc[0] /= m->place_w_sum;
+  fc[1] /= m->place_w_sum;
+  if (m->opt.anchor == KM_ANCHOR_CENTROID) {
+    T[0] = (1 - t) * a->centroid[0] + t * b->centroid[0] - fc[0];
+    T[1] = (1 - t) * a->centroid[1] + t * b->centroid[1] - fc[1];
+    return;
+  }
+  /* sum w (F - fc) . (Q - qc) = sum w (F - fc) . Q, as sum w (F - fc) = 0 */
+  double sa = 0.0, ca = 0.0, sb = 0.0, cb = 0.0;
+  for (size_t k = 0; k < nb; k++) {
+    double w = 0.5 * ((k + 1 < nb ? x[k + 1] : x[k]) - (k > 0 ? x[k - 1] : x[k]));
+    double fx = w * (F[k][0] - fc[0]), fy = w * (F[k][1] - fc[1]);
+    const double *q = m->place_ab[k];
+    sa += fx * q[0] + fy * q[1];
+    ca += fx * q[1] - fy * q[0];
+    sb += fx * q[2] + fy * q[3];
+    cb += fx * q[3] - fy * q[2];
+  }
+  *rot = atan2((1 - t) * ca + t * cb, (1 - t) * sa + t * sb);
+  double cr = cos(*rot), sr = sin(*rot);
+  double qc[2] = {(1 - t) * m->place_qa[0] + t * m->place_qb[0],
+                  (1 - t) * m->place_qa[1] + t * m->place_qb[1]};
+  T[0] = qc[0] - (cr * fc[0] - sr * fc[1]);
+  T[1] = qc[1] - (sr * fc[0] + cr * fc[1]);
+}
+
 /* A frame from the plan: the curve only (metrics and signatures take the
  * general path, which yields them exactly). */
 static km_status planned_frame(const km_morph *m, double t, km_closure how,
                                km_curve *out, km_error *err) {
   const input *a = &m->in[0], *b = &m->in[1];
   double phia = a->sig.angle, phib = phia + km__wrap_angle(b->sig.angle - phia);
-  double Lt = (1 - t) * a->sig.length + t * b->sig.length, rot, T[2];
+  double rot, T[2];
   size_t nb = km__frame_plan_pieces(m->plan) + 1;
-  const double *x = km__frame_plan_breaks(m->plan);
-  double *buf = malloc(4 * nb * sizeof(double));
+  double *buf = malloc(2 * nb * sizeof(double));
   if (!buf) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
-  double (*P)[2] = (double (*)[2])buf, *s = buf + 2 * nb, *w = buf + 3 * nb;
+  double (*P)[2] = (double (*)[2])buf;
   km_curve f, placed;
   km_curve_init(&f);
   km_curve_init(&placed);
@@ -1858,12 +1938,7 @@ static km_status planned_frame(const km_morph *m, double t, km_closure how,
   if (st) goto done;
   if (m->closed && !f.closed && how != KM_CLOSURE_NONE)
     close_polygon(&f, how == KM_CLOSURE_LSQ ? KM_CLOSURE_C0 : how);
-  /* placed by the piece ends (trapezoid weights in arc length) */
-  for (size_t k = 0; k < nb; k++) {
-    s[k] = Lt * x[k];
-    w[k] = 0.5 * ((k + 1 < nb ? x[k + 1] : x[k]) - (k > 0 ? x[k - 1] : x[k]));
-  }
-  place_samples(m, t, (const double (*)[2])P, s, w, nb, &rot, T);
+  planned_placement(m, t, (const double (*)[2])P, nb, &rot, T);
   st = km_curve_transform(&placed, &f, rot, T[0], T[1], err);
   if (!st) {
     placed.closed = f.closed;
