@@ -571,32 +571,39 @@ km_status km_curve_reparam(km_curve *out, const km_curve *c, double t0,
  * NURBS too: rational curves are affinely invariant). Returns KM_OK,
  * KM_EINVAL, KM_ENONFINITE, KM_ERANGE (a point beyond KM_MAX_COORDINATE,
  * err->index names it), KM_ENOMEM; out owned by the caller. */
+km_status km__curve_transform_in_place(km_curve *c, double rot, double tx,
+                                      double ty, km_error *err) {
+  if (!isfinite(rot) || !isfinite(tx) || !isfinite(ty))
+    return km__fail(err, KM_ENONFINITE, KM_FIELD_NONE, -1, NAN,
+                    "rotation and translation must be finite");
+  double cs = cos(rot), sn = sin(rot);
+  for (size_t i = 0; i < c->n; i++) {
+    double x = c->cp[2 * i], y = c->cp[2 * i + 1];
+    double nx = cs * x - sn * y + tx, ny = sn * x + cs * y + ty;
+    if (!(fabs(nx) <= KM_MAX_COORDINATE && fabs(ny) <= KM_MAX_COORDINATE))
+      return km__fail(err, KM_ERANGE, KM_FIELD_CONTROL_POINTS, (long)i, NAN,
+                      "transformed control point %zu exceeds %g", i,
+                      KM_MAX_COORDINATE);
+    c->cp[2 * i] = nx;
+    c->cp[2 * i + 1] = ny;
+  }
+  if (c->closed) {
+    c->cp[2 * (c->n - 1)] = c->cp[0];
+    c->cp[2 * (c->n - 1) + 1] = c->cp[1];
+  }
+  return KM_OK;
+}
+
 km_status km_curve_transform(km_curve *out, const km_curve *c, double rot,
                              double tx, double ty, km_error *err) {
   km_status st = check_curve(c, err);
   if (st) return st;
-  if (!isfinite(rot) || !isfinite(tx) || !isfinite(ty))
-    return km__fail(err, KM_ENONFINITE, KM_FIELD_NONE, -1, NAN,
-                    "rotation and translation must be finite");
   km_curve r;
   st = km_curve_copy(&r, c, err);
-  if (st) return st;
-  double cs = cos(rot), sn = sin(rot);
-  for (size_t i = 0; i < r.n; i++) {
-    double x = c->cp[2 * i], y = c->cp[2 * i + 1];
-    double nx = cs * x - sn * y + tx, ny = sn * x + cs * y + ty;
-    if (!(fabs(nx) <= KM_MAX_COORDINATE && fabs(ny) <= KM_MAX_COORDINATE)) {
-      km_curve_free(&r);
-      return km__fail(err, KM_ERANGE, KM_FIELD_CONTROL_POINTS, (long)i, NAN,
-                      "transformed control point %zu exceeds %g", i,
-                      KM_MAX_COORDINATE);
-    }
-    r.cp[2 * i] = nx;
-    r.cp[2 * i + 1] = ny;
-  }
-  if (r.closed) {
-    r.cp[2 * (r.n - 1)] = r.cp[0];
-    r.cp[2 * (r.n - 1) + 1] = r.cp[1];
+  if (!st) st = km__curve_transform_in_place(&r, rot, tx, ty, err);
+  if (st) {
+    km_curve_free(&r);
+    return st;
   }
   *out = r;
   return KM_OK;

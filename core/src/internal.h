@@ -122,6 +122,12 @@ static inline void km__sincos(double x, double *sn, double *cs) {
   }
 }
 
+/* km_curve_transform on c itself (a valid curve): rotation about the
+ * origin by rot, then translation; KM_ERANGE past KM_MAX_COORDINATE (c is
+ * then partly moved). */
+km_status km__curve_transform_in_place(struct km_curve *c, double rot, double tx,
+                                      double ty, km_error *err);
+
 /* Wrap an angle to (-pi, pi]. */
 double km__wrap_angle(double a);
 

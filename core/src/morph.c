@@ -1930,19 +1930,18 @@ static km_status planned_frame(const km_morph *m, double t, km_closure how,
   double *buf = malloc(2 * nb * sizeof(double));
   if (!buf) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   double (*P)[2] = (double (*)[2])buf;
-  km_curve f, placed;
+  km_curve f;
   km_curve_init(&f);
-  km_curve_init(&placed);
   km_status st = km__frame_plan_curve(m->plan, t, (1 - t) * phia + t * phib,
                                       how == KM_CLOSURE_LSQ, &f, buf, err);
   if (st) goto done;
   if (m->closed && !f.closed && how != KM_CLOSURE_NONE)
     close_polygon(&f, how == KM_CLOSURE_LSQ ? KM_CLOSURE_C0 : how);
   planned_placement(m, t, (const double (*)[2])P, nb, &rot, T);
-  st = km_curve_transform(&placed, &f, rot, T[0], T[1], err);
+  st = km__curve_transform_in_place(&f, rot, T[0], T[1], err);
   if (!st) {
-    placed.closed = f.closed;
-    *out = placed;
+    *out = f;
+    km_curve_init(&f);
   }
 done:
   km_curve_free(&f);
