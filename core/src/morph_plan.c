@@ -1036,10 +1036,11 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t,
   f.cp[cc++] = 0.0;
   f.cp[cc++] = 0.0;
   if (ends) ends[0] = ends[1] = 0.0;
+  /* the tangent a piece ends with is the next one's start but at corners
+   * (theta is continuous there to 1e-12, and so is the turn dp) */
+  double c1 = 0.0, s1 = 0.0;
   for (size_t k = 0; k < np; k++) {
     double h = Lt * (p->x[k + 1] - p->x[k]);
-    double th0 = theta0 + al * p->ta_r[k] + be * p->tb_r[k] +
-                 psi_at_break(p, c, k) + dp[k];
     double th1 = theta0 + al * p->ta_l[k + 1] + be * p->tb_l[k + 1] +
                  psi_at_break(p, c, k + 1) + dp[k];
     double Pn[2] = {P[0] + Lt * sum[2 * k], P[1] + Lt * sum[2 * k + 1]};
@@ -1047,8 +1048,12 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t,
       f.cp[cc++] = P[0];
       f.cp[cc++] = P[1];
     }
-    double c0, s0, c1, s1;
-    km__sincos(th0, &s0, &c0);
+    double c0 = c1, s0 = s1;
+    if (k == 0 || p->corner[k]) {
+      double th0 = theta0 + al * p->ta_r[k] + be * p->tb_r[k] +
+                   psi_at_break(p, c, k) + dp[k];
+      km__sincos(th0, &s0, &c0);
+    }
     km__sincos(th1, &s1, &c1);
     f.cp[cc++] = P[0] + h / 3.0 * c0;
     f.cp[cc++] = P[1] + h / 3.0 * s0;
