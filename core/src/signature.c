@@ -453,18 +453,56 @@ static double theta_tol(const builder *b, double noise, double h) {
  * neither does. */
 static bool fit_theta(const double *th, const double *s, double h,
                       double tol_here, double *coef) {
-  double A[(THETA_DEGREE + 1) * (THETA_DEGREE + 1)];
-  for (int j = 0; j <= THETA_DEGREE; j++) {
-    double u = (s[2 * j] - s[0]) / h;
-    km__bernstein_basis(u, THETA_DEGREE, A + j * (THETA_DEGREE + 1));
-    coef[j] = th[2 * j];
+  /* The ends are the first and last nodes, where the interpolant is the
+   * end coefficient itself: pinned exactly (theta is continuous across
+   * pieces). The rest is the interpolant of theta less the line between
+   * the ends, zero at both, whose interior coefficients solve a system of
+   * the interior nodes at a fixed size (it runs at every piece of every
+   * signature); a straight stretch (theta constant, or linear in s) has
+   * exactly zero there, so its kappa is exactly zero. */
+  enum { NI = THETA_DEGREE - 1 };
+  double A[NI][NI], y[NI], row[THETA_DEGREE + 1], d[NI];
+  double th0 = th[0], dth = th[NPTS - 1] - th[0];
+  for (int j = 0; j < NI; j++) {
+    double u = (s[2 * (j + 1)] - s[0]) / h;
+    km__bernstein_basis(u, THETA_DEGREE, row);
+    for (int k = 0; k < NI; k++) A[j][k] = row[k + 1];
+    y[j] = th[2 * (j + 1)] - (th0 + dth * u);
   }
-  bool ok = km__solve_dense(A, coef, THETA_DEGREE + 1);
-  /* pin the ends exactly so theta is continuous across pieces */
-  if (ok) {
-    coef[0] = th[0];
-    coef[THETA_DEGREE] = th[NPTS - 1];
+  bool ok = true;
+  for (int c = 0; c < NI && ok; c++) {
+    int piv = c;
+    for (int r = c + 1; r < NI; r++)
+      if (fabs(A[r][c]) > fabs(A[piv][c])) piv = r;
+    if (!(fabs(A[piv][c]) > 1e-300)) {
+      ok = false;
+      break;
+    }
+    if (piv != c) {
+      for (int k = 0; k < NI; k++) {
+        double tmp = A[c][k];
+        A[c][k] = A[piv][k];
+        A[piv][k] = tmp;
+      }
+      double tmp = y[c];
+      y[c] = y[piv];
+      y[piv] = tmp;
+    }
+    for (int r = c + 1; r < NI; r++) {
+      double f = A[r][c] / A[c][c];
+      for (int k = c; k < NI; k++) A[r][k] -= f * A[c][k];
+      y[r] -= f * y[c];
+    }
   }
+  for (int r = NI - 1; ok && r >= 0; r--) {
+    double v = y[r];
+    for (int k = r + 1; k < NI; k++) v -= A[r][k] * d[k];
+    d[r] = v / A[r][r];
+  }
+  coef[0] = th0;
+  coef[THETA_DEGREE] = th[NPTS - 1];
+  for (int k = 1; ok && k < THETA_DEGREE; k++)
+    coef[k] = th0 + dth * ((double)k / THETA_DEGREE) + d[k - 1];
   /* A strongly varying speed (rational spans with unequal weights)
    * crowds the nodes' images in s, and the interpolant can swing far
    * between them while meeting every check point: its coefficient hull,

@@ -923,11 +923,48 @@ static void closed_curve_ending_below_resolution_turns_whole_turns(void **state)
   km_curve_free(&c);
 }
 
+/* An edge of a polygon has one direction, computed exactly the same at
+ * every node, so theta is constant on it and kappa exactly zero: not 1e-13
+ * of noise from the fit, which frames would carry as curvature between
+ * corners. A pentagon at arbitrary angles, a rotated square and an L. */
+static void polygon_edges_have_exactly_zero_curvature(void **state) {
+  (void)state;
+  const double pent[12] = {0.3, -1.1, 1.7, -0.4, 1.2, 1.3, -0.6, 0.9, -0.8, -0.7,
+                           0.3, -1.1};
+  const double kp[8] = {0, 0, 1, 2, 3, 4, 5, 5};
+  double sq[10], ksq[7] = {0, 0, 1, 2, 3, 4, 4};
+  for (int i = 0; i < 5; i++) {
+    double a = 0.37 + M_PI / 2 * (i % 4);
+    sq[2 * i] = 3.0 + 2.5 * cos(a);
+    sq[2 * i + 1] = -7.0 + 2.5 * sin(a);
+  }
+  const double ell[16] = {1.5, 0, 3, 0, 3, 1, 2, 1, 2, 2, 0, 2, 0, 0, 1.5, 0};
+  const double kl[10] = {0, 0, 1.5, 2.5, 3.5, 4.5, 6.5, 8.5, 10, 10};
+  const double *pts[3] = {pent, sq, ell}, *kns[3] = {kp, ksq, kl};
+  const size_t ns[3] = {6, 5, 8};
+  for (int k = 0; k < 3; k++) {
+    km_curve c;
+    make_curve(&c, 1, ns[k], kns[k], pts[k], NULL, true);
+    km_signature sig;
+    sign(&c, 0, &sig);
+    for (size_t i = 0; i < sig.kappa.n; i++) {
+      if (sig.kappa.coef[i] != 0.0)
+        print_error("polygon %d: kappa coefficient %zu is %.3g\n", k, i,
+                    sig.kappa.coef[i]);
+      assert_true(sig.kappa.coef[i] == 0.0);
+    }
+    assert_close(sig.turning, 2 * M_PI, 1e-12);
+    km_signature_free(&sig);
+    km_curve_free(&c);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(circle_has_constant_curvature_one_over_r),
       cmocka_unit_test(clockwise_circle_has_curvature_minus_one_over_r),
       cmocka_unit_test(square_has_zero_curvature_and_four_right_corners),
+      cmocka_unit_test(polygon_edges_have_exactly_zero_curvature),
       cmocka_unit_test(clockwise_square_has_four_negative_corners),
       cmocka_unit_test(
           cubic_square_and_star_from_fixtures_have_polygon_corners),
