@@ -766,16 +766,21 @@ static void proportional_matches_on_a_closed_pair_give_the_global_morph(void **s
 
 /* ---- the shape pairs of shapes.json --------------------------------------- */
 
+/* Pair p of shapes.json as curves a, b, morphed with the default options. */
+static km_morph *default_pair_morph(int p, km_curve *a, km_curve *b) {
+  shape_curve(PAIRS[p], 'a', a);
+  shape_curve(PAIRS[p], 'b', b);
+  km_morph_input A = {a, NULL}, B = {b, NULL};
+  km_morph_options o;
+  km_morph_options_default(&o);
+  return morph_new(&A, &B, &o);
+}
+
 static void fixture_pairs_end_frames_length_and_closure(void **state) {
   (void)state;
   for (int p = 0; p < 6; p++) {
     km_curve a, b;
-    shape_curve(PAIRS[p], 'a', &a);
-    shape_curve(PAIRS[p], 'b', &b);
-    km_morph_input A = {&a, NULL}, B = {&b, NULL};
-    km_morph_options o;
-    km_morph_options_default(&o);
-    km_morph *m = morph_new(&A, &B, &o);
+    km_morph *m = default_pair_morph(p, &a, &b);
     double La = km_curve_length(&a), Lb = km_curve_length(&b);
     double tol = 1e-5 * fmax(La, Lb);
     const double ts[5] = {0.0, 0.3, 0.5, 0.8, 1.0};
@@ -812,12 +817,7 @@ static void frames_move_smoothly_through_the_middle(void **state) {
   (void)state;
   for (int p = 0; p < 6; p++) {
     km_curve a, b;
-    shape_curve(PAIRS[p], 'a', &a);
-    shape_curve(PAIRS[p], 'b', &b);
-    km_morph_input A = {&a, NULL}, B = {&b, NULL};
-    km_morph_options o;
-    km_morph_options_default(&o);
-    km_morph *m = morph_new(&A, &B, &o);
+    km_morph *m = default_pair_morph(p, &a, &b);
     double La = km_curve_length(&a), Lb = km_curve_length(&b);
     double tol = 1e-5 * fmax(La, Lb), L = fmax(La, Lb);
     const double delta = 1e-3;
@@ -1000,12 +1000,7 @@ static void planned_default_frames_of_the_fixture_pairs(void **state) {
   long failures = 0;
   for (int p = 0; p < 6; p++) {
     km_curve a, b;
-    shape_curve(PAIRS[p], 'a', &a);
-    shape_curve(PAIRS[p], 'b', &b);
-    km_morph_input A = {&a, NULL}, B = {&b, NULL};
-    km_morph_options o;
-    km_morph_options_default(&o);
-    km_morph *m = morph_new(&A, &B, &o);
+    km_morph *m = default_pair_morph(p, &a, &b);
     double len[2], turning[2];
     km_morph_inputs(m, len, turning);
     double tol = 1e-5 * fmax(len[0], len[1]);
