@@ -5,7 +5,7 @@
 CC      ?= gcc
 BUILD   ?= build
 SAN     ?=
-OPT     ?= -O2
+OPT     ?= -O3
 CSTD    := -std=c11
 WARN    := -Wall -Wextra -Werror -Wshadow -Wpointer-arith -Wstrict-prototypes
 CFLAGS_BASE := $(CSTD) $(OPT) -g $(WARN) -D_POSIX_C_SOURCE=200809L -fno-common
@@ -127,7 +127,7 @@ test: deps
 	@rm -f build/test-results.txt
 	@$(MAKE) --no-print-directory build check-layers
 	@$(MAKE) --no-print-directory CC=clang BUILD=build/clang build >/dev/null
-	@echo "== unit and contract-layer tests (gcc -O2)"
+	@echo "== unit and contract-layer tests (gcc -O3)"
 	@$(MAKE) --no-print-directory test-unit
 	@echo "== the same under AddressSanitizer + UndefinedBehaviorSanitizer"
 	@$(MAKE) --no-print-directory BUILD=build/asan SAN=address OPT=-O1 test-unit

@@ -72,7 +72,7 @@ bool api__member_int(api_ctx *ctx, const cJSON *obj, const char *base,
                      long *out, bool *present) {
   const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
   char p[API_POINTER_MAX];
-  double d;
+  double d = 0.0; /* set by api__num; -O3 cannot see it */
   if (present != NULL)
     *present = v != NULL;
   if (v == NULL)
