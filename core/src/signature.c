@@ -725,18 +725,27 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
      * piece, whose end value absorbs it, so a smooth curve reports no
      * corner - but absorbing tilts the neighbour's theta by up to |turn|
      * over its length, so only where that stays far inside the tolerance;
-     * otherwise the turn is a (tiny) corner, which is exact. */
+     * otherwise the turn is a (tiny) corner, which is exact.
+     * A turn already handed on (pending_start, the end value of the last
+     * piece) is in the next piece's rise from there to its own end: a
+     * later turn absorbed by the last piece or made a corner moves the
+     * value the next piece starts from with it, or it would be counted
+     * twice - once there and once in that rise (a hairpin at 1e6 whose
+     * tip is rounding noise turned 7.4e-4 rad too far, 1.5e-3 off at the
+     * end at a tolerance of 1e-3). */
     double tol = 4.0 * b->tol_theta * b->L;
     double prev_end = b->m > 0 ? b->s[b->m] : -1.0;
     double prev_h = b->m > 0 ? b->s[b->m] - b->s[b->m - 1] : INFINITY;
     if (fabs(turn) < 1e-3 && b->m > b->span_first && prev_end == *s_at &&
         fabs(turn) * prev_h <= 0.05 * tol) {
       b->th[(b->m - 1) * (THETA_DEGREE + 1) + THETA_DEGREE] += turn;
+      if (!isnan(b->pending_start)) b->pending_start += turn;
     } else if (fabs(turn) * (b->L - *s_at) <= 0.05 * tol) {
       if (isnan(b->pending_start)) b->pending_start = th[0];
     } else if (fabs(turn) > CORNER_NOISE) {
       km_status st = push_corner(b, *s_at, km__wrap_angle(turn), mid);
       if (st) return st;
+      if (!isnan(b->pending_start)) b->pending_start += km__wrap_angle(turn);
     } else if (isnan(b->pending_start)) {
       b->pending_start = th[0];
     }
