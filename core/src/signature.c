@@ -399,7 +399,8 @@ static double counted_rec(counted_span *cs, double a, double b, double whole,
   double m = 0.5 * (a + b), nl, nr;
   double l = counted_gl16(cs, a, m, &nl), r = counted_gl16(cs, m, b, &nr);
   double sum = l + r;
-  double rounding = fmax(64 * DBL_EPSILON * fabs(sum), fmax(whole_noise, nl + nr));
+  double rounding =
+      fmax(64 * DBL_EPSILON * fabs(sum), fmax(whole_noise, nl + nr));
   if (fabs(sum - whole) <= fmax(abs_tol, rounding) ||
       b - a <= 1024 * DBL_EPSILON * fmax(fabs(a), fabs(b)))
     return sum;
