@@ -959,6 +959,80 @@ static void polygon_edges_have_exactly_zero_curvature(void **state) {
   }
 }
 
+static void rational_span_leaving_a_degenerate_leg_has_its_exact_length(
+    void **state) {
+  (void)state;
+  /* A rational Bezier of degree 9 on the segment from (1e6, 1e6) to
+   * (1e6 + 1, 1e6 + 0.5), its first point doubled (a degenerate leg) and
+   * its weights jumping from 0.1 to 100 there: the curve leaves its start
+   * within about 1e-4 of the parameter, where its speed is rounding noise
+   * at 1e6, then runs on. Collinear points in order with positive weights
+   * trace the segment once (variation diminishing), so the length is
+   * sqrt(1.25) and the signature ends at the last point; the 16-point rule
+   * and its halves both stepped over that start and measured the span
+   * 6.6e-6 too long at a tolerance of 1e-6. */
+  const double xs[10] = {0, 0, 0.05, 0.15, 0.3, 0.45, 0.6, 0.75, 0.9, 1};
+  const double w[10] = {0.1, 100, 30, 10, 3, 1, 1, 1, 1, 1};
+  double kn[20], cp[20];
+  for (int i = 0; i < 10; i++) {
+    kn[i] = 0;
+    kn[i + 10] = 1;
+    cp[2 * i] = 1e6 + xs[i];
+    cp[2 * i + 1] = 1e6 + 0.5 * xs[i];
+  }
+  km_curve c;
+  make_curve(&c, 9, 10, kn, cp, w, false);
+  const double tol = 1e-6;
+  km_signature sig;
+  sign_abs(&c, tol, &sig);
+  assert_close(sig.length, sqrt(1.25), tol);
+  double end[2];
+  signature_end(&sig, end);
+  assert_close(end[0], 1e6 + 1, tol);
+  assert_close(end[1], 1e6 + 0.5, tol);
+  km_signature_free(&sig);
+  km_curve_free(&c);
+}
+
+static void hairpin_whose_tip_is_rounding_turns_only_once(void **state) {
+  (void)state;
+  /* A closed rational wave of degree 7 at (1e6, 1e6): 47 points from x =
+   * -1 to 1, y = 1e-4 sin(34 pi x), then back to the first, weights over
+   * four decades. Where it turns back its tip is a few ulps of 1e6 long,
+   * traced in pieces of zero length whose turns are handed on or absorbed
+   * by their neighbours; a turn absorbed after another was handed on was
+   * counted twice (7.4e-4 rad) and the signature ended 1.5e-3 from its
+   * start at a tolerance of 1e-3. A closed curve's signature ends where
+   * the curve starts. */
+  enum { N = 48, P = 7 };
+  static const int wexp[N] = {0, 7, 7, 2, 3, 6, 2, 4, 4, 5, 5, 5, 5, 5, 5, 5,
+                              5, 5, 5, 5, 2, 2, 5, 5, 3, 3, 4, 3, 7, 3, 3, 3,
+                              3, 1, 0, 0, 0, 6, 3, 3, 3, 3, 3, 3, 3, 0, 8, 0};
+  double cp[2 * N], w[N], kn[N + P + 1];
+  for (int i = 0; i < N; i++) {
+    double x = (double)i / (N - 1);
+    cp[2 * i] = 1e6 + (2 * x - 1);
+    cp[2 * i + 1] = 1e6 + 1e-4 * sin(2 * M_PI * 17 * x);
+    w[i] = pow(10.0, (wexp[i] - 4) / 2.0);
+  }
+  cp[2 * (N - 1)] = cp[0];
+  cp[2 * (N - 1) + 1] = cp[1];
+  for (int i = 0; i < N + P + 1; i++)
+    kn[i] = i <= P ? 0 : i >= N ? N - P : i - P;
+  km_curve c;
+  make_curve(&c, P, N, kn, cp, w, true);
+  const double tol = 1e-3;
+  km_signature sig;
+  sign_abs(&c, tol, &sig);
+  double turns = sig.turning / (2 * M_PI);
+  assert_close(turns, nearbyint(turns), 1e-9);
+  double end[2];
+  signature_end(&sig, end);
+  assert_true(hypot(end[0] - cp[0], end[1] - cp[1]) <= tol);
+  km_signature_free(&sig);
+  km_curve_free(&c);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(circle_has_constant_curvature_one_over_r),
@@ -985,6 +1059,9 @@ int main(void) {
       cmocka_unit_test(curve_far_from_the_origin_keeps_to_its_rounding),
       cmocka_unit_test(spans_below_their_rounding_are_traced_or_refused),
       cmocka_unit_test(closed_curve_ending_below_resolution_turns_whole_turns),
+      cmocka_unit_test(
+          rational_span_leaving_a_degenerate_leg_has_its_exact_length),
+      cmocka_unit_test(hairpin_whose_tip_is_rounding_turns_only_once),
   };
   return cmocka_run_group_tests_name("signature", tests, NULL, NULL);
 }
