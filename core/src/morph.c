@@ -753,8 +753,11 @@ static km_status plan_frames(km_morph *m, km_error *err) {
   const km_pp tp[2] = {a->theta, b->theta};
   double len[2] = {a->sig.length, b->sig.length};
   double ang[2] = {a->sig.angle, b->sig.angle};
-  /* a planned frame has two control points a piece (a corner one more) */
-  size_t max_pieces = m->opt.max_points / 2;
+  /* a planned frame has two control points a piece and two more (a corner
+   * one more); 0 is no bound, so a bound below a piece's worth is one */
+  size_t max_pieces = 0;
+  if (m->opt.max_points > 0)
+    max_pieces = m->opt.max_points >= 4 ? (m->opt.max_points - 2) / 2 : 1;
   km_status st = km__frame_plan_build(&m->plan, tp, len, ang, m->closed,
                                       m->tol, max_pieces, err);
   if (st == KM_ELIMIT && max_pieces > 0)
