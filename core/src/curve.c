@@ -622,12 +622,29 @@ static double span_gl16(span_quad *q, double a, double b, double *noise) {
       sum += km__gl16_w[k] * polynomial_speed_u(sp, m + h * km__gl16_x[k]);
     fmaxn = sp->degree;
   } else {
+    /* Where small and large weights meet, the speed also varies so fast
+     * (by a factor e per 1e-3 of u near the end of a rational cubic at
+     * 1e15 whose end weight is 1e-4 of its neighbour's) that rounding the
+     * nodes to doubles, by eps |u|, moves it by 1e-13 of itself: more than
+     * the points' rounding, and as local. Bisection toward such a point
+     * found halves and whole differing by that at every depth, and the
+     * length of a part of the span came out NaN. The slope comes from
+     * neighbouring nodes. */
+    double v[16], slope = 0.0;
     fmaxn = 0.0;
     for (int k = 0; k < 16; k++) {
       double f;
-      sum += km__gl16_w[k] * rational_speed_u(sp, m + h * km__gl16_x[k], &f);
+      v[k] = rational_speed_u(sp, m + h * km__gl16_x[k], &f);
+      sum += km__gl16_w[k] * v[k];
       fmaxn = fmax(fmaxn, f);
     }
+    for (int k = 1; k < 16; k++)
+      slope = fmax(slope, fabs(v[k] - v[k - 1]) /
+                              (h * (km__gl16_x[k - 1] - km__gl16_x[k])));
+    *noise = (q->unit * fmaxn +
+              slope * DBL_EPSILON * fmax(fabs(a), fabs(b))) *
+             (b - a);
+    return sum * h;
   }
   *noise = q->unit * fmaxn * (b - a);
   return sum * h;
