@@ -716,6 +716,23 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
                       ua);
     ok = fit_theta(th, s, h, tol_here, coef);
   }
+  /* The checks hold theta only near the nodes, which are Chebyshev in t:
+   * where the speed varies by decades over the piece (a rational end
+   * whose weight is small beside its neighbour's, which the curve leaves
+   * in a boundary layer of the parameter) nearly all of the length lies
+   * between two nodes, and the interpolant is free there within the range
+   * of theta. A rational cubic hairpin at 1e15 with weights 0.01 to 100
+   * put nearly all of a 7.5e14 piece past its last interior nodes, and
+   * its theta stayed 8e-6 rad behind the curve's (1.3e-6 asked) over most
+   * of it: the end missed by 3.4e9 at a tolerance of 1e9. Such a piece is
+   * bisected,
+   * which brings its parts to one scale of speed; Chebyshev nodes of a
+   * speed within a factor 4 leave gaps below a fifth of the length. */
+  if (ok && depth < KM_MAX_REFINE_DEPTH && !tiny_t) {
+    double gap = 0.0;
+    for (int k = 1; k < NPTS; k++) gap = fmax(gap, s[k] - s[k - 1]);
+    if (gap > 0.25 * h) ok = false;
+  }
   if (!ok && noise >= 0.1 && big_step < KM_PI - 0.5 &&
       2.0 * h <= b->free_len) {
     /* directions that are noise, on a piece short enough (see free_len) */
