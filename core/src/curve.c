@@ -553,52 +553,160 @@ void km__bspan_eval(const km__bspan *sp, double t, double pos[2],
 
 /* |dC/du|; without weights from the hodograph, p times the Bezier curve of
  * the legs, at a third of the cost of position and derivative */
-static double bspan_speed_u(const void *ctx, double u) {
-  const km__bspan *sp = ctx;
-  double d[2];
-  if (sp->rational) {
-    double pos[2];
-    km__bspan_eval_u(sp, u, pos, d);
-  } else {
-    int p = sp->degree;
-    double v = 1.0 - u, e[KM__BSPAN_MAX][2];
-    for (int j = 0; j < p; j++) {
-      e[j][0] = sp->h[j + 1][0] - sp->h[j][0];
-      e[j][1] = sp->h[j + 1][1] - sp->h[j][1];
-    }
-    for (int r = 1; r < p; r++)
-      for (int j = 0; j < p - r; j++) {
-        e[j][0] = v * e[j][0] + u * e[j + 1][0];
-        e[j][1] = v * e[j][1] + u * e[j + 1][1];
-      }
-    d[0] = p * e[0][0];
-    d[1] = p * e[0][1];
+static double polynomial_speed_u(const km__bspan *sp, double u) {
+  int p = sp->degree;
+  double v = 1.0 - u, e[KM__BSPAN_MAX][2];
+  for (int j = 0; j < p; j++) {
+    e[j][0] = sp->h[j + 1][0] - sp->h[j][0];
+    e[j][1] = sp->h[j + 1][1] - sp->h[j][1];
   }
-  return sqrt(d[0] * d[0] + d[1] * d[1]);
+  for (int r = 1; r < p; r++)
+    for (int j = 0; j < p - r; j++) {
+      e[j][0] = v * e[j][0] + u * e[j + 1][0];
+      e[j][1] = v * e[j][1] + u * e[j + 1][1];
+    }
+  double dx = p * e[0][0], dy = p * e[0][1];
+  return sqrt(dx * dx + dy * dy);
+}
+
+/* |dC/du| of a rational span by km__bspan_eval_u's steps (the same
+ * digits) without the position, and in *f the weight factor p w0 w1 / w^2
+ * of its last step, by which the rounding of the points is multiplied. */
+static double rational_speed_u(const km__bspan *sp, double u, double *f) {
+  int p = sp->degree;
+  double v = 1.0 - u, d[KM__BSPAN_MAX][3];
+  memcpy(d, sp->h, sizeof(double) * 3 * (size_t)(p + 1));
+  for (int r = 1; r < p; r++)
+    for (int j = 0; j <= p - r; j++) {
+      d[j][0] = v * d[j][0] + u * d[j + 1][0];
+      d[j][1] = v * d[j][1] + u * d[j + 1][1];
+      d[j][2] = v * d[j][2] + u * d[j + 1][2];
+    }
+  double w0 = d[0][2], w1 = d[1][2], w = v * w0 + u * w1;
+  *f = p * (w0 / w) * (w1 / w);
+  double dx = *f * (d[1][0] / w1 - d[0][0] / w0);
+  double dy = *f * (d[1][1] / w1 - d[0][1] / w0);
+  return sqrt(dx * dx + dy * dy);
+}
+
+double km__bspan_noise(const km__bspan *sp) {
+  double M = 0.0;
+  for (int q = 0; q <= sp->degree; q++)
+    M = fmax(M, fmax(fabs(sp->h[q][0]), fabs(sp->h[q][1])) /
+                    fmax(sp->h[q][2], 1e-300));
+  return 8.0 * DBL_EPSILON * sp->degree * M;
+}
+
+/* A span's speed is computed from points of magnitude up to M: its
+ * rounding, 8 eps M (unit) times the weight factor f of the last de
+ * Casteljau step (rational_speed_u) - p without weights, but up to p times
+ * the ratio of the extreme weights where a small weight meets a large one.
+ * There f is large only over a stretch of u about as narrow as that ratio
+ * is large (the curve leaves such a point in a boundary layer of the
+ * parameter): the rounding is local, and so is the precision a length can
+ * have. */
+typedef struct span_quad {
+  const km__bspan *sp;
+  double unit;
+  long evals;
+} span_quad;
+
+/* The 16-point rule on [a, b], and in *noise the rounding its sum may
+ * carry: the largest rounding of the speed at its nodes over the width. */
+static double span_gl16(span_quad *q, double a, double b, double *noise) {
+  const km__bspan *sp = q->sp;
+  double m = 0.5 * (a + b), h = 0.5 * (b - a), sum = 0.0, fmaxn;
+  q->evals += 16;
+  if (!sp->rational) {
+    for (int k = 0; k < 16; k++)
+      sum += km__gl16_w[k] * polynomial_speed_u(sp, m + h * km__gl16_x[k]);
+    fmaxn = sp->degree;
+  } else {
+    /* Where small and large weights meet, the speed also varies so fast
+     * (by a factor e per 1e-3 of u near the end of a rational cubic at
+     * 1e15 whose end weight is 1e-4 of its neighbour's) that rounding the
+     * nodes to doubles, by eps |u|, moves it by 1e-13 of itself: more than
+     * the points' rounding, and as local. Bisection toward such a point
+     * found halves and whole differing by that at every depth, and the
+     * length of a part of the span came out NaN. The slope comes from
+     * neighbouring nodes. */
+    double v[16], slope = 0.0;
+    fmaxn = 0.0;
+    for (int k = 0; k < 16; k++) {
+      double f;
+      v[k] = rational_speed_u(sp, m + h * km__gl16_x[k], &f);
+      sum += km__gl16_w[k] * v[k];
+      fmaxn = fmax(fmaxn, f);
+    }
+    for (int k = 1; k < 16; k++)
+      slope = fmax(slope, fabs(v[k] - v[k - 1]) /
+                              (h * (km__gl16_x[k - 1] - km__gl16_x[k])));
+    *noise = (q->unit * fmaxn +
+              slope * DBL_EPSILON * fmax(fabs(a), fabs(b))) *
+             (b - a);
+    return sum * h;
+  }
+  *noise = q->unit * fmaxn * (b - a);
+  return sum * h;
+}
+
+/* Adaptive quadrature as integrate_rec (the 16-point rule on [a, b]
+ * against its halves, bisecting where they differ by more than the
+ * tolerance), except that a difference within the rounding the rules
+ * carry there is accepted: it cannot be refined, and it is local. Asking
+ * the whole span instead for the rounding of its worst point (the ratio
+ * of its extreme weights times the span's noise, wherever the uniform
+ * request fails) lets the first rule through unrefined: both it and its
+ * halves step over a boundary layer narrower than their nodes' spacing (a
+ * degree-9 span at 1e6 whose weights jump from 0.1 to 100 at a
+ * degenerate leg leaves its first point within about 1e-4 in u) and
+ * agreed on a length 9.2e-6 (2e-5 of it) too long at a tolerance of
+ * 1e-6, where the rounding over the span integrates to about 1e-8. */
+static double span_rec(span_quad *q, double a, double b, double whole,
+                       double whole_noise, double abs_tol, int depth,
+                       long *budget) {
+  double m = 0.5 * (a + b), nl, nr;
+  double l = span_gl16(q, a, m, &nl), r = span_gl16(q, m, b, &nr);
+  double sum = l + r;
+  double rounding =
+      fmax(64 * DBL_EPSILON * fabs(sum), fmax(whole_noise, nl + nr));
+  /* nor where [a, b] is so narrow beside its position that the nodes are
+   * rounded by a part in a thousand: halving it only moves them */
+  if (fabs(sum - whole) <= fmax(abs_tol, rounding) ||
+      b - a <= 1024 * DBL_EPSILON * fmax(fabs(a), fabs(b)))
+    return sum;
+  if (depth >= 40 || --*budget <= 0) return NAN; /* not to the precision */
+  return span_rec(q, a, m, l, nl, 0.5 * abs_tol, depth + 1, budget) +
+         span_rec(q, m, b, r, nr, 0.5 * abs_tol, depth + 1, budget);
+}
+
+double km__bspan_length_counted(const km__bspan *sp, double u0, double u1,
+                                double abs_tol, long *evals) {
+  if (!(u1 > u0)) return 0.0;
+  /* Asking for more than the span's rounding (km__bspan_noise) over the
+   * width only refines into noise (a short span far from the origin). A
+   * rational span is granted up to four times that at once where its
+   * weights vary by more than a factor 4 - a few units of the weight
+   * factor over the span - and beyond that only where the rounding is
+   * locally larger (span_rec). */
+  double wmax = 0.0, wmin = INFINITY;
+  for (int k = 0; k <= sp->degree; k++) {
+    wmax = fmax(wmax, sp->h[k][2]);
+    wmin = fmin(wmin, sp->h[k][2]);
+  }
+  double ratio = sp->rational ? wmax / wmin : 1.0;
+  double noise = km__bspan_noise(sp);
+  span_quad q = {sp, noise / sp->degree, 0};
+  double wn, whole = span_gl16(&q, u0, u1, &wn);
+  long budget = 256;
+  double len = span_rec(&q, u0, u1, whole, wn,
+                        fmax(abs_tol, noise * (u1 - u0) * fmin(ratio, 4.0)),
+                        0, &budget);
+  if (evals) *evals += q.evals;
+  return len;
 }
 
 double km__bspan_length(const km__bspan *sp, double u0, double u1,
                         double abs_tol) {
-  /* The speed is computed from points of magnitude up to M: its rounding
-   * error, about 8 p eps M, bounds the precision any length can have (a
-   * short span far from the origin); asking for more only refines into
-   * noise. A rational span's speed carries the weight factor p w0 w1 /
-   * w^2 (km__bspan_eval_u), and its rounding with it: up to the ratio r of
-   * the extreme weights at a point, a few units integrated over the span.
-   * Four times the bound is asked first; where that is still below the
-   * local noise, r times it, the most the noise can be. */
-  double M = 0.0, wmax = 0.0, wmin = INFINITY;
-  for (int k = 0; k <= sp->degree; k++) {
-    M = fmax(M, fmax(fabs(sp->h[k][0]), fabs(sp->h[k][1])) / sp->h[k][2]);
-    wmax = fmax(wmax, sp->h[k][2]);
-    wmin = fmin(wmin, sp->h[k][2]);
-  }
-  double r = sp->rational ? wmax / wmin : 1.0;
-  double noise = 8.0 * DBL_EPSILON * sp->degree * M * (u1 - u0);
-  double len = km__integrate_adaptive(bspan_speed_u, sp, u0, u1,
-                                      fmax(abs_tol, noise * fmin(r, 4.0)));
-  if (isnan(len) && r > 4.0)
-    len = km__integrate_adaptive(bspan_speed_u, sp, u0, u1,
-                                 fmax(abs_tol, noise * r));
-  return len;
+  return km__bspan_length_counted(sp, u0, u1, abs_tol, NULL);
 }

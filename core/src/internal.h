@@ -65,9 +65,19 @@ void km__bspan_eval(const km__bspan *sp, double t, double pos[2],
 /* The same in the span's variable u = (t - a) / (b - a) in [0, 1]. */
 void km__bspan_eval_u(const km__bspan *sp, double u, double pos[2],
                       double der_u[2]);
-/* Arc length between u0 and u1 (adaptive, NaN as km__integrate_adaptive). */
+/* Arc length between u0 and u1 to abs_tol, or to the rounding of the
+ * speed where that is larger (NaN where neither can be reached within a
+ * fixed amount of work, as km__integrate_adaptive); the _counted form adds
+ * the speed evaluations it made to *evals (if not NULL). */
 double km__bspan_length(const km__bspan *sp, double u0, double u1,
                         double abs_tol);
+double km__bspan_length_counted(const km__bspan *sp, double u0, double u1,
+                                double abs_tol, long *evals);
+/* Rounding error of a span's speed |dC/du| without weights, 8 p eps M for
+ * points of magnitude up to M (a rational span's is larger where its
+ * weights vary widely, see km__bspan_length): it bounds the precision of
+ * any length and direction computed there. */
+double km__bspan_noise(const km__bspan *sp);
 
 /* Span index i with knots[i] <= t < knots[i+1] (last non-empty span at the
  * domain end); side < 0 picks knots[i] < t <= knots[i+1]. */

@@ -319,122 +319,6 @@ static bool tangent_limit(const builder *b, double t, int side,
   return true;
 }
 
-/* Rounding error of the speed |dC/du| in a span, about 8 p eps M for
- * points of magnitude up to M (more where a rational span's weights vary
- * widely, see counted_speed): it bounds the precision of any length and
- * direction computed there. */
-static double span_noise(const km__bspan *sp) {
-  double M = 0.0;
-  for (int q = 0; q <= sp->degree; q++)
-    M = fmax(M, fmax(fabs(sp->h[q][0]), fabs(sp->h[q][1])) /
-                    fmax(sp->h[q][2], 1e-300));
-  return 8.0 * DBL_EPSILON * sp->degree * M;
-}
-
-/* The speed in a span's variable u and its rounding error there, counting
- * evaluations: the work budget is spent in evaluations, wherever they are
- * made. A rational span's derivative is p w0 w1 / w^2 (P1 - P0) at the
- * last de Casteljau step (km__bspan_eval_u), so its rounding is that of
- * the points, 8 eps M, times the weight factor f = p w0 w1 / w^2 - which
- * is p without weights, but up to p times the ratio of the extreme
- * weights where a small weight meets a large one. There f is large only
- * over a stretch of u about as narrow as that ratio is large (the curve
- * leaves such a point in a boundary layer of the parameter): the rounding
- * is local, and so is the precision a length can have. */
-typedef struct counted_span {
-  const km__bspan *sp;
-  double unit; /* 8 eps M: the rounding of |dC/du| per unit of f */
-  long evals;
-} counted_span;
-
-static double counted_speed(counted_span *cs, double u, double *noise) {
-  const km__bspan *sp = cs->sp;
-  int p = sp->degree;
-  double pos[2], d[2];
-  cs->evals++;
-  km__bspan_eval_u(sp, u, pos, d);
-  double f = p;
-  if (sp->rational) {
-    /* the weights alone through the same de Casteljau steps */
-    double v = 1.0 - u, wt[KM__BSPAN_MAX];
-    for (int j = 0; j <= p; j++) wt[j] = sp->h[j][2];
-    for (int r = 1; r < p; r++)
-      for (int j = 0; j <= p - r; j++) wt[j] = v * wt[j] + u * wt[j + 1];
-    double w = v * wt[0] + u * wt[1];
-    f = p * (wt[0] / w) * (wt[1] / w);
-  }
-  *noise = cs->unit * f;
-  return sqrt(d[0] * d[0] + d[1] * d[1]);
-}
-
-/* The 16-point rule on [a, b], and in *noise the rounding its sum may
- * carry: the largest rounding of the speed at its nodes over the width. */
-static double counted_gl16(counted_span *cs, double a, double b,
-                           double *noise) {
-  double m = 0.5 * (a + b), h = 0.5 * (b - a), sum = 0.0, worst = 0.0;
-  for (int k = 0; k < 16; k++) {
-    double e;
-    sum += km__gl16_w[k] * counted_speed(cs, m + h * km__gl16_x[k], &e);
-    worst = fmax(worst, e);
-  }
-  *noise = worst * (b - a);
-  return sum * h;
-}
-
-/* Adaptive quadrature as km__integrate_adaptive (the 16-point rule on
- * [a, b] against its halves, bisecting where they differ by more than the
- * tolerance), except that a difference within the rounding the rules
- * carry there is accepted: it cannot be refined, and it is local. Asking
- * the whole span instead for the rounding of its worst point (the ratio
- * of its extreme weights times span_noise, wherever the uniform request
- * fails) lets the first rule through unrefined: both it and its halves
- * step over a boundary layer narrower than their nodes' spacing (a
- * degree-9 span at 1e6 whose weights jump from 0.1 to 100 at a
- * degenerate leg leaves its first point within about 1e-4 in u) and
- * agreed on a length 9.2e-6 (2e-5 of it) too long at a tolerance of
- * 1e-6, where the rounding over the span integrates to about 1e-8. */
-static double counted_rec(counted_span *cs, double a, double b, double whole,
-                          double whole_noise, double abs_tol, int depth,
-                          long *budget) {
-  double m = 0.5 * (a + b), nl, nr;
-  double l = counted_gl16(cs, a, m, &nl), r = counted_gl16(cs, m, b, &nr);
-  double sum = l + r;
-  double rounding =
-      fmax(64 * DBL_EPSILON * fabs(sum), fmax(whole_noise, nl + nr));
-  if (fabs(sum - whole) <= fmax(abs_tol, rounding) ||
-      b - a <= 1024 * DBL_EPSILON * fmax(fabs(a), fabs(b)))
-    return sum;
-  if (depth >= 40 || --*budget <= 0) return NAN; /* not to the precision */
-  return counted_rec(cs, a, m, l, nl, 0.5 * abs_tol, depth + 1, budget) +
-         counted_rec(cs, m, b, r, nr, 0.5 * abs_tol, depth + 1, budget);
-}
-
-/* Arc length of sp over [u0, u1] to abs_tol or to its rounding: the
- * rounding of the span's speed (span_noise) over the width, up to four
- * times that where the weights vary by more than a factor 4 (as
- * km__bspan_length), and beyond that only where the rounding is locally
- * larger (counted_rec); the evaluations are counted into *evals. NaN where
- * even that cannot be reached. */
-static double counted_length(const km__bspan *sp, double u0, double u1,
-                             double abs_tol, long *evals) {
-  if (!(u1 > u0)) return 0.0;
-  double wmax = 0.0, wmin = INFINITY;
-  for (int q = 0; q <= sp->degree; q++) {
-    wmax = fmax(wmax, sp->h[q][2]);
-    wmin = fmin(wmin, sp->h[q][2]);
-  }
-  double r = sp->rational ? wmax / wmin : 1.0;
-  double noise = span_noise(sp);
-  counted_span cs = {sp, noise / sp->degree, 0};
-  double wn, whole = counted_gl16(&cs, u0, u1, &wn);
-  long budget = 256;
-  double len = counted_rec(&cs, u0, u1, whole, wn,
-                           fmax(abs_tol, noise * (u1 - u0) * fmin(r, 4.0)), 0,
-                           &budget);
-  *evals += cs.evals;
-  return len;
-}
-
 /* Arc length of a span over [u0, u1] of its variable by the 16-point
  * Gauss-Legendre rule: exact to rounding where the speed is smooth, which
  * is checked (fit_piece) before it is used as the length. */
@@ -455,8 +339,9 @@ static double span_length(builder *b, double ua, double ub) {
    * positions need their own digits */
   double a = b->span.a, w = b->span.b - a;
   long evals = 0;
-  double len = counted_length(&b->span, (ua - a) / w, (ub - a) / w,
-                              1e-14 * (ub - ua) * b->span_speed, &evals);
+  double len =
+      km__bspan_length_counted(&b->span, (ua - a) / w, (ub - a) / w,
+                               1e-14 * (ub - ua) * b->span_speed, &evals);
   b->work -= evals;
   b->span_work -= evals;
   return len;
@@ -831,6 +716,23 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
                       ua);
     ok = fit_theta(th, s, h, tol_here, coef);
   }
+  /* The checks hold theta only near the nodes, which are Chebyshev in t:
+   * where the speed varies by decades over the piece (a rational end
+   * whose weight is small beside its neighbour's, which the curve leaves
+   * in a boundary layer of the parameter) nearly all of the length lies
+   * between two nodes, and the interpolant is free there within the range
+   * of theta. A rational cubic hairpin at 1e15 with weights 0.01 to 100
+   * put nearly all of a 7.5e14 piece past its last interior nodes, and
+   * its theta stayed 8e-6 rad behind the curve's (1.3e-6 asked) over most
+   * of it: the end missed by 3.4e9 at a tolerance of 1e9. Such a piece is
+   * bisected,
+   * which brings its parts to one scale of speed; Chebyshev nodes of a
+   * speed within a factor 4 leave gaps below a fifth of the length. */
+  if (ok && depth < KM_MAX_REFINE_DEPTH && !tiny_t) {
+    double gap = 0.0;
+    for (int k = 1; k < NPTS; k++) gap = fmax(gap, s[k] - s[k - 1]);
+    if (gap > 0.25 * h) ok = false;
+  }
   if (!ok && noise >= 0.1 && big_step < KM_PI - 0.5 &&
       2.0 * h <= b->free_len) {
     /* directions that are noise, on a piece short enough (see free_len) */
@@ -927,8 +829,9 @@ km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
       long evals = 0;
       double est = gl16_length(&sp, 0.0, 1.0);
       b.work -= 16;
-      if (!(est > 1e-9 * poly) || !(est > 1e6 * span_noise(&sp)))
-        est = counted_length(&sp, 0.0, 1.0, 1e-15 * poly, &evals);
+      if (!(est > 1e-9 * poly) || !(est > 1e6 * km__bspan_noise(&sp)))
+        est = km__bspan_length_counted(&sp, 0.0, 1.0, 1e-15 * poly,
+                                       &evals);
       span_len[i] = est;
       b.work -= evals;
     }
@@ -1002,7 +905,7 @@ km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
      * again), so together they may cost a quarter of the tolerance;
      * past that the spans are a real curve whose shape its coordinates
      * do not carry, refused rather than taken for a point. */
-    double noise = span_noise(&b.span);
+    double noise = km__bspan_noise(&b.span);
     if (!(len > noise)) {
       if (2.0 * len <= point_len) {
         point_len -= 2.0 * len;

@@ -1033,6 +1033,34 @@ static void hairpin_whose_tip_is_rounding_turns_only_once(void **state) {
   km_curve_free(&c);
 }
 
+static void rational_end_in_a_boundary_layer_keeps_its_turn(void **state) {
+  (void)state;
+  /* A rational cubic at 1e15 whose end weight is 1e-4 of its neighbour's
+   * (weights 100, 0.01, 100, 0.01): the curve runs from P0 to near P2 and
+   * leaves for P3 in a boundary layer of the parameter at t = 1, where
+   * 99.9% of its length lies in the last 3% of t. A clamped rational
+   * Bezier ends at its last control point, so the signature must end
+   * there within the tolerance. The turn of 9e-6 rad just before the
+   * layer fell between two Chebyshev nodes of a piece holding that length
+   * (theta free there within its range), 8e-6 rad behind the curve: the
+   * end was 3.4e9 off at a tolerance of 1e9. */
+  const double kn[8] = {0, 0, 0, 0, 1, 1, 1, 1};
+  const double cp[8] = {0, -89407186999313.359, 500000000000000,
+                        -89407186999313.359, 10000, -89407086999313.344,
+                        750000000000000, -92669565880827.047};
+  const double w[4] = {100, 0.01, 100, 0.01};
+  km_curve c;
+  make_curve(&c, 3, 4, kn, cp, w, false);
+  const double tol = 1e9;
+  km_signature sig;
+  sign_abs(&c, tol, &sig);
+  double end[2];
+  signature_end(&sig, end);
+  assert_true(hypot(end[0] - cp[6], end[1] - cp[7]) <= tol);
+  km_signature_free(&sig);
+  km_curve_free(&c);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(circle_has_constant_curvature_one_over_r),
@@ -1061,6 +1089,7 @@ int main(void) {
       cmocka_unit_test(closed_curve_ending_below_resolution_turns_whole_turns),
       cmocka_unit_test(
           rational_span_leaving_a_degenerate_leg_has_its_exact_length),
+      cmocka_unit_test(rational_end_in_a_boundary_layer_keeps_its_turn),
       cmocka_unit_test(hairpin_whose_tip_is_rounding_turns_only_once),
   };
   return cmocka_run_group_tests_name("signature", tests, NULL, NULL);
