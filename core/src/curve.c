@@ -473,6 +473,21 @@ void km__bspan_make(km__bspan *sp, const km_curve *c, size_t i) {
   }
 }
 
+/* de Casteljau on the homogeneous points of a rational span down to the
+ * last step's two points, d[0] and d[1] (x w, y w, w) */
+static void homogeneous_to_last_step(const km__bspan *sp, double u,
+                                     double d[][3]) {
+  int p = sp->degree;
+  double v = 1.0 - u;
+  memcpy(d, sp->h, sizeof(double) * 3 * (size_t)(p + 1));
+  for (int r = 1; r < p; r++)
+    for (int j = 0; j <= p - r; j++) {
+      d[j][0] = v * d[j][0] + u * d[j + 1][0];
+      d[j][1] = v * d[j][1] + u * d[j + 1][1];
+      d[j][2] = v * d[j][2] + u * d[j + 1][2];
+    }
+}
+
 void km__bspan_eval_u(const km__bspan *sp, double u, double pos[2],
                       double der_u[2]) {
   int p = sp->degree;
@@ -524,13 +539,7 @@ void km__bspan_eval_u(const km__bspan *sp, double u, double pos[2],
     return;
   }
   double d[KM__BSPAN_MAX][3];
-  memcpy(d, sp->h, sizeof(double) * 3 * (size_t)(p + 1));
-  for (int r = 1; r < p; r++)
-    for (int j = 0; j <= p - r; j++) {
-      d[j][0] = v * d[j][0] + u * d[j + 1][0];
-      d[j][1] = v * d[j][1] + u * d[j + 1][1];
-      d[j][2] = v * d[j][2] + u * d[j + 1][2];
-    }
+  homogeneous_to_last_step(sp, u, d);
   /* The last step joins two points P0, P1 of weights w0, w1: C = (v w0 P0
    * + u w1 P1) / w and C' = p w0 w1 / w^2 (P1 - P0), with w = v w0 + u w1.
    * Unlike the quotient rule (H' - C w') / w, no large terms cancel, so
@@ -575,13 +584,7 @@ static double polynomial_speed_u(const km__bspan *sp, double u) {
 static double rational_speed_u(const km__bspan *sp, double u, double *f) {
   int p = sp->degree;
   double v = 1.0 - u, d[KM__BSPAN_MAX][3];
-  memcpy(d, sp->h, sizeof(double) * 3 * (size_t)(p + 1));
-  for (int r = 1; r < p; r++)
-    for (int j = 0; j <= p - r; j++) {
-      d[j][0] = v * d[j][0] + u * d[j + 1][0];
-      d[j][1] = v * d[j][1] + u * d[j + 1][1];
-      d[j][2] = v * d[j][2] + u * d[j + 1][2];
-    }
+  homogeneous_to_last_step(sp, u, d);
   double w0 = d[0][2], w1 = d[1][2], w = v * w0 + u * w1;
   *f = p * (w0 / w) * (w1 / w);
   double dx = *f * (d[1][0] / w1 - d[0][0] / w0);

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "km/curve.h"
+#include "curvecases.h"
 #include "testutil.h"
 
 /* Build a curve that must be valid. */
@@ -445,27 +446,9 @@ static void length_of_a_point_curve_is_zero(void **state) {
 static void rational_segment_leaving_a_degenerate_leg_has_its_length(
     void **state) {
   (void)state;
-  /* A rational Bezier of degree 9 on the segment from (1e6, 1e6) to
-   * (1e6 + 1, 1e6 + 0.5), its first point doubled (a degenerate leg) and
-   * its weights jumping from 0.1 to 100 there: the curve leaves its start
-   * within about 1e-4 of the parameter, where its speed is rounding noise
-   * at 1e6, then runs on. Collinear points in order with positive weights
-   * trace the segment once (variation diminishing), so the length is
-   * sqrt(1.25) and the point at half of it is the segment's middle. The
-   * 16-point rule and its halves both stepped over that start and agreed
-   * on a length 9.2e-6 too long; the rounding of the speed there, 8 p ulps
-   * of 1e6 times the weights' factor, integrates to about 1e-8. */
-  const double xs[10] = {0, 0, 0.05, 0.15, 0.3, 0.45, 0.6, 0.75, 0.9, 1};
-  const double w[10] = {0.1, 100, 30, 10, 3, 1, 1, 1, 1, 1};
-  double kn[20], cp[20];
-  for (int i = 0; i < 10; i++) {
-    kn[i] = 0;
-    kn[i + 10] = 1;
-    cp[2 * i] = 1e6 + xs[i];
-    cp[2 * i + 1] = 1e6 + 0.5 * xs[i];
-  }
+  /* the segment of curvecases.h */
   km_curve c;
-  make_curve(&c, 9, 10, kn, cp, w, false);
+  tc_rational_segment_leaving_a_degenerate_leg(&c);
   const double L = sqrt(1.25), tol = 1e-7;
   assert_close(km_curve_length(&c), L, tol);
   double t = km_curve_param_at_length(&c, 0.5 * L), d[1][2];

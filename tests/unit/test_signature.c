@@ -14,6 +14,7 @@
 #include "km/curve.h"
 #include "km/reconstruct.h"
 #include "km/signature.h"
+#include "curvecases.h"
 #include "testutil.h"
 
 static void make_curve(km_curve *c, int p, size_t n, const double *knots,
@@ -962,26 +963,9 @@ static void polygon_edges_have_exactly_zero_curvature(void **state) {
 static void rational_span_leaving_a_degenerate_leg_has_its_exact_length(
     void **state) {
   (void)state;
-  /* A rational Bezier of degree 9 on the segment from (1e6, 1e6) to
-   * (1e6 + 1, 1e6 + 0.5), its first point doubled (a degenerate leg) and
-   * its weights jumping from 0.1 to 100 there: the curve leaves its start
-   * within about 1e-4 of the parameter, where its speed is rounding noise
-   * at 1e6, then runs on. Collinear points in order with positive weights
-   * trace the segment once (variation diminishing), so the length is
-   * sqrt(1.25) and the signature ends at the last point; the 16-point rule
-   * and its halves both stepped over that start and measured the span
-   * 6.6e-6 too long at a tolerance of 1e-6. */
-  const double xs[10] = {0, 0, 0.05, 0.15, 0.3, 0.45, 0.6, 0.75, 0.9, 1};
-  const double w[10] = {0.1, 100, 30, 10, 3, 1, 1, 1, 1, 1};
-  double kn[20], cp[20];
-  for (int i = 0; i < 10; i++) {
-    kn[i] = 0;
-    kn[i + 10] = 1;
-    cp[2 * i] = 1e6 + xs[i];
-    cp[2 * i + 1] = 1e6 + 0.5 * xs[i];
-  }
+  /* the segment of curvecases.h */
   km_curve c;
-  make_curve(&c, 9, 10, kn, cp, w, false);
+  tc_rational_segment_leaving_a_degenerate_leg(&c);
   const double tol = 1e-6;
   km_signature sig;
   sign_abs(&c, tol, &sig);
