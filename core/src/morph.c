@@ -95,8 +95,9 @@ struct km_morph {
   bool close_by_corners; /* lsq closure by the frames' corners */
   double kmax;           /* the inputs' largest |kappa|: the frames' bound */
   /* placement targets of planned frames: the inputs' points at the plan's
-   * breaks (x, y of a, then of b), their weights, and weighted means */
-  double (*place_ab)[4];
+   * breaks (x, y of a, then of b) and the break's trapezoid weight; the
+   * weights' sum and the weighted means */
+  double (*place_ab)[5];
   double place_w_sum, place_qa[2], place_qb[2];
 };
 
@@ -692,6 +693,7 @@ static km_status plan_placement(km_morph *m, km_error *err) {
   double W = 0.0, qa[2] = {0, 0}, qb[2] = {0, 0};
   for (size_t k = 0; k < nb; k++) {
     double w = 0.5 * ((k + 1 < nb ? x[k + 1] : x[k]) - (k > 0 ? x[k - 1] : x[k]));
+    m->place_ab[k][4] = w;
     table_at(&m->in[0], x[k], m->place_ab[k]);
     table_at(&m->in[1], x[k], m->place_ab[k] + 2);
     for (int c = 0; c < 2; c++) {
@@ -1889,10 +1891,9 @@ static void planned_placement(const km_morph *m, double t, const double (*F)[2],
   T[0] = (1 - t) * a->sig.start[0] + t * b->sig.start[0];
   T[1] = (1 - t) * a->sig.start[1] + t * b->sig.start[1];
   if (t == 0.0 || t == 1.0 || m->opt.anchor == KM_ANCHOR_START) return;
-  const double *x = km__frame_plan_breaks(m->plan);
   double fc[2] = {0, 0};
   for (size_t k = 0; k < nb; k++) {
-    double w = 0.5 * ((k + 1 < nb ? x[k + 1] : x[k]) - (k > 0 ? x[k - 1] : x[k]));
+    double w = m->place_ab[k][4];
     fc[0] += w * F[k][0];
     fc[1] += w * F[k][1];
   }
@@ -1906,9 +1907,8 @@ static void planned_placement(const km_morph *m, double t, const double (*F)[2],
   /* sum w (F - fc) . (Q - qc) = sum w (F - fc) . Q, as sum w (F - fc) = 0 */
   double sa = 0.0, ca = 0.0, sb = 0.0, cb = 0.0;
   for (size_t k = 0; k < nb; k++) {
-    double w = 0.5 * ((k + 1 < nb ? x[k + 1] : x[k]) - (k > 0 ? x[k - 1] : x[k]));
-    double fx = w * (F[k][0] - fc[0]), fy = w * (F[k][1] - fc[1]);
     const double *q = m->place_ab[k];
+    double fx = q[4] * (F[k][0] - fc[0]), fy = q[4] * (F[k][1] - fc[1]);
     sa += fx * q[0] + fy * q[1];
     ca += fx * q[1] - fy * q[0];
     sb += fx * q[2] + fy * q[3];
