@@ -513,6 +513,55 @@ static bool fit_theta(const double *th, const double *s, double h,
  * until the check points agree. *s_at is the arc length at ua on entry
  * and at ub on exit; *theta is the unwrapped angle at ua on entry (whose
  * direction is dir_a) and at ub on exit (direction dir_b). */
+/* A turn at arc length s that no piece carries: at a knot, or one
+ * concentrated in a length below resolution beside a degenerate end;
+ * theta_before is theta just before it. A small turn is handed to a
+ * neighbouring piece, so a smooth curve reports no corner: the last
+ * piece, if it ends here with no corner between, takes it in its end
+ * value (tilting its theta by up to |turn| over its length), or else the
+ * next piece starts from theta_before and rises through it (over at most
+ * the rest of the curve). Either only where the tilt stays within a
+ * twentieth of the tolerance in position; otherwise the turn is a corner,
+ * which is exact however small - a turn of 4.2e-12 rad at a knot of a
+ * degree-9 curve, dropped as rounding, left its end 1.5e-12 of the length
+ * off at a tolerance of 1e-13 of it.
+ * At a knot (knot_corner) a turn above rounding is always a corner: a
+ * break of the tangent between spans is the curve's shape, however slight.
+ * A turn already handed on (pending_start, the end value of the last
+ * piece) is in the next piece's rise from there to its own end: a later
+ * turn absorbed by the last piece or made a corner moves the value the
+ * next piece starts from with it, or it would be counted twice - once
+ * there and once in that rise (a hairpin at 1e6 whose tip is rounding
+ * noise turned 7.4e-4 rad too far, 1.5e-3 off at the end at a tolerance
+ * of 1e-3). */
+static km_status take_turn(builder *b, double turn, double s,
+                           double theta_before, double t, bool knot_corner) {
+  double tol = 4.0 * b->tol_theta * b->L;
+  double prev_end = b->m > 0 ? b->s[b->m] : -1.0;
+  double prev_h = b->m > 0 ? b->s[b->m] - b->s[b->m - 1] : INFINITY;
+  /* inside a span its pieces follow one another; across a knot the last
+   * piece is the previous span's, whose end may carry a corner already */
+  bool last_adjoins =
+      prev_end == s &&
+      (knot_corner ? b->ncorners == 0 || b->corners[b->ncorners - 1].s < s
+                   : b->m > b->span_first);
+  bool small = knot_corner ? fabs(turn) <= CORNER_NOISE : fabs(turn) < 1e-3;
+  if (small && last_adjoins && fabs(turn) * prev_h <= 0.05 * tol) {
+    b->th[(b->m - 1) * (THETA_DEGREE + 1) + THETA_DEGREE] += turn;
+    if (!isnan(b->pending_start)) b->pending_start += turn;
+    return KM_OK;
+  }
+  if ((small || !knot_corner) && fabs(turn) * (b->L - s) <= 0.05 * tol) {
+    if (isnan(b->pending_start)) b->pending_start = theta_before;
+    return KM_OK;
+  }
+  turn = km__wrap_angle(turn);
+  km_status st = push_corner(b, s, turn, t);
+  if (st) return st;
+  if (!isnan(b->pending_start)) b->pending_start += turn;
+  return KM_OK;
+}
+
 static km_status fit_piece(builder *b, double ua, double ub, double known_len,
                            double *s_at, double *theta, const double dir_a[2],
                            const double dir_b[2], int depth) {
@@ -661,34 +710,9 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
                       mid);
     /* Bisection toward a degenerate end ends in such pieces: the turning
      * they carry is real (kappa ~ 1/sqrt(s) there) but concentrated in a
-     * length below resolution. A small turn is handed to a neighbouring
-     * piece, whose end value absorbs it, so a smooth curve reports no
-     * corner - but absorbing tilts the neighbour's theta by up to |turn|
-     * over its length, so only where that stays far inside the tolerance;
-     * otherwise the turn is a (tiny) corner, which is exact.
-     * A turn already handed on (pending_start, the end value of the last
-     * piece) is in the next piece's rise from there to its own end: a
-     * later turn absorbed by the last piece or made a corner moves the
-     * value the next piece starts from with it, or it would be counted
-     * twice - once there and once in that rise (a hairpin at 1e6 whose
-     * tip is rounding noise turned 7.4e-4 rad too far, 1.5e-3 off at the
-     * end at a tolerance of 1e-3). */
-    double tol = 4.0 * b->tol_theta * b->L;
-    double prev_end = b->m > 0 ? b->s[b->m] : -1.0;
-    double prev_h = b->m > 0 ? b->s[b->m] - b->s[b->m - 1] : INFINITY;
-    if (fabs(turn) < 1e-3 && b->m > b->span_first && prev_end == *s_at &&
-        fabs(turn) * prev_h <= 0.05 * tol) {
-      b->th[(b->m - 1) * (THETA_DEGREE + 1) + THETA_DEGREE] += turn;
-      if (!isnan(b->pending_start)) b->pending_start += turn;
-    } else if (fabs(turn) * (b->L - *s_at) <= 0.05 * tol) {
-      if (isnan(b->pending_start)) b->pending_start = th[0];
-    } else if (fabs(turn) > CORNER_NOISE) {
-      km_status st = push_corner(b, *s_at, km__wrap_angle(turn), mid);
-      if (st) return st;
-      if (!isnan(b->pending_start)) b->pending_start += km__wrap_angle(turn);
-    } else if (isnan(b->pending_start)) {
-      b->pending_start = th[0];
-    }
+     * length below resolution; a small one goes into a neighbour. */
+    km_status st = take_turn(b, turn, *s_at, th[0], mid, false);
+    if (st) return st;
     *theta = th[NPTS - 1];
     return KM_OK;
   }
@@ -774,13 +798,14 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
   return fit_piece(b, mid, ub, 0.0, s_at, theta, dm, dir_b, depth + 1);
 }
 
-static km_status check_turn(builder *b, double turn, double t, double s) {
+/* The turn between two spans at parameter t, arc length s: a cusp where
+ * the tangent reverses. */
+static km_status check_cusp(builder *b, double turn, double t, double s) {
   if (fabs(turn) > KM_PI - CUSP_MARGIN)
     return km__fail(b->err, KM_ECUSP, KM_FIELD_KNOTS, -1, t,
                     "the tangent reverses at parameter t = %g (arc length "
                     "%g): a cusp, the curve is not regular there",
                     t, s);
-  if (fabs(turn) > CORNER_NOISE) return push_corner(b, s, turn, t);
   return KM_OK;
 }
 
@@ -947,12 +972,11 @@ km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
     } else {
       double turn = atan2(prev_dir[0] * da[1] - prev_dir[1] * da[0],
                           prev_dir[0] * da[0] + prev_dir[1] * da[1]);
-      st = check_turn(&b, turn, ua, s_at);
+      st = check_cusp(&b, turn, ua, s_at);
+      if (st) goto cleanup;
+      st = take_turn(&b, turn, s_at, theta, ua, true);
       if (st) goto cleanup;
       theta += turn;
-      /* a turn handed on from before the knot starts the next piece after
-       * the knot's corner, which is counted as a corner, not again there */
-      if (fabs(turn) > CORNER_NOISE && !isnan(b.pending_start)) b.pending_start += turn;
     }
     size_t m0 = b.m, c0 = b.ncorners;
     b.span_first = m0;
@@ -1001,8 +1025,13 @@ km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
   if (c->closed) {
     double turn = atan2(prev_dir[0] * first_dir[1] - prev_dir[1] * first_dir[0],
                         prev_dir[0] * first_dir[0] + prev_dir[1] * first_dir[1]);
-    st = check_turn(&b, turn, t1, s_at);
+    /* at the seam a turn's position costs nothing: rounding is dropped */
+    st = check_cusp(&b, turn, t1, s_at);
     if (st) goto cleanup;
+    if (fabs(turn) > CORNER_NOISE) {
+      st = push_corner(&b, s_at, turn, t1);
+      if (st) goto cleanup;
+    }
   }
   /* the pieces' arc lengths sum to the total up to rounding: snap */
   double s_last = b.s[b.m], scale = L / s_last;

@@ -960,6 +960,40 @@ static void polygon_edges_have_exactly_zero_curvature(void **state) {
   }
 }
 
+/* Two unit edges meeting at a knot with a turn of delta = 4e-12 rad, below
+ * what reads as rounding (1e-11): at a tolerance of 1e-13 of the length it
+ * moves the end by delta (4e-12, twenty times the tolerance), so it must
+ * be kept - a turn dropped at a knot moved every later point (a closed
+ * degree-9 curve ended 1.5e-12 of its length off). At the default
+ * tolerance it is absorbed by an edge and no corner is reported. The end
+ * is (1 + cos delta, sin delta) exactly. */
+static void turn_below_rounding_at_a_knot_counts_at_tight_tolerance(
+    void **state) {
+  (void)state;
+  const double delta = 4e-12;
+  const double kn[5] = {0, 0, 1, 2, 2};
+  const double cp[6] = {0, 0, 1, 0, 1 + cos(delta), sin(delta)};
+  const double rels[2] = {1e-13, 0};
+  for (int k = 0; k < 2; k++) {
+    km_curve c;
+    make_curve(&c, 1, 3, kn, cp, NULL, false);
+    km_signature sig;
+    double L = 2.0, tol = rels[k] > 0 ? rels[k] * L : 1e-5 * L;
+    sign_abs(&c, rels[k] * L, &sig);
+    double end[2];
+    signature_end(&sig, end);
+    assert_close(end[0], 1 + cos(delta), tol);
+    assert_close(end[1], sin(delta), tol);
+    if (rels[k] > 0) {
+      assert_close(sig.turning, delta, 1e-15);
+    } else {
+      assert_ncorners(&sig, 0);
+    }
+    km_signature_free(&sig);
+    km_curve_free(&c);
+  }
+}
+
 static void rational_span_leaving_a_degenerate_leg_has_its_exact_length(
     void **state) {
   (void)state;
@@ -1051,6 +1085,7 @@ int main(void) {
       cmocka_unit_test(clockwise_circle_has_curvature_minus_one_over_r),
       cmocka_unit_test(square_has_zero_curvature_and_four_right_corners),
       cmocka_unit_test(polygon_edges_have_exactly_zero_curvature),
+      cmocka_unit_test(turn_below_rounding_at_a_knot_counts_at_tight_tolerance),
       cmocka_unit_test(clockwise_square_has_four_negative_corners),
       cmocka_unit_test(
           cubic_square_and_star_from_fixtures_have_polygon_corners),
