@@ -47,6 +47,23 @@ static const double PI = 3.14159265358979323846;
 #define MAX_POINTS 800
 #define MAX_MORPH_POINTS 400
 #define MAX_SMALL_POINTS 300
+/* The morph signs its moved copy again at a tenth of the tolerance, which
+ * is most of an input's time; a curve's evaluation costs about (p + 1)^2
+ * (de Casteljau) and twice that with weights. Curves morphed stay within
+ * MAX_MORPH_POINTS cubics' worth: a rational curve of degree 9 at 1e6
+ * with degenerate legs, 58 points, took 1.2 s fuzzed with the morph (its
+ * signature 23 ms at -O3), about 0.25 s without it. */
+#define MAX_MORPH_WORK (MAX_MORPH_POINTS * 16)
+/* The many-knot family likewise, from MAX_POINTS cubics' worth up: a
+ * rational curve of degree 7 at 1e9, 738 points, took 0.9 to 1.1 s
+ * fuzzed, 1.4 ms a point against 0.1 to 0.25 for cubics (degree 7:
+ * at most 350 points; 9: 224). */
+#define MANY_KNOTS_WORK (MAX_POINTS * 56)
+static size_t many_knots_points(int degree, bool rational) {
+  size_t per = (size_t)(degree + 1) * (size_t)(degree + 1) * (rational ? 2 : 1);
+  size_t n = MANY_KNOTS_WORK / per;
+  return n < MAX_POINTS ? n : MAX_POINTS;
+}
 
 typedef struct reader {
   const uint8_t *p;
@@ -68,7 +85,7 @@ static void fail(const char *why, double a, double b) {
 
 /* Fill pts (2n values, in about [-1, 1]^2) for one family. */
 static size_t make_points(reader *r, unsigned family, int degree,
-                          unsigned count, double *pts) {
+                          unsigned count, size_t max_points, double *pts) {
   size_t n = 0;
   switch (family % 6) {
   case 0: /* arbitrary points */
@@ -112,8 +129,8 @@ static size_t make_points(reader *r, unsigned family, int degree,
     }
     break;
   }
-  case 3: { /* many knots: a gentle wave, up to MAX_POINTS points */
-    n = (size_t)degree + 1 + (size_t)count % (MAX_POINTS - KM_MAX_DEGREE);
+  case 3: { /* many knots: a gentle wave, up to max_points points */
+    n = (size_t)degree + 1 + (size_t)count % (max_points - KM_MAX_DEGREE);
     double amp = pow(10.0, -(double)(u8(r) % 8));
     double freq = 1 + u8(r) % 64;
     for (size_t i = 0; i < n; i++) {
@@ -339,7 +356,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   if (pts == NULL || knots == NULL || w == NULL)
     goto done;
 
-  size_t n = make_points(r, family, degree, count, pts);
+  size_t n = make_points(r, family, degree, count,
+                         many_knots_points(degree, (flags & 2) != 0), pts);
   bool closed = (flags & 1) && n > (size_t)degree + 1;
   for (size_t i = 0; i < 2 * n; i++)
     pts[i] = pts[i] * scale + offset;
@@ -407,7 +425,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     check_reconstruction(&c, &sig, sig_tol, &rc, bound,
                          max_abs(c.cp, 2 * c.n) + L);
 
-  if (n <= MAX_MORPH_POINTS && (flags & 0x10))
+  size_t morph_work = n * (size_t)(degree + 1) * (size_t)(degree + 1) * (rational ? 2 : 1);
+  if (morph_work <= MAX_MORPH_WORK && (flags & 0x10))
     run_morph(r, &c, &sig, flags, tol);
 
 done:
