@@ -424,6 +424,7 @@ static void morph_time_problem(srv_req *r, const api_morph_plan *plan,
            "(KMORPH_MORPH_TIME) with %zu of %zu frames done; POST /v1/jobs "
            "computes long morphs asynchronously",
            ptr, limit, done, n);
+  srv_metrics_reject(r->srv->metrics, "morph_time");
   api_problem(&r->resp, 422, "/problems/limit-exceeded", "Limit exceeded",
               detail, ptr, message, r->rid);
 }

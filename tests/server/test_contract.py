@@ -404,6 +404,15 @@ class MorphTimeLimit(ContractCase):
         self.assertEqual(r.status, 200, r.body[:300])
         self.assertEqual([f["t"] for f in doc["frames"]], [0, 0.5, 1])
 
+    def test_refusals_are_counted_in_the_metrics(self):
+        def count():
+            text = self.d.request("GET", "/metrics").body.decode()
+            return metric(text, "kmorph_rejected_total",
+                          {"reason": "morph_time"})
+        before = count()
+        self.refused(tight_heavy_morph_body(), "/frames")
+        self.assertEqual(count(), before + 1)
+
     def test_the_same_morph_as_a_job_is_not_held_to_it(self):
         r = self.d.request("POST", "/v1/jobs", body=heavy_morph_body(1000))
         self.assertEqual(r.status, 202, r.body[:300])
