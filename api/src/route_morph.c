@@ -494,6 +494,10 @@ size_t api_morph_frame_count(const api_morph_plan *plan) {
   return plan != NULL ? plan->nframes : 0;
 }
 
+const char *api_morph_frames_pointer(const api_morph_plan *plan) {
+  return plan != NULL && plan->times_given ? "/times" : "/frames";
+}
+
 int api_morph_render_frame(api_morph_plan *plan, size_t i) {
   frame_slot *f;
   if (plan == NULL || i >= plan->nframes)

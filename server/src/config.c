@@ -44,6 +44,8 @@ static const opt_def OPTS[] = {
      "idle seconds before a connection is closed"},
     {"request-time", "KMORPH_REQUEST_TIME", OPT_SECONDS, F(request_time), 0,
      0.01, 86400, "seconds to receive one whole request"},
+    {"morph-time", "KMORPH_MORPH_TIME", OPT_SECONDS, F(morph_time), 0, 0.01,
+     86400, "compute seconds per POST /v1/morph (past it: 422)"},
     {"max-body", "KMORPH_MAX_BODY", OPT_SIZE, F(max_body), 0, 1, 1e12,
      "request body bytes (larger: 413)"},
     {"max-points", "KMORPH_MAX_POINTS", OPT_SIZE, F(max_points), 0, 1, 1e9,
@@ -89,6 +91,7 @@ void srv_config_default(srv_config *cfg)
   cfg->max_connections = 512;
   cfg->timeout = 30;
   cfg->request_time = 60;
+  cfg->morph_time = 60;
   cfg->max_body = (size_t)8 << 20;
   cfg->max_points = 100000;
   cfg->max_frames = 1000;

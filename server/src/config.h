@@ -21,6 +21,7 @@ typedef struct srv_config {
   unsigned max_connections; /* concurrent connections */
   unsigned timeout;         /* idle seconds before a connection is cut */
   double request_time;      /* seconds to receive a whole request */
+  double morph_time;        /* compute seconds per synchronous morph */
   size_t max_body;          /* bytes; larger bodies are 413 */
   size_t max_points;        /* control points per curve */
   size_t max_frames;        /* frames per POST /v1/morph */

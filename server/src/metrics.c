@@ -33,7 +33,7 @@ struct srv_metrics {
   unsigned long long bucket[SRV_R_COUNT][NBUCKET];
   unsigned long long observed[SRV_R_COUNT];
   double sum[SRV_R_COUNT];
-  unsigned long long rejected_queue, rejected_jobs;
+  unsigned long long rejected_queue, rejected_jobs, rejected_time;
 };
 
 const char *srv_route_name(srv_route r)
@@ -81,6 +81,8 @@ void srv_metrics_reject(srv_metrics *m, const char *reason)
   pthread_mutex_lock(&m->mu);
   if (strcmp(reason, "jobs_full") == 0)
     m->rejected_jobs++;
+  else if (strcmp(reason, "morph_time") == 0)
+    m->rejected_time++;
   else
     m->rejected_queue++;
   pthread_mutex_unlock(&m->mu);
@@ -158,12 +160,14 @@ char *srv_metrics_render(srv_metrics *m, const srv_gauges *g, size_t *len)
         ROUTE_NAMES[r], m->observed[r]);
   }
   put(&b,
-      "# HELP kmorph_rejected_total Requests refused at once because the "
-      "daemon was full.\n"
+      "# HELP kmorph_rejected_total Requests refused to protect the daemon: "
+      "at once because it was full, or a synchronous morph stopped at its "
+      "compute time limit.\n"
       "# TYPE kmorph_rejected_total counter\n"
       "kmorph_rejected_total{reason=\"queue_full\"} %llu\n"
-      "kmorph_rejected_total{reason=\"jobs_full\"} %llu\n",
-      m->rejected_queue, m->rejected_jobs);
+      "kmorph_rejected_total{reason=\"jobs_full\"} %llu\n"
+      "kmorph_rejected_total{reason=\"morph_time\"} %llu\n",
+      m->rejected_queue, m->rejected_jobs, m->rejected_time);
   pthread_mutex_unlock(&m->mu);
   put(&b,
       "# HELP kmorph_queue_depth Compute requests waiting for a worker.\n"

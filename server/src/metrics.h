@@ -39,8 +39,9 @@ void srv_metrics_destroy(srv_metrics *m);
 void srv_metrics_observe(srv_metrics *m, srv_route route, int status,
                          double seconds);
 
-/* Count a request refused by admission control (reason: "queue_full",
- * "jobs_full"). */
+/* Count a request refused to protect the daemon (reason: "queue_full",
+ * "jobs_full" by admission control; "morph_time": a synchronous morph
+ * stopped at its compute time limit). */
 void srv_metrics_reject(srv_metrics *m, const char *reason);
 
 /* Gauges supplied by the caller at render time. */

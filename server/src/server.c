@@ -404,6 +404,68 @@ static bool client_gone(srv_req *r)
   return n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR;
 }
 
+/* The answer to a synchronous morph stopped at its compute time limit:
+ * the request is valid but more work than a synchronous answer may take,
+ * a limit like the frame limit (422, named by the member that chose the
+ * frames), with the way out: an asynchronous job. */
+static void morph_time_problem(srv_req *r, const api_morph_plan *plan,
+                               size_t done)
+{
+  double limit = r->srv->cfg.morph_time;
+  size_t n = api_morph_frame_count(plan);
+  const char *ptr = api_morph_frames_pointer(plan);
+  char message[160], detail[400];
+  snprintf(message, sizeof message,
+           "%zu frames take longer than the %g s a synchronous morph may "
+           "compute",
+           n, limit);
+  snprintf(detail, sizeof detail,
+           "%s: the morph ran past its compute time limit of %g s "
+           "(KMORPH_MORPH_TIME) with %zu of %zu frames done; POST /v1/jobs "
+           "computes long morphs asynchronously",
+           ptr, limit, done, n);
+  srv_metrics_reject(r->srv->metrics, "morph_time");
+  api_problem(&r->resp, 422, "/problems/limit-exceeded", "Limit exceeded",
+              detail, ptr, message, r->rid);
+}
+
+/* POST /v1/morph on a worker, frame by frame the way api_handle does it,
+ * so that the work stops between frames when the client leaves or the
+ * compute time limit passes. The time counts from the start of the work,
+ * since preparing (the signatures) can be most of it, and is checked
+ * before each frame: a morph whose last frame ends late is still
+ * answered, its work being done. */
+static void morph_sync(srv_req *r, const api_request *req)
+{
+  srv_server *s = r->srv;
+  double deadline = srv_now() + s->cfg.morph_time;
+  api_morph_plan *plan = NULL;
+  if (api_morph_prepare(&s->api, req, s->api.max_frames_sync, &plan,
+                        &r->resp) != 0)
+    return;
+  size_t n = api_morph_frame_count(plan);
+  size_t done = 0;
+  bool gone = false, late = false;
+  while (done < n && !gone) {
+    if (srv_now() > deadline) {
+      late = true;
+      break;
+    }
+    api_morph_render_frame(plan, done++);
+    if (done % 8 == 0)
+      gone = client_gone(r);
+  }
+  if (gone)
+    api_problem(&r->resp, 503, "/problems/client-gone", "Client gone",
+                "the client closed the connection during the work", NULL,
+                NULL, r->rid);
+  else if (late)
+    morph_time_problem(r, plan, done);
+  else
+    api_morph_result(plan, &r->resp);
+  api_morph_plan_free(plan);
+}
+
 static void compute_task(void *arg, bool cancelled)
 {
   srv_req *r = arg;
@@ -432,27 +494,8 @@ static void compute_task(void *arg, bool cancelled)
                                               : API_ROUTE_RECONSTRUCT;
       api_handle(&s->api, &req, &r->resp);
     } else {
-      /* A synchronous morph frame by frame, the way api_handle does it, so
-       * that a client who leaves stops the work between frames. */
-      api_morph_plan *plan = NULL;
       req.route = API_ROUTE_MORPH;
-      if (api_morph_prepare(&s->api, &req, s->api.max_frames_sync, &plan,
-                            &r->resp) == 0) {
-        size_t n = api_morph_frame_count(plan);
-        bool gone = false;
-        for (size_t i = 0; i < n && !gone; i++) {
-          api_morph_render_frame(plan, i);
-          if (i % 8 == 7)
-            gone = client_gone(r);
-        }
-        if (gone)
-          api_problem(&r->resp, 503, "/problems/client-gone", "Client gone",
-                      "the client closed the connection during the work",
-                      NULL, NULL, r->rid);
-        else
-          api_morph_result(plan, &r->resp);
-        api_morph_plan_free(plan);
-      }
+      morph_sync(r, &req);
     }
   }
   atomic_store(&r->phase, PH_READY);

@@ -387,6 +387,34 @@ static void prepared_plan_renders_the_same_result(void **state) {
   free(body);
 }
 
+/* A limit the caller finds while rendering (the daemon's compute time) is
+ * named by the member that chose the frames. */
+static void plan_names_the_member_that_chose_the_frames(void **state) {
+  (void)state;
+  static const char *const bodies[][2] = {
+      {BOTH ",\"frames\":3}", "/frames"},
+      {BOTH "}", "/frames"},
+      {BOTH ",\"times\":[0,0.5]}", "/times"}};
+  api_config cfg;
+  api_config_default(&cfg);
+  for (size_t k = 0; k < sizeof bodies / sizeof bodies[0]; k++) {
+    api_request req;
+    api_morph_plan *plan = NULL;
+    api_response err;
+    api_response_init(&err);
+    memset(&req, 0, sizeof req);
+    req.route = MORPH;
+    req.body = bodies[k][0];
+    req.length = strlen(bodies[k][0]);
+    assert_int_equal(api_morph_prepare(&cfg, &req, cfg.max_frames_sync, &plan,
+                                       &err),
+                     0);
+    assert_string_equal(api_morph_frames_pointer(plan), bodies[k][1]);
+    api_morph_plan_free(plan);
+    api_response_free(&err);
+  }
+}
+
 static void open_into_closed_is_not_morphable(void **state) {
   (void)state;
   at_buf b = {0};
@@ -432,6 +460,7 @@ int main(void) {
       cmocka_unit_test(animate_d_paths_share_one_structure),
       cmocka_unit_test(svg_is_returned_when_asked),
       cmocka_unit_test(prepared_plan_renders_the_same_result),
+      cmocka_unit_test(plan_names_the_member_that_chose_the_frames),
       cmocka_unit_test(open_into_closed_is_not_morphable),
       cmocka_unit_test(opposite_turning_kept_is_not_morphable),
   };

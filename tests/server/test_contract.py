@@ -3,6 +3,7 @@ kmorphd, each answer checked against its schema in api/openapi.yaml."""
 import json
 import math
 import os
+import re
 import subprocess
 import time
 import unittest
@@ -10,8 +11,9 @@ import unittest
 import yaml
 
 from kmtest import (DAEMON, ROOT, SPEC, ContractCase, Daemon, circle_svg,
-                    close_to, metric, morph_body, open_arc, raw_exchange,
-                    raw_status, schema_errors, component, wait_for)
+                    close_to, heavy_morph_body, metric, morph_body, open_arc,
+                    raw_exchange, raw_status, schema_errors, component,
+                    wait_for)
 
 TWO_PI = 2 * math.pi
 
@@ -234,13 +236,14 @@ class CommandLine(unittest.TestCase):
         self.assertEqual(out.returncode, 0)
         for name in ("KMORPH_PORT", "KMORPH_BIND", "KMORPH_THREADS",
                      "KMORPH_QUEUE", "KMORPH_MAX_BODY", "KMORPH_TIMEOUT",
-                     "KMORPH_JOB_TTL", "KMORPH_JOB_TIME",
+                     "KMORPH_JOB_TTL", "KMORPH_JOB_TIME", "KMORPH_MORPH_TIME",
                      "KMORPH_CORS_ORIGINS", "--port", "--bind"):
             self.assertIn(name, out.stdout)
 
     def test_bad_flags_and_values_exit_2_with_a_message(self):
         for args in (["--no-such-flag"], ["--port", "70000"],
-                     ["--queue", "0"], ["--threads", "two"]):
+                     ["--queue", "0"], ["--threads", "two"],
+                     ["--morph-time", "0"]):
             out = subprocess.run([DAEMON, *args], capture_output=True,
                                  timeout=10, text=True)
             self.assertEqual(out.returncode, 2, args)
@@ -333,6 +336,94 @@ class GeometryEndpoints(ContractCase):
         r = self.d.request("POST", "/v1/morph", body=morph_body(1001))
         doc = self.assertProblem(r, 422, "/v1/morph", "post")
         self.assertEqual(doc["errors"][0]["pointer"], "/frames")
+
+    def test_morph_of_a_few_tenths_of_a_second_is_answered(self):
+        # Six times the limit of MorphTimeLimit below: the default limit
+        # (60 s) lets it through.
+        r = self.d.request("POST", "/v1/morph", body=heavy_morph_body(1000))
+        doc = self.assertDocumented(r, "/v1/morph", "post")
+        self.assertEqual(r.status, 200, r.body[:300])
+        self.assertEqual(len(doc["frames"]), 1000)
+
+
+def tight_heavy_morph_body(**extra):
+    """1,000 frames of the heavy morph at a tolerance 6,000 times finer
+    than the default: about 1.5 s on one core (0.3 s at the default
+    tolerance)."""
+    body = heavy_morph_body(1000)
+    body["tolerance"] = 1e-7
+    body.update(extra)
+    return body
+
+
+class MorphTimeLimit(ContractCase):
+    """A synchronous morph stops at --morph-time: a 422 naming the frames,
+    never a 5xx, and the daemon goes on serving."""
+    LIMIT = 0.05
+
+    @classmethod
+    def setUpClass(cls):
+        cls.d = Daemon("--threads", "2", "--morph-time", str(cls.LIMIT))
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.d.stop()
+
+    def refused(self, body, pointer):
+        t0 = time.monotonic()
+        r = self.d.request("POST", "/v1/morph", body=body)
+        dt = time.monotonic() - t0
+        doc = self.assertProblem(r, 422, "/v1/morph", "post")
+        self.assertEqual(doc["type"], "/problems/limit-exceeded")
+        self.assertEqual([e["pointer"] for e in doc["errors"]], [pointer])
+        detail = doc["detail"]
+        self.assertIn("%g s" % self.LIMIT, detail)
+        self.assertIn("KMORPH_MORPH_TIME", detail)
+        self.assertIn("POST /v1/jobs", detail)
+        m = re.search(r"with (\d+) of (\d+) frames done", detail)
+        self.assertTrue(m, detail)
+        done, total = int(m.group(1)), int(m.group(2))
+        self.assertEqual(total, 1000)
+        self.assertLess(done, total, "the work stopped before its end")
+        self.assertLess(dt, 1.0, "the answer does not wait for every frame")
+        return doc
+
+    def test_long_morph_is_422_naming_frames_with_the_numbers(self):
+        self.refused(tight_heavy_morph_body(), "/frames")
+
+    def test_long_morph_given_times_is_422_naming_times(self):
+        body = tight_heavy_morph_body(times=[i / 999 for i in range(1000)])
+        del body["frames"]
+        self.refused(body, "/times")
+
+    def test_daemon_serves_normally_after_a_refusal(self):
+        self.refused(tight_heavy_morph_body(), "/frames")
+        self.assertEqual(self.d.request("GET", "/healthz").status, 200)
+        r = self.d.request("POST", "/v1/morph", body=morph_body(3))
+        doc = self.assertDocumented(r, "/v1/morph", "post")
+        self.assertEqual(r.status, 200, r.body[:300])
+        self.assertEqual([f["t"] for f in doc["frames"]], [0, 0.5, 1])
+
+    def test_refusals_are_counted_in_the_metrics(self):
+        def count():
+            text = self.d.request("GET", "/metrics").body.decode()
+            return metric(text, "kmorph_rejected_total",
+                          {"reason": "morph_time"})
+        before = count()
+        self.refused(tight_heavy_morph_body(), "/frames")
+        self.assertEqual(count(), before + 1)
+
+    def test_the_same_morph_as_a_job_is_not_held_to_it(self):
+        r = self.d.request("POST", "/v1/jobs", body=heavy_morph_body(1000))
+        self.assertEqual(r.status, 202, r.body[:300])
+        jid = r.json()["id"]
+
+        def final():
+            s = self.d.request("GET", "/v1/jobs/" + jid).json()
+            return s if s["state"] in ("done", "failed") else None
+        s = wait_for(final, 15)
+        self.assertTrue(s, "the job ends")
+        self.assertEqual(s["state"], "done", s)
 
 
 if __name__ == "__main__":

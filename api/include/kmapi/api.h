@@ -70,6 +70,11 @@ int api_morph_prepare(const api_config *cfg, const api_request *req,
                       size_t max_frames, api_morph_plan **plan,
                       api_response *error);
 size_t api_morph_frame_count(const api_morph_plan *plan);
+/* The JSON pointer of the request member that chose the frames: "/times"
+ * if the request listed its times, else "/frames" (also when it relied on
+ * the default count). For limits found above this layer that depend on
+ * how many frames were asked for, e.g. compute time. Static string. */
+const char *api_morph_frames_pointer(const api_morph_plan *plan);
 /* Render frame i (0 <= i < count); distinct i may run concurrently.
  * Returns 0, or an HTTP status (422) if the frame cannot be built. */
 int api_morph_render_frame(api_morph_plan *plan, size_t i);
