@@ -45,6 +45,9 @@
  * morph 21 more passes over the nodes, 228 instead of 207) */
 #define CLOSED_GAP 1e-10
 #define NDER (2 * MAX_RULE)
+/* Closure corrections kept at t = k / WARM_POINTS, from which frames start
+ * theirs (WARM_POINTS + 1 of them, zero at both ends) */
+#define WARM_POINTS 6
 #define MERGE_DEGREE 7   /* of theta on merged input pieces */
 #define MERGE_SHARE 0.1  /* of the tolerance, for merging them */
 
@@ -69,7 +72,7 @@ struct km__frame_plan {
   gnode *node;
   size_t nn;
   double chol[NF * NF]; /* Cholesky factor of the closure metric */
-  double c_half[NF];    /* the closure correction at t = 1/2 */
+  double c_at[WARM_POINTS + 1][NF]; /* closure corrections at t = k / 6 */
   size_t *corner_at;    /* breaks (1 .. np - 1) that are corners */
   size_t ncorners;
   bool by_corners;      /* closed frames close by their corners */
@@ -388,8 +391,8 @@ static size_t frame_scratch(const km__frame_plan *p) {
 }
 
 static km_status close_frame(const km__frame_plan *p, double t, double theta0,
-                             bool close_lsq, double *c, double *sum,
-                             double *e);
+                             bool close_lsq, bool project, double *c,
+                             double *sum, double *e);
 static bool corner_closure(const km__frame_plan *p, double t, double *sum,
                            double *tau, double *delta, double *S,
                            double *dp);
@@ -628,15 +631,6 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
   p->nn = nodes.n;
   nodes.p = NULL;
   if (closed) {
-    double *sum = malloc(frame_scratch(p) * sizeof(double));
-    st = sum ? close_frame(p, 0.5, 0.0, true, p->c_half, sum, sum + 2 * np)
-             : KM_ENOMEM;
-    free(sum);
-    if (st == KM_ENOCONVERGE) {
-      memset(p->c_half, 0, sizeof p->c_half);
-      st = KM_OK;
-    }
-    if (st) goto fail;
     /* Corners close the frames of this morph if they can at t = 1/4, 1/2
      * and 3/4; the choice holds for every frame, so that a sequence does
      * not switch between two closures (a frame where it fails takes the
@@ -650,11 +644,41 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
       double *dp = S + 2 * (nc + 1), c0[NF] = {0};
       p->by_corners = true;
       for (int k = 1; k <= 3 && p->by_corners; k++)
-        p->by_corners = close_frame(p, k / 4.0, 0.0, false, c0, buf,
+        p->by_corners = close_frame(p, k / 4.0, 0.0, false, false, c0, buf,
                                     buf + 2 * np) == KM_OK &&
                         corner_closure(p, k / 4.0, buf, tau, delta, S, dp);
       free(buf);
     }
+    /* The corrections frames start from, at t = k / WARM_POINTS: the
+     * projection and steps from the closed correction found from zero at
+     * t = 1/2, scaled by 4 t (1 - t) - a smooth family in t (the frames of
+     * U_to_S took it, three or four passes each, before they started from
+     * the polynomial through it, two passes each). One that does not
+     * converge is zero, and so are all where corners close the frames
+     * (a frame they cannot close takes steps from zero). */
+    double *sum = p->by_corners ? NULL : malloc(frame_scratch(p) * sizeof(double));
+    if (!p->by_corners && !sum) {
+      st = KM_ENOMEM;
+      goto fail;
+    }
+    double c_half[NF] = {0};
+    if (sum) st = close_frame(p, 0.5, 0.0, true, true, c_half, sum, sum + 2 * np);
+    if (st == KM_ENOCONVERGE) {
+      memset(c_half, 0, sizeof c_half);
+      st = KM_OK;
+    }
+    memset(p->c_at, 0, sizeof p->c_at);
+    for (int k = 1; k < WARM_POINTS && !st && sum; k++) {
+      double t = (double)k / WARM_POINTS;
+      for (int i = 0; i < NF; i++) p->c_at[k][i] = 4 * t * (1 - t) * c_half[i];
+      st = close_frame(p, t, 0.0, true, true, p->c_at[k], sum, sum + 2 * np);
+      if (st == KM_ENOCONVERGE) {
+        memset(p->c_at[k], 0, sizeof p->c_at[k]);
+        st = KM_OK;
+      }
+    }
+    free(sum);
+    if (st) goto fail;
   }
   free(atoms.p);
   free(br);
@@ -893,13 +917,14 @@ static double max_abs(const double *v, int n) {
  * e^(i theta) dr over piece k. scratch: e^(i theta) at the nodes (2 per
  * node).
  *
- * The lsq closure solves G(c) = 0 for the least change of curvature: a
- * projection onto the linearised constraints (the minimum-norm point of
- * J c = J c_old - G in the metric integral psi'^2, whose Gram matrix is
- * Toeplitz with entries 2/3, -1/8, -1/5, -1/120), then steps dc =
- * M^-1 J^T lambda with J dc = -G: with the projection's J (a chord step)
- * when the projection moved c by at most 1e-3, else Newton steps with
- * fresh Jacobians, which converge quadratically. No pass follows the last
+ * The lsq closure solves G(c) = 0 for the least change of curvature: with
+ * project, a projection onto the linearised constraints (the minimum-norm
+ * point of J c = J c_old - G in the metric integral psi'^2, whose Gram
+ * matrix is Toeplitz with entries 2/3, -1/8, -1/5, -1/120) - how the
+ * corrections frames start from are found - else a first step from c;
+ * then steps dc = M^-1 J^T lambda with J dc = -G: with the first J (a
+ * chord step) when the first change was at most 1e-3, else Newton steps
+ * with fresh Jacobians, which converge quadratically. No pass follows the last
  * step when a bound on what it leaves says so:
  *   G(c + dc) = (J(c) - J(c0)) dc + R,
  * |J(c) - J(c0)| dc <= max|dc0| sum_i |dc_i| wb_i for the chord (|e^(i a)
@@ -910,8 +935,8 @@ static double max_abs(const double *v, int n) {
  * share of the same bound) and the frame is closed to CLOSED_GAP of its
  * length, as by a further pass. */
 static km_status close_frame(const km__frame_plan *p, double t, double theta0,
-                             bool close_lsq, double *c, double *sum,
-                             double *scratch) {
+                             bool close_lsq, bool project, double *c,
+                             double *sum, double *scratch) {
   double Lt = (1 - t) * p->La + t * p->Lb;
   bool lsq = close_lsq && p->closed;
   double *e = scratch;
@@ -919,23 +944,26 @@ static km_status close_frame(const km__frame_plan *p, double t, double theta0,
   double Y[2][NF], S[4];
   memcpy(cp + 3, c, sizeof dc);
   frame_pass(p, t, theta0, cp, NULL, false, sum, e, G, lsq ? J : NULL);
-  /* A start that is closed already is not the answer unless it is zero:
-   * frames take the projection from their start, and the start at
-   * t = 1/2 is the closed point found from zero there, which is not where
-   * the projection from it leads - stopping there, the frame at t = 1/2
-   * was 1.4% of U_to_S's length off its neighbours at t = 1/2 +- 1e-6. */
-  if (!lsq || (Lt * hypot(G[0], G[1]) <= CLOSED_GAP * Lt && max_abs(c, NF) == 0))
-    return KM_OK;
-  /* projection */
+  /* With the projection a start that is closed already is the answer
+   * only if it is zero: the projection from it leads elsewhere, and the
+   * frames beside it take that (a closed start kept at t = 1/2 stood 1.4%
+   * of U_to_S's length off its neighbours at 1/2 +- 1e-6). */
+  bool closed = Lt * hypot(G[0], G[1]) <= CLOSED_GAP * Lt;
+  if (!lsq || (closed && (!project || max_abs(c, NF) == 0))) return KM_OK;
   metric_rows(p, J, Y, S);
   double rhs[2] = {-G[0], -G[1]};
-  for (int r = 0; r < 2; r++)
-    for (int i = 0; i < NF; i++) rhs[r] += J[r][i] * c[i];
-  if (!metric_step(Y, S, rhs, dc)) return KM_ENOCONVERGE;
-  for (int i = 0; i < NF; i++) {
-    double ci = dc[i];
-    dc[i] = ci - c[i];
-    c[i] = ci;
+  if (project) {
+    for (int r = 0; r < 2; r++)
+      for (int i = 0; i < NF; i++) rhs[r] += J[r][i] * c[i];
+    if (!metric_step(Y, S, rhs, dc)) return KM_ENOCONVERGE;
+    for (int i = 0; i < NF; i++) {
+      double ci = dc[i];
+      dc[i] = ci - c[i];
+      c[i] = ci;
+    }
+  } else {
+    if (!metric_step(Y, S, rhs, dc)) return KM_ENOCONVERGE;
+    for (int i = 0; i < NF; i++) c[i] += dc[i];
   }
   /* A small first change leaves so little that a chord step with this
    * Jacobian finishes (the bound below); a large one needs Newton steps
@@ -994,6 +1022,20 @@ static bool corner_closure(const km__frame_plan *p, double t, double *sum,
   return true;
 }
 
+/* The closure correction a frame at t starts from: the polynomial through
+ * the kept corrections (smooth in t, exact at each: frames move smoothly
+ * through them, where a piecewise cubic left a kink). */
+static void warm_start(const km__frame_plan *p, double t, double *c) {
+  double x = t * WARM_POINTS;
+  for (int i = 0; i < NF; i++) c[i] = 0.0;
+  for (int j = 1; j < WARM_POINTS; j++) { /* the ends are zero */
+    double l = 1.0;
+    for (int q = 0; q <= WARM_POINTS; q++)
+      if (q != j) l *= (x - q) / (double)(j - q);
+    for (int i = 0; i < NF; i++) c[i] += l * p->c_at[j][i];
+  }
+}
+
 km_status km__frame_plan_curve(const km__frame_plan *p, double t,
                                double theta0, bool close_lsq, km_curve *out,
                                double *ends, km_error *err) {
@@ -1012,16 +1054,22 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t,
   km_status st = KM_OK;
   bool by_corners = false;
   if (lsq && p->by_corners) {
-    st = close_frame(p, t, theta0, false, c, sum, sum + 2 * np);
+    st = close_frame(p, t, theta0, false, false, c, sum, sum + 2 * np);
     by_corners = !st && corner_closure(p, t, sum, tau, delta, S, dp);
   }
   if (!st && !by_corners) {
-    /* the smooth curvature takes the correction, started from the one at
-     * t = 1/2 scaled by 4 t (1 - t): frames near each other need nearly
-     * the same correction, and the ends none */
-    if (lsq)
-      for (int i = 0; i < NF; i++) c[i] = 4 * t * (1 - t) * p->c_half[i];
-    st = close_frame(p, t, theta0, close_lsq, c, sum, sum + 2 * np);
+    /* the smooth curvature takes the correction, by steps from the
+     * cubic through the kept ones (warm_start): closed at those points
+     * already, near it between them, so frames near each other take
+     * nearly the same correction (continuous in t), and the ends none.
+     * Should the steps fail, the projection from there, as the kept
+     * corrections were found. */
+    if (lsq) warm_start(p, t, c);
+    st = close_frame(p, t, theta0, close_lsq, false, c, sum, sum + 2 * np);
+    if (st == KM_ENOCONVERGE && lsq) {
+      warm_start(p, t, c);
+      st = close_frame(p, t, theta0, true, true, c, sum, sum + 2 * np);
+    }
   }
   if (st) {
     free(sum);
