@@ -221,10 +221,11 @@ TEST_FUZZ_SECONDS ?= 60
 # inputs found so far are regression seeds in tests/fuzz/curves/corpus).
 TEST_FUZZ_NAMES := $(FUZZ_NAMES)
 FUZZ_CFLAGS := $(CSTD) -g -O1 $(WARN) -D_POSIX_C_SOURCE=200809L \
+  -fsanitize-coverage-ignorelist=tests/fuzz/coverage-ignore.txt \
   -fsanitize=address,undefined -fno-sanitize-recover=undefined \
   -Iapi/include -Iapi/src $(CORE_INC) $(CJSON_CFLAGS)
 FUZZ_OBJ := $(CORE_SRC:%.c=build/fuzz/obj/%.o) $(API_SRC:%.c=build/fuzz/obj/%.o)
-build/fuzz/obj/%.o: %.c
+build/fuzz/obj/%.o: %.c tests/fuzz/coverage-ignore.txt
 	@mkdir -p $(@D)
 	clang $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link -MMD -MP -c $< -o $@
 -include $(FUZZ_OBJ:.o=.d)
