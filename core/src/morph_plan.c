@@ -261,7 +261,8 @@ static void side_bounds(const side *sd, double r0, double r1, int nd,
 
 /* theta (less the start angle), d theta/dr and d2 theta/dr2 at r, from the
  * piece on the left (side < 0) or the right of r. */
-static void side_eval(const side *sd, double r, int side_dir, double v[3]) {
+/* The piece of an input at r from the side side_dir, and u in it. */
+static size_t side_piece_at(const side *sd, double r, int side_dir, double *u) {
   /* r comes from a break of one input divided by its length: times the
    * length it may miss that break by a rounding unit either way */
   double x = r * sd->L, eps = 1e-12 * sd->L;
@@ -269,7 +270,15 @@ static void side_eval(const side *sd, double r, int side_dir, double v[3]) {
   if (side_dir > 0 && i + 1 < sd->theta->m && x >= sd->theta->x[i + 1] - eps) i++;
   if (side_dir < 0 && i > 0 && x <= sd->theta->x[i] + eps) i--;
   double a = sd->theta->x[i], h = sd->theta->x[i + 1] - a;
-  double u = fmin(fmax((r * sd->L - a) / h, 0.0), 1.0);
+  *u = fmin(fmax((r * sd->L - a) / h, 0.0), 1.0);
+  return i;
+}
+
+/* theta (less the start angle), and its first two derivatives in r */
+static void side_eval(const side *sd, double r, int side_dir, double v[3]) {
+  double u;
+  size_t i = side_piece_at(sd, r, side_dir, &u);
+  double h = sd->theta->x[i + 1] - sd->theta->x[i];
   int dt = sd->theta->degree, dk = sd->kappa->degree;
   const double *kc = sd->kappa->c + i * (size_t)(dk + 1);
   v[0] = km__bern_eval(sd->theta->c + i * (size_t)(dt + 1), dt, u) - sd->angle;
@@ -281,6 +290,14 @@ static void side_eval(const side *sd, double r, int side_dir, double v[3]) {
   } else {
     v[2] = 0.0;
   }
+}
+
+/* theta alone (less the start angle) from the side side_dir */
+static double side_angle(const side *sd, double r, int side_dir) {
+  double u;
+  size_t i = side_piece_at(sd, r, side_dir, &u);
+  int dt = sd->theta->degree;
+  return km__bern_eval(sd->theta->c + i * (size_t)(dt + 1), dt, u) - sd->angle;
 }
 
 static double side_theta(const side *sd, double r) {
@@ -617,15 +634,10 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
   for (size_t k = 1; k < np; k++)
     if (p->corner[k]) p->corner_at[p->ncorners++] = k;
   for (size_t k = 0; k <= np; k++) {
-    double v[3];
-    side_eval(&sd[0], p->x[k], k == 0 ? 1 : -1, v);
-    p->ta_l[k] = v[0];
-    side_eval(&sd[0], p->x[k], k == np ? -1 : 1, v);
-    p->ta_r[k] = v[0];
-    side_eval(&sd[1], p->x[k], k == 0 ? 1 : -1, v);
-    p->tb_l[k] = v[0];
-    side_eval(&sd[1], p->x[k], k == np ? -1 : 1, v);
-    p->tb_r[k] = v[0];
+    p->ta_l[k] = side_angle(&sd[0], p->x[k], k == 0 ? 1 : -1);
+    p->ta_r[k] = side_angle(&sd[0], p->x[k], k == np ? -1 : 1);
+    p->tb_l[k] = side_angle(&sd[1], p->x[k], k == 0 ? 1 : -1);
+    p->tb_r[k] = side_angle(&sd[1], p->x[k], k == np ? -1 : 1);
   }
   p->node = nodes.p;
   p->nn = nodes.n;
