@@ -187,6 +187,21 @@ def wait_for(fn, timeout, interval=0.02):
         time.sleep(interval)
 
 
+def run_job(daemon, body, timeout=15):
+    """POST body to /v1/jobs (asserting 202 is the caller's: the reply is
+    returned) and wait until the job is done or failed: (reply, id, last
+    status document, or None if it did not end in time)."""
+    r = daemon.request("POST", "/v1/jobs", body=body)
+    if r.status != 202:
+        return r, None, None
+    jid = r.json()["id"]
+
+    def final():
+        s = daemon.request("GET", "/v1/jobs/" + jid).json()
+        return s if s["state"] in ("done", "failed") else None
+    return r, jid, wait_for(final, timeout)
+
+
 def metric(text, name, labels=None):
     """The value of one sample in Prometheus text, or None."""
     want = name

@@ -13,7 +13,7 @@ import yaml
 from kmtest import (DAEMON, ROOT, SPEC, ContractCase, Daemon, circle_svg,
                     close_to, heavy_morph_body, metric, morph_body, open_arc,
                     raw_exchange, raw_status, schema_errors, component,
-                    wait_for)
+                    run_job, wait_for)
 
 TWO_PI = 2 * math.pi
 
@@ -414,14 +414,8 @@ class MorphTimeLimit(ContractCase):
         self.assertEqual(count(), before + 1)
 
     def test_the_same_morph_as_a_job_is_not_held_to_it(self):
-        r = self.d.request("POST", "/v1/jobs", body=heavy_morph_body(1000))
+        r, _, s = run_job(self.d, heavy_morph_body(1000))
         self.assertEqual(r.status, 202, r.body[:300])
-        jid = r.json()["id"]
-
-        def final():
-            s = self.d.request("GET", "/v1/jobs/" + jid).json()
-            return s if s["state"] in ("done", "failed") else None
-        s = wait_for(final, 15)
         self.assertTrue(s, "the job ends")
         self.assertEqual(s["state"], "done", s)
 

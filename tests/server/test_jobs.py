@@ -5,7 +5,7 @@ import time
 import unittest
 
 from kmtest import (ContractCase, Daemon, close_to, heavy_morph_body, metric,
-                    morph_body, wait_for)
+                    morph_body, run_job, wait_for)
 
 import math
 
@@ -133,14 +133,8 @@ class JobWallTime(ContractCase):
         cls.d.stop()
 
     def test_job_over_its_wall_time_fails_with_a_clear_error(self):
-        r = self.d.request("POST", "/v1/jobs", body=heavy_morph_body(10000))
+        r, jid, s = run_job(self.d, heavy_morph_body(10000))
         self.assertEqual(r.status, 202, r.body[:300])
-        jid = r.json()["id"]
-
-        def final():
-            s = self.d.request("GET", "/v1/jobs/" + jid).json()
-            return s if s["state"] in ("done", "failed") else None
-        s = wait_for(final, 15)
         self.assertTrue(s, "the job ends")
         self.assertEqual(s["state"], "failed")
         self.assertIn("KMORPH_JOB_TIME", s["error"]["detail"])
