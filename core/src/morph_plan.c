@@ -72,7 +72,7 @@ struct km__frame_plan {
   gnode *node;
   size_t nn;
   double chol[NF * NF]; /* Cholesky factor of the closure metric */
-  double c_at[WARM_POINTS + 1][NF]; /* closure corrections at t = k / 6 */
+  double c_at[WARM_POINTS + 1][NF]; /* closure corrections at t = k / WARM_POINTS */
   size_t *corner_at;    /* breaks (1 .. np - 1) that are corners */
   size_t ncorners;
   bool by_corners;      /* closed frames close by their corners */
@@ -259,9 +259,8 @@ static void side_bounds(const side *sd, double r0, double r1, int nd,
   }
 }
 
-/* theta (less the start angle), d theta/dr and d2 theta/dr2 at r, from the
- * piece on the left (side < 0) or the right of r. */
-/* The piece of an input at r from the side side_dir, and u in it. */
+/* The piece of an input at r, from the left (side_dir < 0) or the right
+ * (side_dir > 0) at a break or wherever it falls (0), and u in it. */
 static size_t side_piece_at(const side *sd, double r, int side_dir, double *u) {
   /* r comes from a break of one input divided by its length: times the
    * length it may miss that break by a rounding unit either way */
@@ -274,7 +273,8 @@ static size_t side_piece_at(const side *sd, double r, int side_dir, double *u) {
   return i;
 }
 
-/* theta (less the start angle), and its first two derivatives in r */
+/* theta (less the start angle), d theta/dr and d2 theta/dr2 at r, from the
+ * piece on the side side_dir of r */
 static void side_eval(const side *sd, double r, int side_dir, double v[3]) {
   double u;
   size_t i = side_piece_at(sd, r, side_dir, &u);
@@ -292,18 +292,10 @@ static void side_eval(const side *sd, double r, int side_dir, double v[3]) {
   }
 }
 
-/* theta alone (less the start angle) from the side side_dir */
+/* theta alone (less the start angle) from the side side_dir of r */
 static double side_angle(const side *sd, double r, int side_dir) {
   double u;
   size_t i = side_piece_at(sd, r, side_dir, &u);
-  int dt = sd->theta->degree;
-  return km__bern_eval(sd->theta->c + i * (size_t)(dt + 1), dt, u) - sd->angle;
-}
-
-static double side_theta(const side *sd, double r) {
-  size_t i = km__pp_find(sd->theta, r * sd->L);
-  double a = sd->theta->x[i], h = sd->theta->x[i + 1] - a;
-  double u = fmin(fmax((r * sd->L - a) / h, 0.0), 1.0);
   int dt = sd->theta->degree;
   return km__bern_eval(sd->theta->c + i * (size_t)(dt + 1), dt, u) - sd->angle;
 }
@@ -602,8 +594,8 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
           gnode nd;
           double r = mid + 0.5 * hc * g->x[n][j];
           nd.w = 0.5 * hc * g->w[n][j];
-          nd.ta = side_theta(&sd[0], r);
-          nd.tb = side_theta(&sd[1], r);
+          nd.ta = side_angle(&sd[0], r, 0);
+          nd.tb = side_angle(&sd[1], r, 0);
           basis_at(r, &nd.bi, nd.bv);
           st = vec_push(&nodes, &nd);
         }
@@ -668,29 +660,31 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
      * the polynomial through it, two passes each). One that does not
      * converge is zero, and so are all where corners close the frames
      * (a frame they cannot close takes steps from zero). */
-    double *sum = p->by_corners ? NULL : malloc(frame_scratch(p) * sizeof(double));
-    if (!p->by_corners && !sum) {
-      st = KM_ENOMEM;
-      goto fail;
-    }
-    double c_half[NF] = {0};
-    if (sum) st = close_frame(p, 0.5, 0.0, true, true, c_half, sum, sum + 2 * np);
-    if (st == KM_ENOCONVERGE) {
-      memset(c_half, 0, sizeof c_half);
-      st = KM_OK;
-    }
     memset(p->c_at, 0, sizeof p->c_at);
-    for (int k = 1; k < WARM_POINTS && !st && sum; k++) {
-      double t = (double)k / WARM_POINTS;
-      for (int i = 0; i < NF; i++) p->c_at[k][i] = 4 * t * (1 - t) * c_half[i];
-      st = close_frame(p, t, 0.0, true, true, p->c_at[k], sum, sum + 2 * np);
+    if (!p->by_corners) {
+      double *sum = malloc(frame_scratch(p) * sizeof(double));
+      if (!sum) {
+        st = KM_ENOMEM;
+        goto fail;
+      }
+      double c_half[NF] = {0};
+      st = close_frame(p, 0.5, 0.0, true, true, c_half, sum, sum + 2 * np);
       if (st == KM_ENOCONVERGE) {
-        memset(p->c_at[k], 0, sizeof p->c_at[k]);
+        memset(c_half, 0, sizeof c_half);
         st = KM_OK;
       }
+      for (int k = 1; k < WARM_POINTS && !st; k++) {
+        double t = (double)k / WARM_POINTS;
+        for (int i = 0; i < NF; i++) p->c_at[k][i] = 4 * t * (1 - t) * c_half[i];
+        st = close_frame(p, t, 0.0, true, true, p->c_at[k], sum, sum + 2 * np);
+        if (st == KM_ENOCONVERGE) {
+          memset(p->c_at[k], 0, sizeof p->c_at[k]);
+          st = KM_OK;
+        }
+      }
+      free(sum);
+      if (st) goto fail;
     }
-    free(sum);
-    if (st) goto fail;
   }
   free(atoms.p);
   free(br);
