@@ -32,4 +32,58 @@ static inline void tc_rational_segment_leaving_a_degenerate_leg(km_curve *c) {
   assert_status(km_curve_create(c, 9, 10, kn, cp, w, false, &err), KM_OK);
 }
 
+/* A parabola traced through its vertex as a hairpin: C'(u) = (u - U, E)
+ * on u in [0, 1], so C(u) = (((u - U)^2 - U^2) / 2, E u), moved to
+ * (ox, oy). With U = 1e-3 and E = 1e-6 the curve runs back by U^2 / 2,
+ * turns by pi - 2e-3 within about 1e-6 of the parameter at u = U, and
+ * runs on: its speed sqrt((u - U)^2 + E^2) has a V-shaped dip of that
+ * width, and every Gauss-Legendre node of [0, 1], of its halves and of
+ * their halves lies beyond it, where the speed is the polynomial u - U:
+ * the rules agree on a length U^2 (1e-6) short, the run into the tip and
+ * back lost. The exact length is tc_hairpin_length(0, 1). Written as a
+ * Bezier of degree 2 or, elevated, 3; weight > 0 makes every weight that
+ * (the same curve, through the rational code). */
+#define TC_HAIRPIN_U 1e-3
+#define TC_HAIRPIN_E 1e-6
+/* integral of sqrt(x^2 + E^2) from 0 to x */
+static inline double tc_hairpin_primitive(double x) {
+  const double E = TC_HAIRPIN_E;
+  return 0.5 * x * sqrt(x * x + E * E) + 0.5 * E * E * asinh(x / E);
+}
+/* its arc length between u0 and u1 */
+static inline double tc_hairpin_length(double u0, double u1) {
+  return tc_hairpin_primitive(u1 - TC_HAIRPIN_U) -
+         tc_hairpin_primitive(u0 - TC_HAIRPIN_U);
+}
+static inline void tc_hairpin(km_curve *c, int degree, double weight,
+                              double ox, double oy) {
+  const double U = TC_HAIRPIN_U, E = TC_HAIRPIN_E;
+  /* quadratic Bezier: P1 = P0 + C'(0) / 2 */
+  const double q[3][2] = {{0, 0}, {-0.5 * U, 0.5 * E}, {0.5 - U, E}};
+  double cp[8], kn[8], w[4];
+  int n = degree + 1;
+  for (int k = 0; k < 2; k++) {
+    if (degree == 2) {
+      for (int i = 0; i < 3; i++) cp[2 * i + k] = q[i][k];
+    } else {
+      cp[k] = q[0][k];
+      cp[2 + k] = (q[0][k] + 2 * q[1][k]) / 3;
+      cp[4 + k] = (2 * q[1][k] + q[2][k]) / 3;
+      cp[6 + k] = q[2][k];
+    }
+  }
+  for (int i = 0; i < n; i++) {
+    cp[2 * i] += ox;
+    cp[2 * i + 1] += oy;
+    kn[i] = 0;
+    kn[i + n] = 1;
+    w[i] = weight;
+  }
+  km_error err;
+  km_curve_init(c);
+  assert_status(km_curve_create(c, degree, (size_t)n, kn, cp,
+                                weight > 0 ? w : NULL, false, &err),
+                KM_OK);
+}
+
 #endif

@@ -459,6 +459,30 @@ static void rational_segment_leaving_a_degenerate_leg_has_its_length(
   km_curve_free(&c);
 }
 
+static void hairpin_length_counts_its_tip(void **state) {
+  (void)state;
+  /* curvecases.h: a tip the quadrature's nodes all step over; as a
+   * quadratic and a cubic, with and without (equal) weights, and far from
+   * the origin */
+  const double L = tc_hairpin_length(0, 1), U = TC_HAIRPIN_U;
+  for (int v = 0; v < 6; v++) {
+    km_curve c;
+    double off = v >= 4 ? 1e3 : 0.0;
+    tc_hairpin(&c, 2 + v % 2, (v / 2) % 2 ? 3.0 : 0.0, off, off);
+    /* a few ulps of the coordinates a node, far from the origin */
+    double tol = 1e-13 * L + 64 * 2.2e-16 * off;
+    assert_close(km_curve_length(&c), L, tol);
+    assert_close(km_curve_length_between(&c, 0, 2 * U),
+                 tc_hairpin_length(0, 2 * U), tol);
+    assert_close(km_curve_length_between(&c, 0.5 * U, 0.7),
+                 tc_hairpin_length(0.5 * U, 0.7), tol);
+    /* the point at the arc length of u = 0.5 is u = 0.5 */
+    assert_close(km_curve_param_at_length(&c, tc_hairpin_length(0, 0.5)), 0.5,
+                 1e-9);
+    km_curve_free(&c);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(eval_bezier_t_t2_t3_is_exact),
@@ -476,6 +500,7 @@ int main(void) {
       cmocka_unit_test(length_of_a_point_curve_is_zero),
       cmocka_unit_test(
           rational_segment_leaving_a_degenerate_leg_has_its_length),
+      cmocka_unit_test(hairpin_length_counts_its_tip),
   };
   return cmocka_run_group_tests_name("curve_eval", tests, NULL, NULL);
 }

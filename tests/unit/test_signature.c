@@ -1051,6 +1051,35 @@ static void hairpin_whose_tip_is_rounding_turns_only_once(void **state) {
   km_curve_free(&c);
 }
 
+static void hairpin_signature_counts_its_tip(void **state) {
+  (void)state;
+  /* The hairpin of curvecases.h, whose tip every quadrature node of its
+   * span steps over, as a quadratic and a cubic, with and without
+   * (equal) weights, at the origin and at (1e3, 1e3) where the speed's
+   * rounding loosens what the quadrature is asked: the signature is as
+   * long as the curve, turns as its end tangents do, and ends at its end.
+   * Measured with its tip lost, the length came out U^2 = 1e-6 short (an
+   * open cubic near 1e12 ended 8.8 times its tolerance off the same way) */
+  const double L = tc_hairpin_length(0, 1), U = TC_HAIRPIN_U,
+               E = TC_HAIRPIN_E;
+  const double turn = atan2(E, 1 - U) - atan2(E, -U);
+  for (int v = 0; v < 8; v++) {
+    km_curve c;
+    double off = (v / 4) % 2 ? 1e3 : 0.0, tol = 1e-9;
+    tc_hairpin(&c, 2 + v % 2, (v / 2) % 2 ? 3.0 : 0.0, off, off);
+    km_signature sig;
+    sign_abs(&c, tol, &sig);
+    assert_close(sig.length, L, tol);
+    assert_close(sig.turning, turn, 1e-9);
+    double end[2];
+    signature_end(&sig, end);
+    assert_close(end[0], off + 0.5 - U, 2 * tol);
+    assert_close(end[1], off + E, 2 * tol);
+    km_signature_free(&sig);
+    km_curve_free(&c);
+  }
+}
+
 static void rational_end_in_a_boundary_layer_keeps_its_turn(void **state) {
   (void)state;
   /* A rational cubic at 1e15 whose end weight is 1e-4 of its neighbour's
@@ -1110,6 +1139,7 @@ int main(void) {
           rational_span_leaving_a_degenerate_leg_has_its_exact_length),
       cmocka_unit_test(rational_end_in_a_boundary_layer_keeps_its_turn),
       cmocka_unit_test(hairpin_whose_tip_is_rounding_turns_only_once),
+      cmocka_unit_test(hairpin_signature_counts_its_tip),
   };
   return cmocka_run_group_tests_name("signature", tests, NULL, NULL);
 }
