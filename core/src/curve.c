@@ -748,22 +748,27 @@ static void hodo_restrict(double (*c)[2], int d, double u0, double u1) {
         c[j][q] = (1.0 - v) * c[j][q] + v * c[j + 1][q];
 }
 
+/* Whether the coefficients above the floor lie within 60 degrees of their
+ * sum (any axis serves the bound; this one needs no square roots), and in
+ * *big the largest magnitude. */
 static bool hodo_in_cone(const double (*c)[2], int d, double floor,
                          double *big) {
-  double ex = 0.0, ey = 0.0, n[HODO_MAX];
-  *big = 0.0;
+  double ex = 0.0, ey = 0.0, n2[HODO_MAX], big2 = 0.0, f2 = floor * floor;
   for (int j = 0; j <= d; j++) {
-    n[j] = sqrt(c[j][0] * c[j][0] + c[j][1] * c[j][1]);
-    *big = fmax(*big, n[j]);
-    if (n[j] > floor) {
-      ex += c[j][0] / n[j];
-      ey += c[j][1] / n[j];
+    n2[j] = c[j][0] * c[j][0] + c[j][1] * c[j][1];
+    big2 = fmax(big2, n2[j]);
+    if (n2[j] > f2) {
+      ex += c[j][0];
+      ey += c[j][1];
     }
   }
-  for (int j = 0; j <= d; j++)
-    if (n[j] > floor &&
-        !(c[j][0] * ex + c[j][1] * ey >= 0.5 * n[j] * sqrt(ex * ex + ey * ey)))
-      return false;
+  *big = sqrt(big2);
+  double e2 = ex * ex + ey * ey;
+  for (int j = 0; j <= d; j++) {
+    if (!(n2[j] > f2)) continue;
+    double dot = c[j][0] * ex + c[j][1] * ey;
+    if (!(dot > 0.0 && dot * dot >= 0.25 * n2[j] * e2)) return false;
+  }
   return true;
 }
 
