@@ -488,10 +488,14 @@ static void homogeneous_to_last_step(const km__bspan *sp, double u,
     }
 }
 
-void km__bspan_eval_u(const km__bspan *sp, double u, double pos[2],
-                      double der_u[2]) {
+/* km__bspan_eval_u, and in *wf (if not NULL) the factor by which the
+ * rounding of the points reaches the derivative beyond its polynomial
+ * share (see km__bspan_eval) */
+static void eval_u(const km__bspan *sp, double u, double pos[2],
+                   double der_u[2], double *wf) {
   int p = sp->degree;
   double v = 1.0 - u;
+  if (wf) *wf = 1.0;
   if (!sp->rational && p == 3) {
     /* cubics (every SVG curve): the same de Casteljau steps, unrolled */
     for (int q = 0; q < 2; q++) {
@@ -550,12 +554,18 @@ void km__bspan_eval_u(const km__bspan *sp, double u, double pos[2],
     pos[q] = (v * d[0][q] + u * d[1][q]) / w;
     der_u[q] = f * (d[1][q] / w1 - d[0][q] / w0);
   }
+  if (wf) *wf = f / p;
+}
+
+void km__bspan_eval_u(const km__bspan *sp, double u, double pos[2],
+                      double der_u[2]) {
+  eval_u(sp, u, pos, der_u, NULL);
 }
 
 void km__bspan_eval(const km__bspan *sp, double t, double pos[2],
-                    double der[2]) {
+                    double der[2], double *wf) {
   double len = sp->b - sp->a;
-  km__bspan_eval_u(sp, (t - sp->a) / len, pos, der);
+  eval_u(sp, (t - sp->a) / len, pos, der, wf);
   der[0] /= len;
   der[1] /= len;
 }
@@ -683,169 +693,205 @@ static double span_rec(span_quad *q, double a, double b, double whole,
          span_rec(q, m, b, r, nr, 0.5 * abs_tol, depth + 1, budget);
 }
 
-/* ---- where the speed nearly vanishes inside a span -------------------
+/* ---- where the quadrature must not step over a feature ----------------
  *
  * Adaptive quadrature judges a length by comparing rules, and two rules
  * agree on a wrong value when the speed has a feature narrower than the
- * spacing of both rules' nodes. The worst is a hairpin: C' passes close by
- * zero, so |C'| has a V-shaped dip (the tangent turns by nearly pi within
- * it). Where no node lands in the dip, every rule integrates the smooth
- * branch on one side across it, and the curve's excursion into the tip
- * and back is lost: an open cubic near 1e12 whose span turns back on
- * itself 5e-4 of the span from its start was measured 2,503 too short
- * (1.6e-6 of it) at every depth, its nodes all beyond the tip.
- * Such a dip is found from the hodograph, not by sampling: dC/du is N(u)
- * / w(u)^2 with N a polynomial in Bernstein form (degree p - 1 without
- * weights; 2p - 1 with them, N = A' w - A w' for the homogeneous numerator
- * A taken about the span's first point, whose large coordinates would
- * otherwise cancel). Where N's coefficients lie in a cone of half-angle
- * 60 degrees, |C'| is at least half of a polynomial with non-negative
- * coefficients over w^2 and has no dip; elsewhere the interval is halved
- * (de Casteljau on N) until its parts pass, and where a part fails whose
- * halves pass, their common end is a point the quadrature must not step
- * over. A smoothly turning span (a semicircle) passes after a halving or
- * two; only a real dip goes deep. */
+ * spacing of both rules' nodes. Two such features are found from the
+ * span's Bernstein coefficients rather than by sampling:
+ *   - A hairpin: C' passes close by zero, and |C'| has a V-shaped dip (the
+ *     tangent turns by nearly pi within it). Where no node lands in the
+ *     dip, every rule integrates the smooth branch on one side across it
+ *     and the run into the tip and back is lost: an open cubic near 1e12
+ *     whose span turns back 5e-4 of the span from its start was measured
+ *     2,503 too short (1.6e-6 of it) at every depth, its nodes all beyond
+ *     the tip. dC/du is N(u) / w(u)^2 with N a polynomial in Bernstein form
+ *     (degree p - 1 without weights; 2p - 1 with them, N = A' w - A w' for
+ *     the homogeneous numerator A taken about the span's first point,
+ *     whose large coordinates would otherwise cancel). Where N's
+ *     coefficients lie in a cone of half-angle 60 degrees, |C'| is at
+ *     least half of a polynomial with non-negative coefficients over w^2
+ *     and has no dip; elsewhere the interval is halved (de Casteljau)
+ *     until its parts pass, and where a part fails whose halves pass,
+ *     their common end is a break. A smooth turn (a semicircle) passes
+ *     after a halving or two, and the first three halvings are wide
+ *     enough for the rules' nodes to sample what lies in them; only a
+ *     real dip goes deep. Split there, the dip's wrong branch (beyond the
+ *     point where the tangent has turned through 60 degrees from its
+ *     least speed) is some |C'|min / |C''| wide and costs about
+ *     |C'|min^2 / |C''|: second order in the least speed.
+ *   - A boundary layer: where a small weight meets a large one, w has a
+ *     zero just outside the interval, and the curve leaves the small
+ *     weight's point within a part of u about as narrow as their ratio is
+ *     large: a degree-9 segment at 1e6 whose weights jump from 0.1 to 300
+ *     at a degenerate leg was measured 7.7e-7 short (its nodes all beyond
+ *     the layer). Where w's coefficients on a part differ by more than a
+ *     factor 4, w's zero is at least about as far from the part as the
+ *     part is wide, and the rules converge honestly; elsewhere the part is
+ *     halved and every halving is a break, so parts shrink geometrically
+ *     toward the layer. */
 #define HODO_MAX (2 * KM__BSPAN_MAX)
-#define KINK_VISITS 4096
-#define KINKS_MAX 32
+#define PART_VISITS 4096
+#define BREAKS_MAX 256
 
-typedef struct kink_search {
-  double floor;  /* coefficients below this are rounding: no direction */
-  double tiny;   /* a part this short in length is not halved further */
-  double wmin2;  /* the least weight squared: |C'| <= max |N_j| / wmin2 */
+typedef struct part_search {
+  double floor; /* N's coefficients below this are rounding: no direction */
+  double tiny;  /* a part this short in length is not halved further */
+  int dn, dw;   /* the degrees of N and of w */
   int visits;
-  size_t n, max;
-  double *out;
-} kink_search;
+  size_t n;
+  double out[BREAKS_MAX];
+} part_search;
 
-/* split N (degree d) at the middle: left half into l, right into r */
-static void hodo_halves(const double (*c)[2], int d, double (*l)[2],
-                        double (*r)[2]) {
-  double t[HODO_MAX][2];
-  memcpy(t, c, sizeof(double) * 2 * (size_t)(d + 1));
+/* Bernstein coefficients c (degree d, dim values each) of [0, 1/2] into l
+ * and of [1/2, 1] into r */
+static void bern_halves(const double *c, int d, int dim, double *l,
+                        double *r) {
+  double t[HODO_MAX * 2];
+  memcpy(t, c, sizeof(double) * (size_t)(dim * (d + 1)));
   for (int k = 0; k <= d; k++) {
-    l[k][0] = t[0][0];
-    l[k][1] = t[0][1];
-    r[d - k][0] = t[d - k][0];
-    r[d - k][1] = t[d - k][1];
-    for (int j = 0; j < d - k; j++) {
-      t[j][0] = 0.5 * (t[j][0] + t[j + 1][0]);
-      t[j][1] = 0.5 * (t[j][1] + t[j + 1][1]);
+    for (int q = 0; q < dim; q++) {
+      l[k * dim + q] = t[q];
+      r[(d - k) * dim + q] = t[(d - k) * dim + q];
     }
+    for (int j = 0; j < d - k; j++)
+      for (int q = 0; q < dim; q++)
+        t[j * dim + q] = 0.5 * (t[j * dim + q] + t[(j + 1) * dim + q]);
   }
 }
 
-/* N on [u0, u1] of [0, 1]: two de Casteljau steps */
-static void hodo_restrict(double (*c)[2], int d, double u0, double u1) {
+/* c on [u0, u1] of [0, 1]: two de Casteljau steps */
+static void bern_restrict(double *c, int d, int dim, double u0, double u1) {
   for (int r = 1; r <= d; r++) /* keep [0, u1] */
     for (int j = d; j >= r; j--)
-      for (int q = 0; q < 2; q++)
-        c[j][q] = (1.0 - u1) * c[j - 1][q] + u1 * c[j][q];
+      for (int q = 0; q < dim; q++)
+        c[j * dim + q] = (1.0 - u1) * c[(j - 1) * dim + q] + u1 * c[j * dim + q];
   double v = u1 > 0 ? u0 / u1 : 0.0;
   for (int r = 1; r <= d; r++) /* and of that [v, 1] */
     for (int j = 0; j <= d - r; j++)
-      for (int q = 0; q < 2; q++)
-        c[j][q] = (1.0 - v) * c[j][q] + v * c[j + 1][q];
+      for (int q = 0; q < dim; q++)
+        c[j * dim + q] = (1.0 - v) * c[j * dim + q] + v * c[(j + 1) * dim + q];
 }
 
-/* Whether the coefficients above the floor lie within 60 degrees of their
+/* Whether N's coefficients above the floor lie within 60 degrees of their
  * sum (any axis serves the bound; this one needs no square roots), and in
  * *big the largest magnitude. */
-static bool hodo_in_cone(const double (*c)[2], int d, double floor,
-                         double *big) {
+static bool hodo_in_cone(const double *c, int d, double floor, double *big) {
   double ex = 0.0, ey = 0.0, n2[HODO_MAX], big2 = 0.0, f2 = floor * floor;
   for (int j = 0; j <= d; j++) {
-    n2[j] = c[j][0] * c[j][0] + c[j][1] * c[j][1];
+    n2[j] = c[2 * j] * c[2 * j] + c[2 * j + 1] * c[2 * j + 1];
     big2 = fmax(big2, n2[j]);
     if (n2[j] > f2) {
-      ex += c[j][0];
-      ey += c[j][1];
+      ex += c[2 * j];
+      ey += c[2 * j + 1];
     }
   }
   *big = sqrt(big2);
   double e2 = ex * ex + ey * ey;
   for (int j = 0; j <= d; j++) {
     if (!(n2[j] > f2)) continue;
-    double dot = c[j][0] * ex + c[j][1] * ey;
+    double dot = c[2 * j] * ex + c[2 * j + 1] * ey;
     if (!(dot > 0.0 && dot * dot >= 0.25 * n2[j] * e2)) return false;
   }
   return true;
 }
 
-/* True where N's coefficients on [a, b] lie in the cone. A part that fails
- * while both its halves pass holds the dip (or a smooth turn of over 120
- * degrees, which is harmless): its middle is recorded, except for the
- * first three halvings, whose parts are wide enough that the rules' nodes
- * sample whatever lies in them. Split there, the dip's wrong branch, the
- * part of it beyond the point where the tangent has turned through 60
- * degrees from its least speed, is some |C'|min / |C''| wide and costs
- * about |C'|min^2 / |C''| - second order in the least speed. */
-static bool find_kinks(kink_search *ks, const double (*c)[2], int d,
-                       double a, double b, int depth) {
-  double big;
-  if (hodo_in_cone(c, d, ks->floor, &big)) return true;
-  if (++ks->visits > KINK_VISITS) return true; /* noise: nothing to find */
+static void add_break(part_search *ps, double u) {
+  if (ps->n < BREAKS_MAX) ps->out[ps->n++] = u;
+}
+
+/* N (n) and w (w, NULL without weights) on the part [a, b]: true where it
+ * needs no break inside */
+static bool find_breaks(part_search *ps, const double *n, const double *w,
+                        double a, double b, int depth) {
+  double big, wlo = 1.0, whi = 1.0;
+  if (w) {
+    wlo = whi = w[0];
+    for (int j = 1; j <= ps->dw; j++) {
+      wlo = fmin(wlo, w[j]);
+      whi = fmax(whi, w[j]);
+    }
+  }
+  bool cone = hodo_in_cone(n, ps->dn, ps->floor, &big);
+  bool layer = whi > 4.0 * wlo;
+  if ((cone && !layer) || ++ps->visits > PART_VISITS) return true;
   double m = 0.5 * (a + b);
-  if ((b - a) * big / ks->wmin2 <= ks->tiny || depth >= 60 ||
+  if ((b - a) * big / (wlo * wlo) <= ps->tiny || depth >= 60 ||
       b - a <= 1024 * DBL_EPSILON * fmax(fabs(a), fabs(b))) {
-    if (depth >= 3 && ks->n < ks->max) ks->out[ks->n++] = m;
+    if (depth >= 3 || layer) add_break(ps, m);
     return false;
   }
-  double l[HODO_MAX][2], r[HODO_MAX][2];
-  hodo_halves(c, d, l, r);
-  bool lp = find_kinks(ks, (const double(*)[2])l, d, a, m, depth + 1);
-  bool rp = find_kinks(ks, (const double(*)[2])r, d, m, b, depth + 1);
-  if (lp && rp && depth >= 3 && ks->n < ks->max) ks->out[ks->n++] = m;
+  double nl[HODO_MAX * 2], nr[HODO_MAX * 2], wl[KM__BSPAN_MAX],
+      wr[KM__BSPAN_MAX];
+  bern_halves(n, ps->dn, 2, nl, nr);
+  if (w) bern_halves(w, ps->dw, 1, wl, wr);
+  size_t before = ps->n;
+  bool lp = find_breaks(ps, nl, w ? wl : NULL, a, m, depth + 1);
+  bool rp = find_breaks(ps, nr, w ? wr : NULL, m, b, depth + 1);
+  if (layer || (lp && rp && depth >= 3)) {
+    /* in order: the left half's breaks stand before the right half's */
+    size_t k = before;
+    while (k < ps->n && ps->out[k] < m) k++;
+    if (ps->n < BREAKS_MAX) {
+      memmove(ps->out + k + 1, ps->out + k, (ps->n - k) * sizeof(double));
+      ps->out[k] = m;
+      ps->n++;
+    }
+  }
   return false;
 }
 
-/* Points of (u0, u1), in order, where the span's speed dips close to zero,
- * found down to parts no longer than tiny: at most max of them in out. */
-static size_t span_kinks(const km__bspan *sp, double u0, double u1,
-                         double tiny, double *out, size_t max) {
+/* The breaks of (u0, u1), in order, down to parts no longer than tiny:
+ * ps->out[0 .. ps->n). */
+static void span_breaks(const km__bspan *sp, double u0, double u1,
+                        double tiny, part_search *ps) {
   int p = sp->degree, d;
-  double c[HODO_MAX][2], wmin = INFINITY, wmax = 0.0;
-  if (!(u1 > u0) || max == 0) return 0;
+  double c[HODO_MAX * 2], w[KM__BSPAN_MAX], wmax = 0.0;
+  ps->n = 0;
+  ps->visits = 0;
+  if (!(u1 > u0)) return;
   for (int k = 0; k <= p; k++) {
-    wmin = fmin(wmin, sp->h[k][2]);
-    wmax = fmax(wmax, sp->h[k][2]);
+    w[k] = sp->h[k][2];
+    wmax = fmax(wmax, w[k]);
   }
   if (!sp->rational) {
     d = p - 1;
     for (int j = 0; j < p; j++)
       for (int q = 0; q < 2; q++)
-        c[j][q] = p * (sp->h[j + 1][q] - sp->h[j][q]);
+        c[2 * j + q] = p * (sp->h[j + 1][q] - sp->h[j][q]);
   } else {
     /* N_k = sum over i + j = k of C(p-1, i) C(p, j) / C(2p-1, k)
      * (dA_i w_j - dw_i A_j), the product rule of Bernstein forms */
-    double A[KM__BSPAN_MAX][2], w[KM__BSPAN_MAX];
+    double A[KM__BSPAN_MAX][2];
     double ox = sp->h[0][0] / sp->h[0][2], oy = sp->h[0][1] / sp->h[0][2];
     for (int j = 0; j <= p; j++) {
-      w[j] = sp->h[j][2];
       A[j][0] = sp->h[j][0] - w[j] * ox;
       A[j][1] = sp->h[j][1] - w[j] * oy;
     }
     d = 2 * p - 1;
-    for (int k = 0; k <= d; k++) c[k][0] = c[k][1] = 0.0;
+    for (int k = 0; k <= 2 * d + 1; k++) c[k] = 0.0;
     for (int i = 0; i < p; i++) {
       double dax = p * (A[i + 1][0] - A[i][0]), day = p * (A[i + 1][1] - A[i][1]);
       double dw = p * (w[i + 1] - w[i]);
       for (int j = 0; j <= p; j++) {
         double f = km__binomial[p - 1][i] * km__binomial[p][j] /
                    km__binomial[d][i + j];
-        c[i + j][0] += f * (dax * w[j] - dw * A[j][0]);
-        c[i + j][1] += f * (day * w[j] - dw * A[j][1]);
+        c[2 * (i + j)] += f * (dax * w[j] - dw * A[j][0]);
+        c[2 * (i + j) + 1] += f * (day * w[j] - dw * A[j][1]);
       }
     }
   }
-  if (u0 > 0.0 || u1 < 1.0) hodo_restrict(c, d, u0, u1);
+  if (u0 > 0.0 || u1 < 1.0) {
+    bern_restrict(c, d, 2, u0, u1);
+    bern_restrict(w, p, 1, u0, u1);
+  }
   /* the rounding of N: that of the points (km__bspan_noise, over p) times
    * p and the weights' scale twice */
-  double wscale = sp->rational ? wmax * wmax : 1.0;
-  kink_search ks = {km__bspan_noise(sp) * wscale, tiny,
-                    sp->rational ? wmin * wmin : 1.0, 0, 0, max, out};
-  find_kinks(&ks, (const double(*)[2])c, d, u0, u1, 0);
-  return ks.n;
+  ps->floor = km__bspan_noise(sp) * (sp->rational ? wmax * wmax : 1.0);
+  ps->tiny = tiny;
+  ps->dn = d;
+  ps->dw = p;
+  find_breaks(ps, c, sp->rational ? w : NULL, u0, u1, 0);
 }
 
 double km__bspan_length_counted(const km__bspan *sp, double u0, double u1,
@@ -866,13 +912,14 @@ double km__bspan_length_counted(const km__bspan *sp, double u0, double u1,
   double noise = km__bspan_noise(sp);
   span_quad q = {sp, noise / sp->degree, 0};
   double tol = fmax(abs_tol, noise * (u1 - u0) * fmin(ratio, 4.0));
-  /* the rule must not step over a hairpin's tip: parts end there */
-  double kinks[KINKS_MAX];
-  size_t nk = span_kinks(sp, u0, u1, 0.0625 * tol, kinks, KINKS_MAX);
+  /* the rules must not step over a hairpin's tip or a boundary layer:
+   * parts end there */
+  part_search ps;
+  span_breaks(sp, u0, u1, 0.0625 * tol, &ps);
   double len = 0.0, a = u0;
-  long budget = 256;
-  for (size_t i = 0; i <= nk; i++) {
-    double b = i < nk ? kinks[i] : u1, wn;
+  long budget = 256 + 8 * (long)ps.n;
+  for (size_t i = 0; i <= ps.n; i++) {
+    double b = i < ps.n ? ps.out[i] : u1, wn;
     if (!(b > a)) continue;
     double whole = span_gl16(&q, a, b, &wn);
     len += span_rec(&q, a, b, whole, wn, tol * ((b - a) / (u1 - u0)), 0,

@@ -59,9 +59,13 @@ typedef struct km__bspan {
 } km__bspan;
 /* Fill sp with span [knots[i], knots[i+1]] of c (a non-empty span). */
 void km__bspan_make(km__bspan *sp, const km_curve *c, size_t i);
-/* Position and derivative with respect to t at t in [a, b]. */
+/* Position and derivative with respect to t at t in [a, b]; in *wf (if
+ * not NULL) the weight factor w0 w1 / w^2 of the last de Casteljau step
+ * (1 without weights): the derivative carries km__bspan_noise times that
+ * of rounding, which near a small weight beside a large one is many times
+ * the polynomial share. */
 void km__bspan_eval(const km__bspan *sp, double t, double pos[2],
-                    double der[2]);
+                    double der[2], double *wf);
 /* The same in the span's variable u = (t - a) / (b - a) in [0, 1]. */
 void km__bspan_eval_u(const km__bspan *sp, double u, double pos[2],
                       double der_u[2]);

@@ -591,19 +591,24 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
   dir[0][1] = dir_a[1];
   dir[NPTS - 1][0] = dir_b[0];
   dir[NPTS - 1][1] = dir_b[1];
-  double speed[NPTS], F[NPTS];
+  double speed[NPTS], F[NPTS], rounding[NPTS];
   for (int k = 0; k < NPTS; k++) {
-    double d[2][2];
-    km__bspan_eval(&b->span, t[k], d[0], d[1]);
+    double d[2][2], wf;
+    km__bspan_eval(&b->span, t[k], d[0], d[1], &wf);
     double n = sqrt(d[1][0] * d[1][0] + d[1][1] * d[1][1]);
     speed[k] = n;
+    /* the rounding of C' here: the points' times the weight factor of a
+     * rational span (at 1e6, where a weight of 0.1 meets one of 100, a
+     * thousand times the polynomial share: directions there spun three
+     * whole turns within 1e-10 of t and were refused as a cusp) */
+    rounding[k] = b->deriv_noise * fmax(wf, 1.0);
     if (k == 0 || k == NPTS - 1) continue;
     /* C' well above its rounding error is the tangent, however small;
      * below that its direction is noise (the speed vanishes there in
      * exact arithmetic, or nearly), and the last reliable direction
      * stands in: across such a stretch, far shorter than the rounding of
      * the coordinates, only the turn between its ends counts */
-    if (n > 16.0 * b->deriv_noise) {
+    if (n > 16.0 * rounding[k]) {
       dir[k][0] = d[1][0] / n;
       dir[k][1] = d[1][1] / n;
     } else {
@@ -616,7 +621,7 @@ static km_status fit_piece(builder *b, double ua, double ub, double known_len,
    * would only bisect into noise. */
   double noise = 0.0;
   for (int k = 0; k < NPTS; k++)
-    if (speed[k] > 0) noise = fmax(noise, b->deriv_noise / speed[k]);
+    if (speed[k] > 0) noise = fmax(noise, rounding[k] / speed[k]);
   if (noise > 0.1) noise = 0.1;
   /* unwrap, watching for steps too large to interpolate */
   bool coarse = false;

@@ -105,7 +105,7 @@ static void bezier_span_evaluation_agrees_with_de_boor(void **state) {
           km__bspan_make(&sp, &c, i);
           for (int k = 0; k <= 10; k++) {
             double t = kn[i] + (kn[i + 1] - kn[i]) * k / 10.0, pos[2], der[2], d[2][2];
-            km__bspan_eval(&sp, t, pos, der);
+            km__bspan_eval(&sp, t, pos, der, NULL);
             km_curve_eval_side(&c, t, k == 10 ? -1 : 1, 1, d);
             double scale = 1 + off;
             for (int q = 0; q < 2; q++) {

@@ -997,19 +997,28 @@ static void turn_below_rounding_at_a_knot_counts_at_tight_tolerance(
 static void rational_span_leaving_a_degenerate_leg_has_its_exact_length(
     void **state) {
   (void)state;
-  /* the segment of curvecases.h */
-  km_curve c;
-  tc_rational_segment_leaving_a_degenerate_leg(&c);
-  const double tol = 1e-6;
-  km_signature sig;
-  sign_abs(&c, tol, &sig);
-  assert_close(sig.length, sqrt(1.25), tol);
-  double end[2];
-  signature_end(&sig, end);
-  assert_close(end[0], 1e6 + 1, tol);
-  assert_close(end[1], 1e6 + 0.5, tol);
-  km_signature_free(&sig);
-  km_curve_free(&c);
+  /* the segment of curvecases.h, its boundary layer narrower as w1 grows,
+   * at a loose tolerance and at one below the rounding floor at 1e6 (16 p
+   * ulps of 1e6, 3.2e-8, which the signature keeps to): a straight
+   * segment, however its directions are rounded where it leaves its
+   * start, is no cusp */
+  const double w1s[4] = {100, 300, 1000, 10000}, tols[2] = {1e-6, 1e-9};
+  const double floor = 16 * 9 * 2.220446049250313e-16 * (1e6 + 1);
+  for (int i = 0; i < 8; i++) {
+    km_curve c;
+    tc_rational_segment_leaving_a_degenerate_leg(&c, w1s[i / 2]);
+    double tol = tols[i % 2], promised = fmax(tol, floor);
+    km_signature sig;
+    sign_abs(&c, tol, &sig);
+    assert_close(sig.length, sqrt(1.25), promised);
+    assert_close(sig.turning, 0.0, 1e-9);
+    double end[2];
+    signature_end(&sig, end);
+    assert_close(end[0], 1e6 + 1, 2 * promised);
+    assert_close(end[1], 1e6 + 0.5, 2 * promised);
+    km_signature_free(&sig);
+    km_curve_free(&c);
+  }
 }
 
 static void hairpin_whose_tip_is_rounding_turns_only_once(void **state) {
