@@ -374,7 +374,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
                       NULL) != KM_OK)
     goto done;
 
-  if (getenv("FUZZ_CURVES_VERBOSE") != NULL) {
+  bool verbose = getenv("FUZZ_CURVES_VERBOSE") != NULL;
+  if (verbose) {
     fprintf(stderr, "family %u degree %d n %zu closed %d rational %d "
             "scale %g offset %g flags 0x%02x\n", family % 6, degree, n,
             (int)closed, (int)rational, scale, offset, flags);
@@ -402,7 +403,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   km_error err;
   clock_t c0 = clock();
   km_status sst = km_signature_compute(&c, tol, &sig, &err);
-  if (getenv("FUZZ_CURVES_VERBOSE") != NULL)
+  if (verbose)
     fprintf(stderr, "tol %g signature %s in %.3f s, length %.17g, %zu "
             "kappa knots\n", tol, km_status_name(sst),
             (double)(clock() - c0) / CLOCKS_PER_SEC, sig.length,
@@ -421,7 +422,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
                               max_abs(c.cp, 2 * c.n));
   double bound = -1;
   int rdeg = (flags & 8) ? 5 : 3;
-  if (km_reconstruct(&sig, rdeg, tol, &rc, &bound, &err) == KM_OK)
+  c0 = clock();
+  km_status rst = km_reconstruct(&sig, rdeg, tol, &rc, &bound, &err);
+  if (verbose)
+    fprintf(stderr, "reconstruct (degree %d) %s in %.3f s, %zu points\n", rdeg,
+            km_status_name(rst), (double)(clock() - c0) / CLOCKS_PER_SEC,
+            rst == KM_OK ? rc.n : (size_t)0);
+  if (rst == KM_OK)
     check_reconstruction(&c, &sig, sig_tol, &rc, bound,
                          max_abs(c.cp, 2 * c.n) + L);
 
@@ -430,12 +437,22 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
    * pieces err by h^4 max|theta'''| / 384): counted from 1e-8 of the
    * scale, where the bound above was measured (a rational cubic of 44
    * points at 1e-13 took 1.5-2.2 s with its morph, 6,615 signature
-   * pieces) */
-  double fine = tol > 0 ? pow(1e-8 * scale / tol, 0.25) : 1.0;
+   * pieces), and of the length for the tolerance the morph keeps (raised
+   * to its floors), whichever is finer: a closed quartic with degenerate
+   * legs jumping across its box is 6 to 10 times longer than the box's
+   * half-width, and at 1e-13 of its length took 2.2 s with its morph (24
+   * points). */
+  double fine = fmax(tol > 0 ? pow(1e-8 * scale / tol, 0.25) : 1.0,
+                     pow(1e-8 * L / sig_tol, 0.25));
   double morph_work = (double)n * (degree + 1) * (degree + 1) *
                       (rational ? 2 : 1) * fmax(fine, 1.0);
-  if (morph_work <= MAX_MORPH_WORK && (flags & 0x10))
+  if (morph_work <= MAX_MORPH_WORK && (flags & 0x10)) {
+    c0 = clock();
     run_morph(r, &c, &sig, flags, tol);
+    if (verbose)
+      fprintf(stderr, "morph in %.3f s\n",
+              (double)(clock() - c0) / CLOCKS_PER_SEC);
+  }
 
 done:
   km_curve_free(&rc);
