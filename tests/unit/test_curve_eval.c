@@ -469,7 +469,7 @@ static void hairpin_length_counts_its_tip(void **state) {
    * quadratic and a cubic, with and without (equal) weights, and far from
    * the origin */
   const double L = tc_hairpin_length(0, 1), U = TC_HAIRPIN_U;
-  for (int v = 0; v < 6; v++) {
+  for (int v = 0; v < 8; v++) {
     km_curve c;
     double off = v >= 4 ? 1e3 : 0.0;
     tc_hairpin(&c, 2 + v % 2, (v / 2) % 2 ? 3.0 : 0.0, off, off);
