@@ -743,76 +743,58 @@ typedef struct part_search {
   double out[BREAKS_MAX];
 } part_search;
 
-/* Bernstein coefficients c (degree d, dim values each) of [0, 1/2] into l
- * and of [1/2, 1] into r */
-static void bern_halves(const double *c, int d, int dim, double *l,
-                        double *r) {
-  double t[HODO_MAX * 2];
-  memcpy(t, c, sizeof(double) * (size_t)(dim * (d + 1)));
-  for (int k = 0; k <= d; k++) {
-    for (int q = 0; q < dim; q++) {
-      l[k * dim + q] = t[q];
-      r[(d - k) * dim + q] = t[(d - k) * dim + q];
-    }
-    for (int j = 0; j < d - k; j++)
-      for (int q = 0; q < dim; q++)
-        t[j * dim + q] = 0.5 * (t[j * dim + q] + t[(j + 1) * dim + q]);
-  }
-}
-
-/* c on [u0, u1] of [0, 1]: two de Casteljau steps */
-static void bern_restrict(double *c, int d, int dim, double u0, double u1) {
-  for (int r = 1; r <= d; r++) /* keep [0, u1] */
-    for (int j = d; j >= r; j--)
-      for (int q = 0; q < dim; q++)
-        c[j * dim + q] = (1.0 - u1) * c[(j - 1) * dim + q] + u1 * c[j * dim + q];
-  double v = u1 > 0 ? u0 / u1 : 0.0;
-  for (int r = 1; r <= d; r++) /* and of that [v, 1] */
-    for (int j = 0; j <= d - r; j++)
-      for (int q = 0; q < dim; q++)
-        c[j * dim + q] = (1.0 - v) * c[j * dim + q] + v * c[(j + 1) * dim + q];
-}
+/* N (x, y) and w in Bernstein form on a part of the span */
+typedef struct part {
+  double x[HODO_MAX], y[HODO_MAX], w[KM__BSPAN_MAX];
+} part;
 
 /* Whether N's coefficients above the floor lie within 60 degrees of their
  * sum (any axis serves the bound; this one needs no square roots), and in
  * *big the largest magnitude. */
-static bool hodo_in_cone(const double *c, int d, double floor, double *big) {
+static bool hodo_in_cone(const part *pt, int d, double floor, double *big) {
   double ex = 0.0, ey = 0.0, n2[HODO_MAX], big2 = 0.0, f2 = floor * floor;
   for (int j = 0; j <= d; j++) {
-    n2[j] = c[2 * j] * c[2 * j] + c[2 * j + 1] * c[2 * j + 1];
+    n2[j] = pt->x[j] * pt->x[j] + pt->y[j] * pt->y[j];
     big2 = fmax(big2, n2[j]);
     if (n2[j] > f2) {
-      ex += c[2 * j];
-      ey += c[2 * j + 1];
+      ex += pt->x[j];
+      ey += pt->y[j];
     }
   }
   *big = sqrt(big2);
   double e2 = ex * ex + ey * ey;
   for (int j = 0; j <= d; j++) {
     if (!(n2[j] > f2)) continue;
-    double dot = c[2 * j] * ex + c[2 * j + 1] * ey;
+    double dot = pt->x[j] * ex + pt->y[j] * ey;
     if (!(dot > 0.0 && dot * dot >= 0.25 * n2[j] * e2)) return false;
   }
   return true;
+}
+
+static void restrict_part(const part_search *ps, const part *pt, bool weights,
+                          double u0, double u1, part *out) {
+  km__bern_restrict(pt->x, ps->dn, u0, u1, out->x);
+  km__bern_restrict(pt->y, ps->dn, u0, u1, out->y);
+  if (weights) km__bern_restrict(pt->w, ps->dw, u0, u1, out->w);
 }
 
 static void add_break(part_search *ps, double u) {
   if (ps->n < BREAKS_MAX) ps->out[ps->n++] = u;
 }
 
-/* N (n) and w (w, NULL without weights) on the part [a, b]: true where it
- * needs no break inside */
-static bool find_breaks(part_search *ps, const double *n, const double *w,
+/* The part [a, b] (weights: whether w counts): true where it needs no
+ * break inside */
+static bool find_breaks(part_search *ps, const part *pt, bool weights,
                         double a, double b, int depth) {
   double big, wlo = 1.0, whi = 1.0;
-  if (w) {
-    wlo = whi = w[0];
+  if (weights) {
+    wlo = whi = pt->w[0];
     for (int j = 1; j <= ps->dw; j++) {
-      wlo = fmin(wlo, w[j]);
-      whi = fmax(whi, w[j]);
+      wlo = fmin(wlo, pt->w[j]);
+      whi = fmax(whi, pt->w[j]);
     }
   }
-  bool cone = hodo_in_cone(n, ps->dn, ps->floor, &big);
+  bool cone = hodo_in_cone(pt, ps->dn, ps->floor, &big);
   bool layer = whi > 4.0 * wlo;
   if ((cone && !layer) || ++ps->visits > PART_VISITS) return true;
   double m = 0.5 * (a + b);
@@ -821,13 +803,12 @@ static bool find_breaks(part_search *ps, const double *n, const double *w,
     if (depth >= 3 || layer) add_break(ps, m);
     return false;
   }
-  double nl[HODO_MAX * 2], nr[HODO_MAX * 2], wl[KM__BSPAN_MAX],
-      wr[KM__BSPAN_MAX];
-  bern_halves(n, ps->dn, 2, nl, nr);
-  if (w) bern_halves(w, ps->dw, 1, wl, wr);
+  part half;
   size_t before = ps->n;
-  bool lp = find_breaks(ps, nl, w ? wl : NULL, a, m, depth + 1);
-  bool rp = find_breaks(ps, nr, w ? wr : NULL, m, b, depth + 1);
+  restrict_part(ps, pt, weights, 0.0, 0.5, &half);
+  bool lp = find_breaks(ps, &half, weights, a, m, depth + 1);
+  restrict_part(ps, pt, weights, 0.5, 1.0, &half);
+  bool rp = find_breaks(ps, &half, weights, m, b, depth + 1);
   if (layer || (lp && rp && depth >= 3)) {
     /* in order: the left half's breaks stand before the right half's */
     size_t k = before;
@@ -841,57 +822,49 @@ static bool find_breaks(part_search *ps, const double *n, const double *w,
   return false;
 }
 
-/* The breaks of (u0, u1), in order, down to parts no longer than tiny:
- * ps->out[0 .. ps->n). */
+/* The breaks of (u0, u1), in order, down to parts no longer than tiny,
+ * where N's coefficients below floor are rounding: ps->out[0 .. ps->n). */
 static void span_breaks(const km__bspan *sp, double u0, double u1,
-                        double tiny, part_search *ps) {
-  int p = sp->degree, d;
-  double c[HODO_MAX * 2], w[KM__BSPAN_MAX], wmax = 0.0;
+                        double floor, double tiny, part_search *ps) {
+  int p = sp->degree;
+  part whole, pt;
   ps->n = 0;
   ps->visits = 0;
-  if (!(u1 > u0)) return;
-  for (int k = 0; k <= p; k++) {
-    w[k] = sp->h[k][2];
-    wmax = fmax(wmax, w[k]);
-  }
+  for (int k = 0; k <= p; k++) whole.w[k] = sp->h[k][2];
   if (!sp->rational) {
-    d = p - 1;
-    for (int j = 0; j < p; j++)
-      for (int q = 0; q < 2; q++)
-        c[2 * j + q] = p * (sp->h[j + 1][q] - sp->h[j][q]);
+    ps->dn = p - 1;
+    for (int j = 0; j < p; j++) {
+      whole.x[j] = p * (sp->h[j + 1][0] - sp->h[j][0]);
+      whole.y[j] = p * (sp->h[j + 1][1] - sp->h[j][1]);
+    }
   } else {
     /* N_k = sum over i + j = k of C(p-1, i) C(p, j) / C(2p-1, k)
      * (dA_i w_j - dw_i A_j), the product rule of Bernstein forms */
+    const double *w = whole.w;
     double A[KM__BSPAN_MAX][2];
     double ox = sp->h[0][0] / sp->h[0][2], oy = sp->h[0][1] / sp->h[0][2];
     for (int j = 0; j <= p; j++) {
       A[j][0] = sp->h[j][0] - w[j] * ox;
       A[j][1] = sp->h[j][1] - w[j] * oy;
     }
-    d = 2 * p - 1;
-    for (int k = 0; k <= 2 * d + 1; k++) c[k] = 0.0;
+    int d = ps->dn = 2 * p - 1;
+    for (int k = 0; k <= d; k++) whole.x[k] = whole.y[k] = 0.0;
     for (int i = 0; i < p; i++) {
       double dax = p * (A[i + 1][0] - A[i][0]), day = p * (A[i + 1][1] - A[i][1]);
       double dw = p * (w[i + 1] - w[i]);
       for (int j = 0; j <= p; j++) {
         double f = km__binomial[p - 1][i] * km__binomial[p][j] /
                    km__binomial[d][i + j];
-        c[2 * (i + j)] += f * (dax * w[j] - dw * A[j][0]);
-        c[2 * (i + j) + 1] += f * (day * w[j] - dw * A[j][1]);
+        whole.x[i + j] += f * (dax * w[j] - dw * A[j][0]);
+        whole.y[i + j] += f * (day * w[j] - dw * A[j][1]);
       }
     }
   }
-  if (u0 > 0.0 || u1 < 1.0) {
-    bern_restrict(c, d, 2, u0, u1);
-    bern_restrict(w, p, 1, u0, u1);
-  }
-  /* the rounding of N: that of the points (km__bspan_noise, over p) times
-   * p and the weights' scale twice */
-  ps->floor = km__bspan_noise(sp) * (sp->rational ? wmax * wmax : 1.0);
+  ps->floor = floor;
   ps->tiny = tiny;
-  ps->dn = d;
   ps->dw = p;
-  find_breaks(ps, c, sp->rational ? w : NULL, u0, u1, 0);
+  restrict_part(ps, &whole, sp->rational, u0, u1, &pt);
+  find_breaks(ps, &pt, sp->rational, u0, u1, 0);
 }
 
 double km__bspan_length_counted(const km__bspan *sp, double u0, double u1,
@@ -915,7 +888,10 @@ double km__bspan_length_counted(const km__bspan *sp, double u0, double u1,
   /* the rules must not step over a hairpin's tip or a boundary layer:
    * parts end there */
   part_search ps;
-  span_breaks(sp, u0, u1, 0.0625 * tol, &ps);
+  /* N's rounding: the points' (noise, over p) times p and the weights'
+   * scale twice */
+  span_breaks(sp, u0, u1, noise * (sp->rational ? wmax * wmax : 1.0),
+              0.0625 * tol, &ps);
   double len = 0.0, a = u0;
   long budget = 256 + 8 * (long)ps.n;
   for (size_t i = 0; i <= ps.n; i++) {
