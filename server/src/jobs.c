@@ -90,8 +90,10 @@ int srv_jobs_start(srv_jobs *j, api_morph_plan *plan,
     tail = &(*tail)->next;
   *tail = nj;
   j->live++;
-  pthread_mutex_unlock(&j->mu);
+  /* Copied under the lock: once it is released a worker may render every
+   * frame, finalize the job and free nj before this thread runs again. */
   memcpy(id, nj->id, SRV_JOB_ID_LEN + 1);
+  pthread_mutex_unlock(&j->mu);
   return 0;
 }
 
