@@ -46,8 +46,27 @@ static const opt_def OPTS[] = {
      0.01, 86400, "seconds to receive one whole request"},
     {"morph-time", "KMORPH_MORPH_TIME", OPT_SECONDS, F(morph_time), 0, 0.01,
      86400, "compute seconds per POST /v1/morph (past it: 422)"},
+    {"compute-time", "KMORPH_COMPUTE_TIME", OPT_SECONDS, F(compute_time), 0,
+     0.01, 86400,
+     "compute seconds per POST /v1/signature or /v1/reconstruct (past it: "
+     "422)"},
+    {"header-time", "KMORPH_HEADER_TIME", OPT_SECONDS, F(header_time), 0,
+     0.05, 3600, "seconds to receive a request's header (past it: 408)"},
+    {"send-time", "KMORPH_SEND_TIME", OPT_SECONDS, F(send_time), 0, 0.05,
+     86400, "seconds to deliver one answer before the connection is cut"},
+    {"per-ip", "KMORPH_PER_IP", OPT_UINT, F(per_ip), 0, 1, 100000,
+     "concurrent connections from one client address"},
+    {"reserved-connections", "KMORPH_RESERVED_CONNECTIONS", OPT_UINT,
+     F(reserved), 0, 0, 10000,
+     "slots beyond --max-connections kept for quick requests (/healthz)"},
     {"max-body", "KMORPH_MAX_BODY", OPT_SIZE, F(max_body), 0, 1, 1e12,
      "request body bytes (larger: 413)"},
+    {"max-output", "KMORPH_MAX_OUTPUT", OPT_SIZE, F(max_output), 0, 1024,
+     1e13, "bytes of one answer, predicted before work (larger: 422)"},
+    {"body-memory", "KMORPH_BODY_MEMORY", OPT_SIZE, F(body_memory), 0, 1,
+     1e13, "bytes of all request bodies in flight (past it: 503)"},
+    {"result-memory", "KMORPH_RESULT_MEMORY", OPT_SIZE, F(result_memory), 0,
+     1, 1e13, "bytes of kept job results (oldest evicted: 410)"},
     {"max-points", "KMORPH_MAX_POINTS", OPT_SIZE, F(max_points), 0, 1, 1e9,
      "control points per curve, given or returned"},
     {"max-frames", "KMORPH_MAX_FRAMES", OPT_SIZE, F(max_frames), 0, 1, 1e9,
@@ -76,6 +95,9 @@ static const opt_def OPTS[] = {
      "folder whose index.html is served at /"},
     {"access-log", "KMORPH_ACCESS_LOG", OPT_BOOL, F(access_log), 0, 0, 1,
      "one line per request on stderr (1/0)"},
+    {"log-file", "KMORPH_LOG_FILE", OPT_STR, F(log_file),
+     sizeof(((srv_config *)0)->log_file), 0, 0,
+     "append the log here instead of stderr (reopened on SIGHUP)"},
 };
 #undef F
 #define NOPTS (sizeof OPTS / sizeof OPTS[0])
@@ -92,7 +114,15 @@ void srv_config_default(srv_config *cfg)
   cfg->timeout = 30;
   cfg->request_time = 60;
   cfg->morph_time = 60;
+  cfg->compute_time = 60;
+  cfg->header_time = 10;
+  cfg->send_time = 300;
+  cfg->per_ip = 128;
+  cfg->reserved = 16;
   cfg->max_body = (size_t)8 << 20;
+  cfg->max_output = (size_t)64 << 20;
+  cfg->body_memory = (size_t)256 << 20;
+  cfg->result_memory = (size_t)512 << 20;
   cfg->max_points = 100000;
   cfg->max_frames = 1000;
   cfg->max_job_frames = 10000;

@@ -22,7 +22,15 @@ typedef struct srv_config {
   unsigned timeout;         /* idle seconds before a connection is cut */
   double request_time;      /* seconds to receive a whole request */
   double morph_time;        /* compute seconds per synchronous morph */
+  double compute_time;      /* compute seconds per signature/reconstruct */
+  double header_time;       /* seconds to receive a request's header */
+  double send_time;         /* seconds to deliver one answer */
+  unsigned per_ip;          /* connections per client address */
+  unsigned reserved;        /* extra slots for quick probes when full */
   size_t max_body;          /* bytes; larger bodies are 413 */
+  size_t max_output;        /* bytes of one answer, predicted before work */
+  size_t body_memory;       /* bytes of all bodies in flight */
+  size_t result_memory;     /* bytes of all kept job results */
   size_t max_points;        /* control points per curve */
   size_t max_frames;        /* frames per POST /v1/morph */
   size_t max_job_frames;    /* frames per POST /v1/jobs */
@@ -36,6 +44,7 @@ typedef struct srv_config {
   char cors_origins[512];   /* comma-separated, "*" = any, "" = no CORS */
   char web_root[512];       /* folder of the web page served at / */
   bool access_log;          /* one line per request on stderr */
+  char log_file[512];       /* log to this file (reopened on SIGHUP) */
 } srv_config;
 
 /* Fill *cfg with the built-in defaults. */
