@@ -13,9 +13,39 @@
 #include "km/fn.h"
 #include "km/limits.h"
 #include "km/status.h"
+#include "km/stop.h"
 
 #define KM_PI 3.14159265358979323846
 #define KM__BSPAN_MAX 10 /* KM_MAX_DEGREE + 1 */
+
+/* ---- stopping (km/stop.h) ------------------------------------------------
+ * One call's poll of its caller's km_stop: loops count their work in units
+ * and the callback is asked once every KM_STOP_POLL_UNITS of them. Once it
+ * said stop every later check says so without asking again, so nested
+ * loops unwind one after the other. A NULL km__poll never stops, so
+ * helpers shared with callers that cannot stop take NULL. */
+typedef struct km__poll {
+  const km_stop *stop;
+  long left;    /* units until the next question */
+  bool stopped; /* the answer was yes */
+  long asked;   /* questions asked (for tests and figures) */
+} km__poll;
+
+void km__poll_init(km__poll *p, const km_stop *stop);
+/* Count units of work; true when the computation must end now. */
+static inline bool km__poll_stop(km__poll *p, long units) {
+  if (!p) return false;
+  if (p->stopped) return true;
+  if (!p->stop || !p->stop->requested) return false;
+  p->left -= units;
+  if (p->left > 0) return false;
+  p->left = KM_STOP_POLL_UNITS;
+  p->asked++;
+  p->stopped = p->stop->requested(p->stop->ctx);
+  return p->stopped;
+}
+/* The status of a stopped call, with its message in err. */
+km_status km__stopped(km_error *err);
 
 /* Record an error: code, field, element index, parameter and a message
  * formatted by km__format (a small printf subset: %s %d %ld %zu %g; no
@@ -192,11 +222,24 @@ km_status km__pp_merge(const km_pp *p, int degree, double delta, km_pp *out);
 km_status km__pp_derivative(const km_pp *p, km_pp *out);
 
 
-/* km_signature_compute, with rel_tol times the curve's length as the
+/* km_signature_compute_until, with rel_tol times the curve's length as the
  * tolerance where tol is not positive (the public default is 1e-5). */
 struct km_signature;
 km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
-                                struct km_signature *out, km_error *err);
+                                km__poll *poll, struct km_signature *out,
+                                km_error *err);
+
+/* km_curve_self_intersections with the caller's poll: -1 also when
+ * stopped (then poll->stopped). */
+long km__self_intersections(const km_curve *c, double tol, km__poll *poll);
+
+/* km_reconstruct_until with the caller's poll (NULL: never stops). With
+ * points_only not NULL nothing is built: *points_only receives the number
+ * of control points the curve would have (out, error_bound unused). */
+km_status km__reconstruct(const struct km_signature *sig, int degree,
+                          double tol, size_t max_points, km__poll *poll,
+                          km_curve *out, double *error_bound,
+                          size_t *points_only, km_error *err);
 
 /* theta(s) of a signature as pieces (breaks at kappa's breaks and at the
  * corners; corner turns folded into the pieces' start values) beside the

@@ -79,7 +79,8 @@ typedef struct ctx {
   size_t nseg, capseg;
   double *hits; /* (ta, tb) pairs, ta < tb */
   size_t nhit, caphit;
-  bool oom;
+  bool oom;       /* out of memory, or stopped: the count ends */
+  km__poll *poll; /* the caller's stop condition, or NULL */
 } ctx;
 
 static void cart(const double h[3], double out[2]) {
@@ -162,7 +163,7 @@ static void push_seg(ctx *x, const seg *s) {
 }
 
 static void collect(ctx *x, const seg *s, int depth) {
-  if (x->oom) return;
+  if (x->oom || (x->oom = km__poll_stop(x->poll, 4))) return;
   /* monotone up to the rounding of the coordinates (far from the origin
    * that rounding wiggles every control polygon, however small) and up to
    * a tenth of the tolerance: a sub-curve monotone but for steps back of
@@ -255,6 +256,7 @@ static void refine(ctx *x, size_t ka, double ua, size_t kb, double ub) {
    * one whose tangents are closest to parallel */
   double best = INFINITY, bua = ua, bub = ub;
   for (int it = 0; it < 100 && x->newton_left > 0; it++, x->newton_left--) {
+    if ((x->oom = km__poll_stop(x->poll, 2))) return;
     eval_piece(x, ka, ua, Pa, Da);
     eval_piece(x, kb, ub, Pb, Db);
     double fx = Pa[0] - Pb[0], fy = Pa[1] - Pb[1], f = hypot(fx, fy);
@@ -351,6 +353,8 @@ static void chord_seed(ctx *x, const seg *A, const seg *B) {
 
 static void pair(ctx *x, const seg *A, const seg *B, int depth) {
   if (x->oom || !boxes_overlap(A, B, x->margin)) return;
+  /* two flatness tests and a split: some 4 units */
+  if ((x->oom = km__poll_stop(x->poll, 4))) return;
   int p = x->p;
   if (--x->pairs_left <= 0) {
     chord_seed(x, A, B);
@@ -429,6 +433,22 @@ static int by_xmin(const void *a, const void *b) {
  * folded almost onto itself over a long stretch gets the crossings found
  * within it. Thread-safe; allocates only scratch. */
 long km_curve_self_intersections(const km_curve *c, double tol) {
+  return km__self_intersections(c, tol, NULL);
+}
+
+km_status km_curve_self_intersections_until(const km_curve *c, double tol,
+                                            const km_stop *stop,
+                                            long *count) {
+  km__poll poll;
+  km__poll_init(&poll, stop);
+  long n = km__self_intersections(c, tol, &poll);
+  if (poll.stopped) return KM_ECANCELLED;
+  if (n < 0) return c && c->knots && c->cp ? KM_ENOMEM : KM_EINVAL;
+  *count = n;
+  return KM_OK;
+}
+
+long km__self_intersections(const km_curve *c, double tol, km__poll *poll) {
   if (!c || !c->knots || !c->cp || c->degree < KM_MIN_DEGREE ||
       c->degree > KM_MAX_DEGREE || c->n < (size_t)c->degree + 1)
     return -1;
@@ -437,6 +457,7 @@ long km_curve_self_intersections(const km_curve *c, double tol) {
   km__h_init(&bz);
   ctx x;
   memset(&x, 0, sizeof x);
+  x.poll = poll;
   seg **order = NULL;
   long result = -1;
   if (km__h_from_curve(&h, c, 3) || km__h_to_bezier(&bz, &h)) goto cleanup;
@@ -492,6 +513,7 @@ long km_curve_self_intersections(const km_curve *c, double tol) {
     /* past every bound nothing more can be found */
     if (x.pairs_left <= 0 && (x.seeds_left <= 0 || x.newton_left <= 0)) break;
     for (size_t j = i + 1; j < x.nseg && !x.oom && sweep_left-- > 0; j++) {
+      if ((j & 15) == 0 && (x.oom = km__poll_stop(poll, 4))) break;
       if (order[j]->xmin > order[i]->xmax + x.margin) break;
       if (!boxes_overlap(order[i], order[j], x.margin)) continue;
       if (consecutive_same_way(&x, order[i], order[j])) continue;

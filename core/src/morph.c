@@ -99,6 +99,9 @@ struct km_morph {
    * weights' sum and the weighted means */
   double (*place_ab)[5];
   double place_w_sum, place_qa[2], place_qb[2];
+  /* the caller's stop condition while km_morph_create runs, NULL after:
+   * frames take their own (km_morph_frame_until) */
+  km__poll *poll;
 };
 
 static void input_free(input *in) {
@@ -122,10 +125,10 @@ void km_morph_free(km_morph *m) {
 }
 
 static km_status ensure_curve(input *in, double tol, size_t max_points,
-                              km_error *err) {
+                              km__poll *poll, km_error *err) {
   if (in->has_curve) return KM_OK;
-  km_status st = km_reconstruct_within(&in->sig, 3, tol, max_points,
-                                       &in->curve, NULL, err);
+  km_status st = km__reconstruct(&in->sig, 3, tol, max_points, poll,
+                                 &in->curve, NULL, NULL, err);
   if (!st) in->has_curve = true;
   return st;
 }
@@ -160,7 +163,7 @@ static void table_step(const double *tc, int d, double h, double u0,
 
 /* theta pieces, and unless keep_table the position table and centroid, of
  * an input's signature */
-static km_status input_tables(input *in, bool keep_table) {
+static km_status input_tables(input *in, bool keep_table, km__poll *poll) {
   km__pp_free(&in->kappa);
   km__pp_free(&in->theta);
   km_status st = km__build_theta(&in->sig, &in->kappa, &in->theta);
@@ -186,6 +189,9 @@ static km_status input_tables(input *in, bool keep_table) {
         table_step(in->theta.c + piece * (size_t)(dt + 1), dt, h, u0, u1, kb, d);
         x += d[0];
         y += d[1];
+        /* four nodes a chunk of a quarter radian (table_step) */
+        if (km__poll_stop(poll, 4 + (long)fmin(16.0 * kb * (u1 - u0) * h, 4e6)))
+          return KM_ECANCELLED;
       }
       s_prev = e;
       if (e >= b && piece + 1 < in->theta.m) piece++;
@@ -336,7 +342,8 @@ done:
 }
 
 /* Closed input starting at arc length s0 instead of 0. */
-static km_status rotate_start(input *in, double s0, km_error *err) {
+static km_status rotate_start(input *in, double s0, km__poll *poll,
+                              km_error *err) {
   double L = in->sig.length;
   if (!(s0 > 1e-12 * L) || !(s0 < L - 1e-12 * L)) return KM_OK;
   km_status st = in->has_curve ? rotate_curve(in, s0, err) : KM_OK;
@@ -360,7 +367,7 @@ static km_status rotate_start(input *in, double s0, km_error *err) {
     in->table[TABLE_N][0] = in->table[0][0];
     in->table[TABLE_N][1] = in->table[0][1];
   }
-  return input_tables(in, on_table);
+  return input_tables(in, on_table, poll);
 }
 
 /* The signature of the same closed curve traced backwards, exactly:
@@ -413,7 +420,7 @@ static km_status reverse_signature(const km_signature *sig, km_signature *out,
 
 /* `to` traced backwards: its signature exactly, its curve (if kept) by
  * reversing the control points. */
-static km_status reverse_input(input *in, km_error *err) {
+static km_status reverse_input(input *in, km__poll *poll, km_error *err) {
   km_signature r;
   km_status st = reverse_signature(&in->sig, &r, err);
   if (st) return st;
@@ -426,7 +433,7 @@ static km_status reverse_input(input *in, km_error *err) {
     km_curve_free(&in->curve);
     in->curve = c;
   }
-  return input_tables(in, false);
+  return input_tables(in, false, poll);
 }
 
 /* Best cyclic shift of b's start (fraction of Lb): least squares over
@@ -656,7 +663,7 @@ static size_t auto_matches(const input *a, const input *b, double *pairs,
 /* An input's copy, signature and tables; a signature computed from its
  * curve is held to tol, or without one to 1e-6 of its own length. */
 static km_status prepare_input(input *in, const km_morph_input *src,
-                               double tol, km_error *err) {
+                               double tol, km__poll *poll, km_error *err) {
   memset(in, 0, sizeof *in);
   km_curve_init(&in->curve);
   km_signature_init(&in->sig);
@@ -671,11 +678,11 @@ static km_status prepare_input(input *in, const km_morph_input *src,
   if (src->sig)
     st = km_signature_copy(&in->sig, src->sig, err);
   else if (src->curve)
-    st = km__signature_compute(&in->curve, tol, 1e-6, &in->sig, err);
+    st = km__signature_compute(&in->curve, tol, 1e-6, poll, &in->sig, err);
   else
     st = km__fail(err, KM_EINVAL, KM_FIELD_NONE, -1, NAN, "missing input");
   if (st) return st;
-  return input_tables(in, false);
+  return input_tables(in, false, poll);
 }
 
 static void table_at(const input *in, double r, double out[2]);
@@ -717,7 +724,8 @@ static km_status blend_signature(const km_morph *m, double t,
                                  km_signature *out, km_error *err);
 static km_status close_lsq(const km_signature *sig, bool by_corners,
                            const double *weights, km_signature *out,
-                           double *gap0, bool *used_corners, km_error *err);
+                           double *gap0, bool *used_corners, km__poll *poll,
+                           km_error *err);
 
 /* Whether the lsq closure goes by the frames' corners: so if it can at
  * t = 1/4, 1/2 and 3/4, for every frame of the morph (a sequence must not
@@ -730,7 +738,8 @@ static bool corners_close(const km_morph *m) {
     double gap;
     bool used = false;
     bool ok = blend_signature(m, k / 4.0, &blended, NULL) == KM_OK &&
-              close_lsq(&blended, true, NULL, &closed, &gap, &used, NULL) == KM_OK;
+              close_lsq(&blended, true, NULL, &closed, &gap, &used, m->poll,
+                        NULL) == KM_OK;
     km_signature_free(&blended);
     km_signature_free(&closed);
     if (!ok || !used) return false;
@@ -761,7 +770,7 @@ static km_status plan_frames(km_morph *m, km_error *err) {
   if (m->opt.max_points > 0)
     max_pieces = m->opt.max_points >= 4 ? (m->opt.max_points - 2) / 2 : 1;
   km_status st = km__frame_plan_build(&m->plan, tp, len, ang, m->closed,
-                                      m->tol, max_pieces, err);
+                                      m->tol, max_pieces, m->poll, err);
   if (st == KM_ELIMIT && max_pieces > 0)
     return km__fail(err, KM_ELIMIT, KM_FIELD_TOLERANCE, -1, NAN,
                     "the frames need more than %zu control points at this "
@@ -797,7 +806,7 @@ static km_status input_copy(input *out, const input *in, km_error *err) {
  * fraction dshift of its length along: its inputs are copied, not
  * computed again. */
 static km_status morph_shifted(const km_morph *base, double dshift,
-                               km_morph **out, km_error *err) {
+                               km__poll *poll, km_morph **out, km_error *err) {
   km_morph *m = calloc(1, sizeof *m);
   if (!m) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   for (int i = 0; i < 2; i++) {
@@ -811,6 +820,7 @@ static km_status morph_shifted(const km_morph *base, double dshift,
   m->tol = base->tol;
   m->closed = base->closed;
   m->kmax = base->kmax;
+  m->poll = poll;
   m->ra = malloc(2 * sizeof(double));
   m->rb = malloc(2 * sizeof(double));
   km_status st = m->ra && m->rb ? KM_OK
@@ -822,7 +832,8 @@ static km_status morph_shifted(const km_morph *base, double dshift,
     st = input_copy(&m->in[0], &base->in[0], err);
   }
   if (!st) st = input_copy(&m->in[1], &base->in[1], err);
-  if (!st) st = rotate_start(&m->in[1], dshift * m->in[1].sig.length, err);
+  if (!st)
+    st = rotate_start(&m->in[1], dshift * m->in[1].sig.length, poll, err);
   if (!st) st = plan_frames(m, err);
   if (st) {
     km_morph_free(m);
@@ -838,9 +849,10 @@ static km_status create_impl(km_morph **out, const km_morph_input *from,
                              const km_morph_input *to,
                              const km_morph_options *opt,
                              double *cand,
-                             size_t *ncand, km_error *err) {
+                             size_t *ncand, km__poll *poll, km_error *err) {
   km_morph *m = calloc(1, sizeof *m);
   if (!m) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  m->poll = poll;
   for (int i = 0; i < 2; i++) {
     km_curve_init(&m->in[i].curve);
     km_signature_init(&m->in[i].sig);
@@ -855,9 +867,9 @@ static km_status create_impl(km_morph **out, const km_morph_input *from,
    * known only with both lengths; a tenth of 1e-5 of each curve's own is
    * at least as tight, and needs no length before the signature. */
   double tol = opt->tolerance > 0 ? opt->tolerance : 0.0;
-  st = prepare_input(&m->in[0], from, 0.1 * tol, err);
+  st = prepare_input(&m->in[0], from, 0.1 * tol, poll, err);
   if (st) goto fail;
-  st = prepare_input(&m->in[1], to, 0.1 * tol, err);
+  st = prepare_input(&m->in[1], to, 0.1 * tol, poll, err);
   if (st) goto fail;
   input *a = &m->in[0], *b = &m->in[1];
   if (!(opt->tolerance > 0)) tol = 1e-5 * fmax(a->sig.length, b->sig.length);
@@ -882,7 +894,7 @@ static km_status create_impl(km_morph **out, const km_morph_input *from,
     double na = a->sig.turning / (2 * KM_PI), nb = b->sig.turning / (2 * KM_PI);
     long ta = lround(na), tb = lround(nb);
     if (ta == -tb && ta != 0 && opt->orient == KM_ORIENT_AUTO) {
-      st = reverse_input(b, err);
+      st = reverse_input(b, poll, err);
       if (st) goto fail;
       tb = lround(b->sig.turning / (2 * KM_PI));
     }
@@ -898,7 +910,7 @@ static km_status create_impl(km_morph **out, const km_morph_input *from,
       *ncand = best_shifts(a, b, cand);
       shift = cand[0];
       if (shift > 0) {
-        st = rotate_start(b, shift * b->sig.length, err);
+        st = rotate_start(b, shift * b->sig.length, poll, err);
         if (st) goto fail;
       }
     }
@@ -935,8 +947,8 @@ static km_status create_impl(km_morph **out, const km_morph_input *from,
   m->nk = nm + 2;
   m->nuser = nm;
   if (opt->method == KM_METHOD_LINEAR) {
-    st = ensure_curve(a, 0.1 * tol, opt->max_points, err);
-    if (!st) st = ensure_curve(b, 0.1 * tol, opt->max_points, err);
+    st = ensure_curve(a, 0.1 * tol, opt->max_points, poll, err);
+    if (!st) st = ensure_curve(b, 0.1 * tol, opt->max_points, poll, err);
     if (!st)
       st = km_curve_make_compatible(&a->curve, &b->curve, &m->lin[0],
                                     &m->lin[1], err);
@@ -957,13 +969,17 @@ fail:
 
 /* Self-crossings of five frames (t = 1/6 .. 5/6), counted until they
  * reach cap: a candidate that has as many as the best one so far loses. */
+static km_status frame_impl(const km_morph *m, double t, km__poll *poll,
+                            km_curve *out, km_frame_metrics *metrics,
+                            km_signature *sig_out, km_error *err);
+
 static long preview_crossings(const km_morph *m, long cap) {
   long total = 0;
   static const double T[5] = {3 / 6.0, 2 / 6.0, 4 / 6.0, 1 / 6.0, 5 / 6.0};
   for (int k = 0; k < 5 && total < cap; k++) {
     km_curve c;
-    if (km_morph_frame(m, T[k], &c, NULL, NULL, NULL) != KM_OK) return LONG_MAX;
-    long x = km_curve_self_intersections(&c, m->tol);
+    if (frame_impl(m, T[k], m->poll, &c, NULL, NULL, NULL) != KM_OK) return LONG_MAX;
+    long x = km__self_intersections(&c, m->tol, m->poll);
     km_curve_free(&c);
     if (x > 0) total += x;
   }
@@ -976,7 +992,10 @@ km_status km_morph_create(km_morph **out, const km_morph_input *from,
   double cand[SHIFT_CANDIDATES];
   size_t ncand = 0;
   km_morph *m = NULL;
-  km_status st = create_impl(&m, from, to, opt, cand, &ncand, err);
+  km__poll poll;
+  km__poll_init(&poll, opt->stop);
+  km_status st = create_impl(&m, from, to, opt, cand, &ncand, &poll, err);
+  if (st == KM_ECANCELLED || (st && poll.stopped)) return km__stopped(err);
   if (st) return st;
   /* Among starts that align about as well, prefer one whose frames do not
    * cross themselves: the first candidate, in order of alignment, none of
@@ -992,7 +1011,8 @@ km_status km_morph_create(km_morph **out, const km_morph_input *from,
     for (size_t i = 1; i < ncand && pick == SIZE_MAX; i++) {
       km_morph *alt = NULL;
       double d = cand[i] - cand[0];
-      if (morph_shifted(m, d < 0 ? d + 1.0 : d, &alt, NULL) != KM_OK) continue;
+      if (morph_shifted(m, d < 0 ? d + 1.0 : d, &poll, &alt, NULL) != KM_OK)
+        continue;
       alts[n++] = alt;
       if (preview_crossings(alt, 1) == 0) pick = n - 1;
     }
@@ -1010,6 +1030,12 @@ km_status km_morph_create(km_morph **out, const km_morph_input *from,
       if (k != pick) km_morph_free(alts[k]);
     m = alts[pick];
   }
+  if (poll.stopped) {
+    km_morph_free(m);
+    return km__stopped(err);
+  }
+  m->poll = NULL;
+  m->opt.stop = NULL;
   *out = m;
   return KM_OK;
 }
@@ -1165,7 +1191,12 @@ static km_status blend_smooth(const km_morph *m, double t, km_pp *out,
   km_status st = KM_EINVAL;
   /* alpha and beta must stay positive at the middle nodes too: where a
    * segment's ratio differs much from its neighbours', pull its end nodes
-   * toward its own ratio (at the ratio itself the segment is feasible) */
+   * toward its own ratio (at the ratio itself the segment is feasible).
+   * Each pull halves the nodes' distance from the ratio as often as this
+   * segment alone needs: a match next to an end or to another match makes
+   * a ratio 1e-300 of its neighbours', a thousand halvings, and with fewer
+   * the map would turn piecewise linear (G1) only below some ratio, a jump
+   * in the frames as the match approaches the end. */
   for (int round = 0; round < 64 && st; round++) {
     st = KM_OK;
     for (size_t k = 0; k < K; k++) {
@@ -1173,8 +1204,13 @@ static km_status blend_smooth(const km_morph *m, double t, km_pp *out,
       double lo = 0.02 * fmin(rho[k], amax - rho[k]);
       if (mid[k] > lo && mid[k] < amax - lo) continue;
       st = KM_EINVAL;
-      node[k] = rho[k] + 0.5 * (node[k] - rho[k]);
-      node[k + 1] = rho[k] + 0.5 * (node[k + 1] - rho[k]);
+      double dev = rho[k] - mid[k];
+      double room = dev > 0 ? rho[k] - lo : amax - lo - rho[k];
+      int halvings = 1;
+      if (room > 0 && fabs(dev) > room) frexp(fabs(dev) / room, &halvings);
+      if (halvings < 1) halvings = 1;
+      node[k] = rho[k] + ldexp(node[k] - rho[k], -halvings);
+      node[k + 1] = rho[k] + ldexp(node[k + 1] - rho[k], -halvings);
       if (m->closed && k == 0) node[K] = node[0];
       if (m->closed && k == K - 1) node[0] = node[K];
     }
@@ -1433,7 +1469,7 @@ typedef struct qnode {
  * of the closure basis and chunked so theta moves <= 0.5 rad per 8-point
  * rule (exact to rounding there, see km__integrate_exp). */
 static km_status closure_nodes(const km_pp *kp, const km_pp *tp, double h,
-                               qnode **out, size_t *nout) {
+                               km__poll *poll, qnode **out, size_t *nout) {
   size_t cap = 0, n = 0;
   qnode *q = NULL;
   int dk = kp->degree, dt = tp->degree;
@@ -1448,6 +1484,10 @@ static km_status closure_nodes(const km_pp *kp, const km_pp *tp, double h,
       if (hi <= lo) hi = b;
       int chunks = (int)ceil(kb * (hi - lo) / 0.5);
       if (chunks < 1) chunks = 1;
+      if (km__poll_stop(poll, 8L * chunks)) {
+        free(q);
+        return KM_ECANCELLED;
+      }
       for (int c = 0; c < chunks; c++) {
         double ca = lo + (hi - lo) * c / chunks, cb = lo + (hi - lo) * (c + 1) / chunks;
         double mid = 0.5 * (ca + cb), hw = 0.5 * (cb - ca);
@@ -1489,7 +1529,8 @@ static km_status closure_nodes(const km_pp *kp, const km_pp *tp, double h,
  * before. */
 static km_status close_lsq(const km_signature *sig, bool by_corners,
                            const double *weights, km_signature *out,
-                           double *gap0, bool *used_corners, km_error *err) {
+                           double *gap0, bool *used_corners, km__poll *poll,
+                           km_error *err) {
   enum { NB = LSQ_INTERVALS, NF = LSQ_INTERVALS - 3 };
   double L = sig->length, h = L / NB;
   km_pp kp, tp, dpsi, kt;
@@ -1501,7 +1542,7 @@ static km_status close_lsq(const km_signature *sig, bool by_corners,
   size_t nq = 0;
   double c[NF] = {0};
   km_status st = km__build_theta(sig, &kp, &tp);
-  if (!st) st = closure_nodes(&kp, &tp, h, &q, &nq);
+  if (!st) st = closure_nodes(&kp, &tp, h, poll, &q, &nq);
   if (st) goto done;
   /* the gap before any correction, and the integrals of the stretches
    * between interior corners (for the closure by corners) */
@@ -1575,6 +1616,10 @@ static km_status close_lsq(const km_signature *sig, bool by_corners,
     double G[2] = {0, 0}, J[2][NF];
     memset(J, 0, sizeof J);
     for (size_t n = 0; n < nq; n++) {
+      if ((n & 255) == 0 && km__poll_stop(poll, 512)) {
+        st = KM_ECANCELLED;
+        goto done;
+      }
       double u = q[n].s / h, th = q[n].theta;
       int i0 = (int)floor(u) - 3;
       double bv[4];
@@ -1665,6 +1710,7 @@ done:
   km__pp_free(&tp);
   km__pp_free(&dpsi);
   km__pp_free(&kt);
+  if (st == KM_ECANCELLED) return km__stopped(err);
   if (st == KM_ENOMEM || st == KM_ENOCONVERGE || st == KM_ELIMIT)
     km__fail(err, st, KM_FIELD_NONE, -1, NAN,
              st == KM_ENOCONVERGE ? "closing the frame did not converge"
@@ -1832,7 +1878,8 @@ static double curve_kappa(const km_curve *c, double t, double *speed) {
 
 /* Metrics of a curve measured directly (linear frames may have cusps, so
  * no signature is assumed): dense Gauss-Legendre per span. */
-static void curve_metrics(const km_curve *c, double tol, km_frame_metrics *mt) {
+static void curve_metrics(const km_curve *c, double tol, km__poll *poll,
+                          km_frame_metrics *mt) {
   double L = 0.0, kmax = 0.0, bend = 0.0;
   for (size_t i = (size_t)c->degree; i < c->n; i++) {
     double a = c->knots[i], b = c->knots[i + 1];
@@ -1855,13 +1902,13 @@ static void curve_metrics(const km_curve *c, double tol, km_frame_metrics *mt) {
   (void)L;
   mt->max_abs_kappa = kmax;
   mt->bending_energy = bend;
-  mt->self_intersections = km_curve_self_intersections(c, tol);
+  mt->self_intersections = km__self_intersections(c, tol, poll);
   mt->closure_gap = 0.0;
 }
 
 static km_status linear_frame(const km_morph *m, double t, km_curve *out,
                               km_frame_metrics *metrics, km_signature *sig_out,
-                              km_error *err) {
+                              km__poll *poll, km_error *err) {
   const km_curve *a = &m->lin[0], *b = &m->lin[1];
   km_curve f;
   km_status st = km_curve_copy(&f, a, err);
@@ -1870,12 +1917,17 @@ static km_status linear_frame(const km_morph *m, double t, km_curve *out,
   if (f.w)
     for (size_t i = 0; i < f.n; i++) f.w[i] = (1 - t) * a->w[i] + t * b->w[i];
   f.closed = a->closed && b->closed;
-  if (metrics) curve_metrics(&f, m->tol, metrics);
+  if (metrics) curve_metrics(&f, m->tol, poll, metrics);
   if (sig_out) {
     km_signature_init(sig_out);
     /* a linear frame may be singular (cusp): then no signature */
-    if (km_signature_compute(&f, m->tol, sig_out, NULL) != KM_OK)
+    if (km__signature_compute(&f, m->tol, 1e-5, poll, sig_out, NULL) != KM_OK)
       km_signature_init(sig_out);
+  }
+  if (poll && poll->stopped) {
+    km_curve_free(&f);
+    km_signature_free(sig_out);
+    return km__stopped(err);
   }
   *out = f;
   return KM_OK;
@@ -1925,7 +1977,7 @@ static void planned_placement(const km_morph *m, double t, const double (*F)[2],
 /* A frame from the plan: the curve only (metrics and signatures take the
  * general path, which yields them exactly). */
 static km_status planned_frame(const km_morph *m, double t, km_closure how,
-                               km_curve *out, km_error *err) {
+                               km__poll *poll, km_curve *out, km_error *err) {
   const input *a = &m->in[0], *b = &m->in[1];
   double phia = a->sig.angle, phib = phia + km__wrap_angle(b->sig.angle - phia);
   double rot, T[2];
@@ -1936,7 +1988,7 @@ static km_status planned_frame(const km_morph *m, double t, km_closure how,
   km_curve f;
   km_curve_init(&f);
   km_status st = km__frame_plan_curve(m->plan, t, (1 - t) * phia + t * phib,
-                                      how == KM_CLOSURE_LSQ, &f, buf, err);
+                                      how == KM_CLOSURE_LSQ, &f, buf, poll, err);
   if (st) goto done;
   if (m->closed && !f.closed && how != KM_CLOSURE_NONE)
     close_polygon(&f, how == KM_CLOSURE_LSQ ? KM_CLOSURE_C0 : how);
@@ -1992,10 +2044,12 @@ static void interval_max(const km_fn *kappa, double L, double *out) {
  * where the curvature changes moves. Frames without matches change too
  * little to need this (and their planned form must agree with this one). */
 static km_status close_within_bound(const km_morph *m, const km_signature *blended,
-                                    km_signature *out, double *gap, km_error *err) {
+                                    km_signature *out, double *gap,
+                                    km__poll *poll, km_error *err) {
   enum { NB = LSQ_INTERVALS };
   bool used = false;
-  km_status st = close_lsq(blended, m->close_by_corners, NULL, out, gap, &used, err);
+  km_status st = close_lsq(blended, m->close_by_corners, NULL, out, gap, &used,
+                           poll, err);
   double bound = m->kmax * (1 + 1e-9);
   if (st || used || m->nuser == 0 || km_signature_max_abs_kappa(out) <= bound) return st;
   double w[NB], kb[NB], best = km_signature_max_abs_kappa(out);
@@ -2008,7 +2062,7 @@ static km_status close_within_bound(const km_morph *m, const km_signature *blend
     km_signature trial;
     double g;
     km_signature_init(&trial);
-    if (close_lsq(blended, false, w, &trial, &g, NULL, NULL) != KM_OK) break;
+    if (close_lsq(blended, false, w, &trial, &g, NULL, poll, NULL) != KM_OK) break;
     double k = km_signature_max_abs_kappa(&trial);
     interval_max(&trial.kappa, trial.length, kb);
     for (int iv = 0; iv < NB; iv++)
@@ -2022,19 +2076,39 @@ static km_status close_within_bound(const km_morph *m, const km_signature *blend
       km_signature_free(&trial);
     }
   }
+  if (poll && poll->stopped) {
+    km_signature_free(out);
+    return km__stopped(err);
+  }
   return KM_OK; /* the closed frame nearest to the bound */
 }
 
 km_status km_morph_frame(const km_morph *m, double t, km_curve *out,
                          km_frame_metrics *metrics, km_signature *sig_out,
                          km_error *err) {
+  return frame_impl(m, t, NULL, out, metrics, sig_out, err);
+}
+
+km_status km_morph_frame_until(const km_morph *m, double t,
+                               const km_stop *stop, km_curve *out,
+                               km_frame_metrics *metrics,
+                               km_signature *sig_out, km_error *err) {
+  km__poll poll;
+  km__poll_init(&poll, stop);
+  return frame_impl(m, t, &poll, out, metrics, sig_out, err);
+}
+
+static km_status frame_impl(const km_morph *m, double t, km__poll *poll,
+                            km_curve *out, km_frame_metrics *metrics,
+                            km_signature *sig_out, km_error *err) {
   if (!(t >= 0.0 && t <= 1.0))
     return km__fail(err, KM_ERANGE, KM_FIELD_TIMES, -1, t,
                     "time %g is outside [0, 1]", t);
   if (m->opt.method == KM_METHOD_LINEAR)
-    return linear_frame(m, t, out, metrics, sig_out, err);
+    return linear_frame(m, t, out, metrics, sig_out, poll, err);
   km_closure how = m->opt.closure == KM_CLOSURE_AUTO ? KM_CLOSURE_LSQ : m->opt.closure;
-  if (m->plan && !metrics && !sig_out) return planned_frame(m, t, how, out, err);
+  if (m->plan && !metrics && !sig_out)
+    return planned_frame(m, t, how, poll, out, err);
   km_signature blended, closed;
   km_signature_init(&blended);
   km_signature_init(&closed);
@@ -2044,10 +2118,13 @@ km_status km_morph_frame(const km_morph *m, double t, km_curve *out,
   const km_signature *use = &blended;
   double gap = 0.0, bound = 0.0;
   km_status st = blend_signature(m, t, &blended, err);
+  /* the blend is linear in the pieces: a few units each */
+  if (!st && km__poll_stop(poll, 4 * (long)blended.kappa.n))
+    st = km__stopped(err);
   if (st) goto done;
   if (m->closed && how == KM_CLOSURE_LSQ) {
     /* close_lsq measures the gap itself (its first residual) */
-    st = close_within_bound(m, &blended, &closed, &gap, err);
+    st = close_within_bound(m, &blended, &closed, &gap, poll, err);
     if (st) goto done;
     use = &closed;
   } else if (m->closed) {
@@ -2056,8 +2133,8 @@ km_status km_morph_frame(const km_morph *m, double t, km_curve *out,
     if (st) goto done;
     gap = hypot(end[0] - blended.start[0], end[1] - blended.start[1]);
   }
-  st = km_reconstruct_within(use, m->opt.degree, 0.9 * m->tol,
-                             m->opt.max_points, &f, &bound, err);
+  st = km__reconstruct(use, m->opt.degree, 0.9 * m->tol, m->opt.max_points,
+                       poll, &f, &bound, NULL, err);
   if (st) goto done;
   if (m->closed && !f.closed && how != KM_CLOSURE_NONE && how != KM_CLOSURE_LSQ)
     close_polygon(&f, how);
@@ -2072,8 +2149,12 @@ km_status km_morph_frame(const km_morph *m, double t, km_curve *out,
     metrics->length = use->length;
     metrics->max_abs_kappa = km_signature_max_abs_kappa(use);
     metrics->bending_energy = km_signature_bending_energy(use);
-    metrics->self_intersections = km_curve_self_intersections(&placed, m->tol);
+    metrics->self_intersections = km__self_intersections(&placed, m->tol, poll);
     metrics->closure_gap = m->closed ? gap : 0.0;
+    if (poll && poll->stopped) {
+      st = km__stopped(err);
+      goto done;
+    }
   }
   if (sig_out) {
     double cr = cos(rot), sr = sin(rot);
@@ -2091,5 +2172,56 @@ done:
   km_signature_free(&closed);
   km_curve_free(&f);
   km_curve_free(&placed);
+  return st;
+}
+
+/* The frame's closed signature as frame_impl makes it, without the curve
+ * (the blend and the closure of the general path). */
+static km_status frame_signature(const km_morph *m, double t, km__poll *poll,
+                                 km_signature *out, km_error *err) {
+  km_closure how = m->opt.closure == KM_CLOSURE_AUTO ? KM_CLOSURE_LSQ : m->opt.closure;
+  km_signature blended;
+  km_signature_init(&blended);
+  km_status st = blend_signature(m, t, &blended, err);
+  if (!st && km__poll_stop(poll, 4 * (long)blended.kappa.n)) st = km__stopped(err);
+  if (!st && m->closed && how == KM_CLOSURE_LSQ) {
+    double gap;
+    st = close_within_bound(m, &blended, out, &gap, poll, err);
+    km_signature_free(&blended);
+    return st;
+  }
+  if (!st) {
+    *out = blended;
+    return KM_OK;
+  }
+  km_signature_free(&blended);
+  return st;
+}
+
+km_status km_morph_frame_points(const km_morph *m, double t,
+                                km_frame_parts parts, const km_stop *stop,
+                                size_t *points, km_error *err) {
+  if (!(t >= 0.0 && t <= 1.0))
+    return km__fail(err, KM_ERANGE, KM_FIELD_TIMES, -1, t,
+                    "time %g is outside [0, 1]", t);
+  if (m->opt.method == KM_METHOD_LINEAR) {
+    *points = m->lin[0].n;
+    return KM_OK;
+  }
+  if (m->plan && parts == KM_FRAME_CURVE) {
+    *points = km__frame_plan_points(m->plan);
+    return KM_OK;
+  }
+  km__poll poll;
+  km__poll_init(&poll, stop);
+  km_signature sig;
+  km_signature_init(&sig);
+  size_t n = 0;
+  km_status st = frame_signature(m, t, &poll, &sig, err);
+  if (!st)
+    st = km__reconstruct(&sig, m->opt.degree, 0.9 * m->tol, m->opt.max_points,
+                         &poll, NULL, NULL, &n, err);
+  km_signature_free(&sig);
+  if (!st) *points = n;
   return st;
 }

@@ -349,7 +349,7 @@ static void both_bounds(const side sd[2], double r0, double r1, int nd,
 static km_status plan_interval(vec *atoms, const side sd[2], double r0,
                                double r1, size_t iv, const double *D,
                                double tolp, double j2, double j3,
-                               bool corner, size_t max_atoms) {
+                               bool corner, size_t max_atoms, km__poll *poll) {
   double h = r1 - r0, e = pow(h, 4) / 384.0 * m4_of(D);
   int parts = 1;
   if (e > tolp) {
@@ -367,6 +367,7 @@ static km_status plan_interval(vec *atoms, const side sd[2], double r0,
     else
       memcpy(Dk, D, sizeof Dk);
     at.m4 = m4_of(Dk);
+    if (km__poll_stop(poll, parts > 1 ? 32 : 1)) return KM_ECANCELLED;
     km_status st = vec_push(atoms, &at);
     if (st) return st;
   }
@@ -401,14 +402,15 @@ static size_t frame_scratch(const km__frame_plan *p) {
 
 static km_status close_frame(const km__frame_plan *p, double t, double theta0,
                              bool close_lsq, bool project, double *c,
-                             double *sum, double *e);
+                             double *sum, double *e, km__poll *poll);
 static bool corner_closure(const km__frame_plan *p, double t, double *sum,
                            double *tau, double *delta, double *S,
                            double *dp);
 
 km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const double length[2],
                                const double angle[2], bool closed, double tol,
-                               size_t max_pieces, km_error *err) {
+                               size_t max_pieces, km__poll *poll,
+                               km_error *err) {
   km_status st = KM_OK;
   double *br = NULL, *Dall = NULL;
   vec atoms = {NULL, 0, 0, sizeof(atom)}, nodes = {NULL, 0, 0, sizeof(gnode)};
@@ -480,8 +482,13 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
     st = KM_ENOMEM;
     goto fail;
   }
-  for (size_t i = 0; i + 1 < m; i++)
+  for (size_t i = 0; i + 1 < m; i++) {
     both_bounds(sd, br[i], br[i + 1], NDER, Dall + i * (NDER + 1));
+    if (km__poll_stop(poll, 2 * NDER)) {
+      st = KM_ECANCELLED;
+      goto fail;
+    }
+  }
   /* atoms; jumps and corners at the merged breaks */
   double tolp = 0.5 * tol / Lmax;
   for (size_t i = 0; i + 1 < m; i++) {
@@ -500,7 +507,7 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
       }
     }
     st = plan_interval(&atoms, sd, br[i], br[i + 1], i, Dall + i * (NDER + 1),
-                       tolp, j2, j3, corner, 2 * max_pieces);
+                       tolp, j2, j3, corner, 2 * max_pieces, poll);
     if (st) goto fail;
   }
   /* merge atoms greedily into output pieces while the bound holds */
@@ -588,6 +595,8 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
         chunks *= 2;
       }
       double hc = (b - a) / chunks;
+      /* a node costs two angles and its basis: some 4 units */
+      if (km__poll_stop(poll, 4L * chunks * n + 2 * NDER)) st = KM_ECANCELLED;
       for (int c = 0; c < chunks && !st; c++) {
         double mid = a + hc * (c + 0.5);
         for (int j = 0; j < n && !st; j++) {
@@ -649,7 +658,7 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
       p->by_corners = true;
       for (int k = 1; k <= 3 && p->by_corners; k++)
         p->by_corners = close_frame(p, k / 4.0, 0.0, false, false, c0, buf,
-                                    buf + 2 * np) == KM_OK &&
+                                    buf + 2 * np, poll) == KM_OK &&
                         corner_closure(p, k / 4.0, buf, tau, delta, S, dp);
       free(buf);
     }
@@ -668,7 +677,8 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
         goto fail;
       }
       double c_half[NF] = {0};
-      st = close_frame(p, 0.5, 0.0, true, true, c_half, sum, sum + 2 * np);
+      st = close_frame(p, 0.5, 0.0, true, true, c_half, sum, sum + 2 * np,
+                       poll);
       if (st == KM_ENOCONVERGE) {
         memset(c_half, 0, sizeof c_half);
         st = KM_OK;
@@ -676,7 +686,8 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
       for (int k = 1; k < WARM_POINTS && !st; k++) {
         double t = (double)k / WARM_POINTS;
         for (int i = 0; i < NF; i++) p->c_at[k][i] = 4 * t * (1 - t) * c_half[i];
-        st = close_frame(p, t, 0.0, true, true, p->c_at[k], sum, sum + 2 * np);
+        st = close_frame(p, t, 0.0, true, true, p->c_at[k], sum, sum + 2 * np,
+                         poll);
         if (st == KM_ENOCONVERGE) {
           memset(p->c_at[k], 0, sizeof p->c_at[k]);
           st = KM_OK;
@@ -685,6 +696,10 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
       free(sum);
       if (st) goto fail;
     }
+  }
+  if (poll && poll->stopped) {
+    st = KM_ECANCELLED;
+    goto fail;
   }
   free(atoms.p);
   free(br);
@@ -707,6 +722,7 @@ fail:
     km__pp_free(&mk[w]);
   }
   km__frame_plan_free(p);
+  if (st == KM_ECANCELLED) return km__stopped(err);
   return km__fail(err, st, KM_FIELD_TOLERANCE, -1, NAN,
                   st == KM_ELIMIT ? "the frames need too many pieces at this "
                                     "tolerance: loosen it"
@@ -715,6 +731,11 @@ fail:
 
 size_t km__frame_plan_pieces(const km__frame_plan *p) { return p->np; }
 size_t km__frame_plan_nodes(const km__frame_plan *p) { return p->nn; }
+size_t km__frame_plan_points(const km__frame_plan *p) {
+  size_t ncorner = 0;
+  for (size_t k = 1; k < p->np; k++) ncorner += p->corner[k];
+  return 2 * p->np + 2 + ncorner; /* as km__frame_plan_curve builds them */
+}
 const double *km__frame_plan_breaks(const km__frame_plan *p) { return p->x; }
 bool km__frame_plan_by_corners(const km__frame_plan *p) { return p->by_corners; }
 
@@ -816,7 +837,8 @@ static inline void exp_i_tiny(double d, double *cs, double *sn) {
  * (basis_at). */
 static void frame_pass(const km__frame_plan *p, double t, double theta0,
                        const double *cp, const double *dcp, bool e_known,
-                       double *sum, double *e, double G[2], double J[2][NF]) {
+                       double *sum, double *e, double G[2], double J[2][NF],
+                       km__poll *poll) {
   double al = 1 - t, be = t, Jp[2][NF + 6];
   if (J) memset(Jp, 0, sizeof Jp);
   G[0] = G[1] = 0.0;
@@ -829,6 +851,8 @@ static void frame_pass(const km__frame_plan *p, double t, double theta0,
   bool tiny = e_known && max_abs(dcp + 3, NF) <= 0.01;
   for (size_t k = 0; k < p->np; k++) {
     double sx = 0.0, sy = 0.0;
+    /* the caller sees poll->stopped: what was summed is then unused */
+    if (km__poll_stop(poll, (long)(p->first[k + 1] - p->first[k]) + 1)) return;
     for (size_t j = p->first[k]; j < p->first[k + 1]; j++) {
       const gnode *nd = &p->node[j];
       const double *bv = nd->bv;
@@ -956,14 +980,15 @@ static bool metric_step(double Y[2][NF], const double S[4], const double rhs[2],
  * length, as by a further pass. */
 static km_status close_frame(const km__frame_plan *p, double t, double theta0,
                              bool close_lsq, bool project, double *c,
-                             double *sum, double *scratch) {
+                             double *sum, double *scratch, km__poll *poll) {
   double Lt = (1 - t) * p->La + t * p->Lb;
   bool lsq = close_lsq && p->closed;
   double *e = scratch;
   double cp[NF + 6] = {0}, dcp[NF + 6] = {0}, dc[NF], G[2], J[2][NF];
   double Y[2][NF], S[4];
   memcpy(cp + 3, c, sizeof dc);
-  frame_pass(p, t, theta0, cp, NULL, false, sum, e, G, lsq ? J : NULL);
+  frame_pass(p, t, theta0, cp, NULL, false, sum, e, G, lsq ? J : NULL, poll);
+  if (poll && poll->stopped) return KM_ECANCELLED;
   /* With the projection a start that is closed already is the answer
    * only if it is zero: the projection from it leads elsewhere, and the
    * frames beside it take that (a closed start kept at t = 1/2 stood 1.4%
@@ -992,7 +1017,8 @@ static km_status close_frame(const km__frame_plan *p, double t, double theta0,
   bool chord = dc0 <= 1e-3;
   for (int it = 0;; it++) {
     memcpy(dcp + 3, dc, sizeof dc);
-    frame_pass(p, t, theta0, cp, dcp, true, sum, e, G, chord ? NULL : J);
+    frame_pass(p, t, theta0, cp, dcp, true, sum, e, G, chord ? NULL : J, poll);
+    if (poll && poll->stopped) return KM_ECANCELLED;
     if (Lt * hypot(G[0], G[1]) <= CLOSED_GAP * Lt) return KM_OK;
     if (it == 40) return KM_ENOCONVERGE;
     if (!chord) metric_rows(p, J, Y, S);
@@ -1058,7 +1084,7 @@ static void warm_start(const km__frame_plan *p, double t, double *c) {
 
 km_status km__frame_plan_curve(const km__frame_plan *p, double t,
                                double theta0, bool close_lsq, km_curve *out,
-                               double *ends, km_error *err) {
+                               double *ends, km__poll *poll, km_error *err) {
   double Lt = (1 - t) * p->La + t * p->Lb, al = 1 - t, be = t;
   size_t np = p->np;
   double c[NF] = {0};
@@ -1074,7 +1100,7 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t,
   km_status st = KM_OK;
   bool by_corners = false;
   if (lsq && p->by_corners) {
-    st = close_frame(p, t, theta0, false, false, c, sum, sum + 2 * np);
+    st = close_frame(p, t, theta0, false, false, c, sum, sum + 2 * np, poll);
     by_corners = !st && corner_closure(p, t, sum, tau, delta, S, dp);
   }
   if (!st && !by_corners) {
@@ -1085,11 +1111,16 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t,
      * Should the steps fail, the projection from there, as the kept
      * corrections were found. */
     if (lsq) warm_start(p, t, c);
-    st = close_frame(p, t, theta0, close_lsq, false, c, sum, sum + 2 * np);
+    st = close_frame(p, t, theta0, close_lsq, false, c, sum, sum + 2 * np,
+                     poll);
     if (st == KM_ENOCONVERGE && lsq) {
       warm_start(p, t, c);
-      st = close_frame(p, t, theta0, true, true, c, sum, sum + 2 * np);
+      st = close_frame(p, t, theta0, true, true, c, sum, sum + 2 * np, poll);
     }
+  }
+  if (st == KM_ECANCELLED || (poll && poll->stopped)) {
+    free(sum);
+    return km__stopped(err);
   }
   if (st) {
     free(sum);

@@ -26,13 +26,16 @@ typedef struct km__frame_plan km__frame_plan;
  * and a tenth to merging the inputs' pieces). More than max_pieces pieces
  * a frame (0: no bound but memory) fails with KM_ELIMIT, early: the
  * uniform splits are refused past twice that before their bounds are
- * taken. */
+ * taken. Stops (KM_ECANCELLED) when poll says so (NULL: never). */
 km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const double length[2],
                                const double angle[2], bool closed, double tol,
-                               size_t max_pieces, km_error *err);
+                               size_t max_pieces, km__poll *poll,
+                               km_error *err);
 void km__frame_plan_free(km__frame_plan *p);
 size_t km__frame_plan_pieces(const km__frame_plan *p);
 size_t km__frame_plan_nodes(const km__frame_plan *p);
+/* Control points of every frame km__frame_plan_curve builds. */
+size_t km__frame_plan_points(const km__frame_plan *p);
 /* The pieces' ends in normalised arc length r (pieces + 1 of them). */
 const double *km__frame_plan_breaks(const km__frame_plan *p);
 /* Whether the lsq closure of this morph's frames goes by their corners
@@ -56,10 +59,11 @@ void km__closure_metric_weighted(const double *w, double *M);
  * origin with tangent angle theta0. close_lsq: closes a closed pair by the
  * lsq correction of theta. The result is marked closed (end snapped to start) when
  * its gap is within the tolerance. ends (optional, 2 (pieces + 1) values)
- * receives the pieces' end points. */
+ * receives the pieces' end points. Stops (KM_ECANCELLED) when poll says so
+ * (NULL: never). */
 km_status km__frame_plan_curve(const km__frame_plan *p, double t,
                                double theta0, bool close_lsq, km_curve *out,
-                               double *ends, km_error *err);
+                               double *ends, km__poll *poll, km_error *err);
 
 /* Closure by the corners: a frame whose integral of e^(i theta) splits at
  * its nc interior corners (turns tau) into stretch integrals S (2 (nc + 1)

@@ -183,9 +183,13 @@ typedef struct plan {
   out_piece *p;
   size_t n, cap;
   size_t limit; /* pieces allowed (KM_MAX_OUTPUT_PIECES beyond the input's) */
+  km__poll *poll; /* the caller's stop condition, or NULL */
 } plan;
 
 static km_status plan_push(plan *pl, out_piece op) {
+  /* a piece's bounds cost a few dozen operations, its output about as
+   * many again: some 8 units */
+  if (km__poll_stop(pl->poll, 8)) return KM_ECANCELLED;
   if (pl->n >= pl->limit) return KM_ELIMIT;
   if (pl->n == pl->cap) {
     size_t cap = pl->cap ? 2 * pl->cap : 64;
@@ -299,12 +303,31 @@ static void merge_cubic(plan *pl, const theta_pieces *tp, double tol) {
 
 km_status km_reconstruct(const km_signature *sig, int degree, double tol,
                          km_curve *out, double *error_bound, km_error *err) {
-  return km_reconstruct_within(sig, degree, tol, 0, out, error_bound, err);
+  return km__reconstruct(sig, degree, tol, 0, NULL, out, error_bound, NULL,
+                         err);
 }
 
 km_status km_reconstruct_within(const km_signature *sig, int degree, double tol,
                                 size_t max_points, km_curve *out,
                                 double *error_bound, km_error *err) {
+  return km__reconstruct(sig, degree, tol, max_points, NULL, out, error_bound,
+                         NULL, err);
+}
+
+km_status km_reconstruct_until(const km_signature *sig, int degree, double tol,
+                               size_t max_points, const km_stop *stop,
+                               km_curve *out, double *error_bound,
+                               km_error *err) {
+  km__poll poll;
+  km__poll_init(&poll, stop);
+  return km__reconstruct(sig, degree, tol, max_points, &poll, out, error_bound,
+                         NULL, err);
+}
+
+km_status km__reconstruct(const km_signature *sig, int degree, double tol,
+                          size_t max_points, km__poll *poll, km_curve *out,
+                          double *error_bound, size_t *points_only,
+                          km_error *err) {
   if (degree != 3 && degree != 5)
     return km__fail(err, KM_EDEGREE, KM_FIELD_DEGREE, -1, NAN,
                     "reconstruction degree must be 3 or 5, not %d", degree);
@@ -312,7 +335,7 @@ km_status km_reconstruct_within(const km_signature *sig, int degree, double tol,
   if (!(tol > 0) || !isfinite(tol)) tol = 1e-5 * L;
   if (tol < KM_MIN_RELATIVE_TOLERANCE * L) tol = KM_MIN_RELATIVE_TOLERANCE * L;
   theta_pieces tp;
-  plan pl = {NULL, 0, 0, 0};
+  plan pl = {NULL, 0, 0, 0, poll};
   double *pos = NULL;
   km_curve c;
   km_curve_init(&c);
@@ -326,6 +349,10 @@ km_status km_reconstruct_within(const km_signature *sig, int degree, double tol,
     pl.limit = max_points / (size_t)degree;
   for (size_t i = 0; i < tp.theta.m; i++) {
     st = plan_range(&pl, &tp, i, 0.0, 1.0, degree, 0.9 * tol, 0);
+    if (st == KM_ECANCELLED) {
+      km__stopped(err);
+      goto cleanup;
+    }
     if (st) {
       st = km__fail(err, st, KM_FIELD_TOLERANCE, -1, NAN,
                     st == KM_ELIMIT ? "the curve needs more than %zu pieces "
@@ -347,7 +374,7 @@ km_status km_reconstruct_within(const km_signature *sig, int degree, double tol,
   pos[0] = sig->start[0];
   pos[1] = sig->start[1];
   double max_bound = 0.0;
-  for (size_t j = 0; j < np; j++) {
+  for (size_t j = 0; j < np && !points_only; j++) {
     const out_piece *op = &pl.p[j];
     double sx = 0.0, sy = 0.0;
     for (size_t i = op->piece; i <= op->piece_end; i++) {
@@ -360,6 +387,11 @@ km_status km_reconstruct_within(const km_signature *sig, int degree, double tol,
                         kb[0], d);
       sx += d[0];
       sy += d[1];
+      /* 16 nodes a chunk of at most half a radian (km__integrate_exp) */
+      if (km__poll_stop(poll, 16 + (long)fmin(32.0 * kb[0] * (u1 - u0) * h, 1e9))) {
+        st = km__stopped(err);
+        goto cleanup;
+      }
     }
     pos[2 * j + 2] = pos[2 * j] + sx;
     pos[2 * j + 3] = pos[2 * j + 1] + sy;
@@ -391,6 +423,11 @@ km_status km_reconstruct_within(const km_signature *sig, int degree, double tol,
     nknots += (size_t)mult;
   }
   ncp = nknots - (size_t)p - 1;
+  if (points_only) {
+    free(cont);
+    *points_only = ncp;
+    goto cleanup;
+  }
   st = km__curve_alloc(&c, p, ncp, false);
   if (st) {
     free(cont);

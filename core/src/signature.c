@@ -205,6 +205,7 @@ typedef struct builder {
   long span_work;       /* and for the span being processed */
   double free_len;      /* position error left for pieces taken as turning
                            uniformly (twice their length) */
+  km__poll *poll;        /* the caller's stop condition, or NULL */
   km_error *err;
 } builder;
 
@@ -565,6 +566,7 @@ static km_status take_turn(builder *b, double turn, double s,
 static km_status fit_piece(builder *b, double ua, double ub, double known_len,
                            double *s_at, double *theta, const double dir_a[2],
                            const double dir_b[2], int depth) {
+  if (km__poll_stop(b->poll, 2 * NPTS)) return km__stopped(b->err);
   if (b->span_work < 0)
     return km__fail(b->err, KM_ELIMIT, KM_FIELD_TOLERANCE, -1, ua,
                     "the curve needs too much work at tolerance %g near "
@@ -816,11 +818,20 @@ static km_status check_cusp(builder *b, double turn, double t, double s) {
 
 km_status km_signature_compute(const km_curve *c, double tol,
                                km_signature *out, km_error *err) {
-  return km__signature_compute(c, tol, 1e-5, out, err);
+  return km__signature_compute(c, tol, 1e-5, NULL, out, err);
+}
+
+km_status km_signature_compute_until(const km_curve *c, double tol,
+                                     const km_stop *stop, km_signature *out,
+                                     km_error *err) {
+  km__poll poll;
+  km__poll_init(&poll, stop);
+  return km__signature_compute(c, tol, 1e-5, &poll, out, err);
 }
 
 km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
-                                km_signature *out, km_error *err) {
+                                km__poll *poll, km_signature *out,
+                                km_error *err) {
   if (!c || !c->knots || !c->cp || c->degree < KM_MIN_DEGREE ||
       c->degree > KM_MAX_DEGREE || c->n < (size_t)c->degree + 1)
     return km__fail(err, KM_EINVAL, KM_FIELD_NONE, -1, NAN,
@@ -829,6 +840,7 @@ km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
   memset(&b, 0, sizeof b);
   b.c = c;
   b.err = err;
+  b.poll = poll;
   b.pending_start = NAN;
   b.work = KM_SIGNATURE_WORK_BASE + KM_SIGNATURE_WORK_PER_POINT * (long)c->n;
   km_status st = KM_OK;
@@ -864,6 +876,10 @@ km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
                                        &evals);
       span_len[i] = est;
       b.work -= evals;
+      if (km__poll_stop(poll, 16 + evals)) {
+        st = km__stopped(err);
+        goto cleanup;
+      }
     }
     L += span_len[i];
     if (isnan(L)) break; /* reported below; no more work for this curve */

@@ -15,6 +15,7 @@
 
 #include "km/curve.h"
 #include "km/signature.h"
+#include "km/stop.h"
 
 typedef enum km_morph_method { KM_METHOD_CURVATURE, KM_METHOD_LINEAR } km_morph_method;
 typedef enum km_blend { KM_BLEND_TURNING, KM_BLEND_PAPER } km_blend;
@@ -42,6 +43,10 @@ typedef struct km_morph_options {
   bool auto_matches;      /* matches: "auto" */
   size_t max_points;      /* control points a frame may have; 0: the core's
                              own bound (KM_MAX_OUTPUT_PIECES) */
+  const km_stop *stop;    /* km_morph_create ends early with KM_ECANCELLED
+                             when this asks it to (km/stop.h); NULL, the
+                             default: never. Borrowed for the call only:
+                             the morph keeps no reference to it */
 } km_morph_options;
 
 void km_morph_options_default(km_morph_options *o);
@@ -67,7 +72,10 @@ typedef struct km_morph km_morph;
  * KM_ETURNING (closed curves of different turning numbers; the message
  * gives both), KM_EMATCH (matches not strictly increasing in (0,1) on both
  * sides; err->index is the pair), KM_ECUSP / KM_EDEGENERATE from the
- * inputs, KM_ENOMEM. *out is owned by the caller (km_morph_free). */
+ * inputs, KM_ENOMEM, KM_ECANCELLED when opt->stop asked it to stop (its
+ * signatures, tables, automatic matches, start search, plans and preview
+ * frames all poll it; nothing is leaked). *out is owned by the caller
+ * (km_morph_free). */
 km_status km_morph_create(km_morph **out, const km_morph_input *from,
                           const km_morph_input *to,
                           const km_morph_options *opt, km_error *err);
@@ -82,6 +90,31 @@ km_status km_morph_frame(const km_morph *m, double t, km_curve *out,
                          km_frame_metrics *metrics, km_signature *sig_out,
                          km_error *err);
 
+/* km_morph_frame that ends early when stop (km/stop.h; NULL: never) asks
+ * it to: then KM_ECANCELLED and nothing written to out, metrics or
+ * sig_out. The blend, closure, reconstruction, plan passes and the
+ * crossing count of the metrics poll it. Distinct calls may pass distinct
+ * stops on one shared morph. */
+km_status km_morph_frame_until(const km_morph *m, double t,
+                               const km_stop *stop, km_curve *out,
+                               km_frame_metrics *metrics,
+                               km_signature *sig_out, km_error *err);
+
+/* What a frame is asked for: its curve alone, or its metrics or signature
+ * too (such frames are blended and reconstructed exactly, not taken from
+ * the morph's plan, and may have other control points). */
+typedef enum km_frame_parts { KM_FRAME_CURVE, KM_FRAME_WITH_METRICS } km_frame_parts;
+
+/* Control points the curve of the frame at t will have (km_morph_frame
+ * with metrics or a signature asked for when parts is
+ * KM_FRAME_WITH_METRICS), in *points, without building it: exact, and for
+ * a planned morph's curves free; otherwise at the cost of the frame's
+ * blend and closure (a third to a half of the frame). Stops as
+ * km_morph_frame_until. Errors as km_morph_frame. Thread-safe. */
+km_status km_morph_frame_points(const km_morph *m, double t,
+                                km_frame_parts parts, const km_stop *stop,
+                                size_t *points, km_error *err);
+
 /* The correspondence used, as pairs of arc-length fractions (r_from, r_to):
  * writes up to cap pairs into pairs (may be NULL), returns the count. */
 size_t km_morph_matches_used(const km_morph *m, double *pairs, size_t cap);
@@ -93,5 +126,11 @@ void km_morph_inputs(const km_morph *m, double length[2], double turning[2]);
  * curve folded almost onto itself over a long stretch gets the crossings
  * found within a bounded amount of work: see intersect.c). */
 long km_curve_self_intersections(const km_curve *c, double tol);
+/* The same count ending early when stop (km/stop.h; NULL: never) asks it
+ * to: KM_OK with *count, KM_ECANCELLED (*count untouched), KM_EINVAL for
+ * an invalid curve, KM_ENOMEM. */
+km_status km_curve_self_intersections_until(const km_curve *c, double tol,
+                                            const km_stop *stop,
+                                            long *count);
 
 #endif

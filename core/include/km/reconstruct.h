@@ -12,6 +12,7 @@
 
 #include "km/curve.h"
 #include "km/signature.h"
+#include "km/stop.h"
 
 /* Reconstruct sig as a B-spline of degree 3 or 5 (else KM_EDEGREE) within
  * tol (tol <= 0: 1e-5 * length). Corners become knots of multiplicity
@@ -31,6 +32,15 @@ km_status km_reconstruct(const km_signature *sig, int degree, double tol,
 km_status km_reconstruct_within(const km_signature *sig, int degree, double tol,
                                 size_t max_points, km_curve *out,
                                 double *error_bound, km_error *err);
+
+/* km_reconstruct_within that ends early when stop (km/stop.h; NULL:
+ * never) asks it to: then KM_ECANCELLED, *out and *error_bound untouched,
+ * nothing leaked. Polled every KM_STOP_POLL_UNITS units of work (an output
+ * piece planned, a quadrature node). */
+km_status km_reconstruct_until(const km_signature *sig, int degree, double tol,
+                               size_t max_points, const km_stop *stop,
+                               km_curve *out, double *error_bound,
+                               km_error *err);
 
 /* Exact curve point at arc length s (numerical quadrature to ~1e-15 L):
  * used by tests and metrics. pos and tangent angle. */

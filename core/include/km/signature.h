@@ -13,6 +13,7 @@
 
 #include "km/curve.h"
 #include "km/fn.h"
+#include "km/stop.h"
 
 typedef struct km_corner {
   double s;    /* arc length of the corner, in [0, length] */
@@ -58,6 +59,13 @@ km_status km_signature_create(km_signature *out, double length,
  * Thread-safe; out owned by the caller. */
 km_status km_signature_compute(const km_curve *c, double tol,
                                km_signature *out, km_error *err);
+
+/* km_signature_compute that ends early when stop (km/stop.h; NULL: never)
+ * asks it to: then KM_ECANCELLED, *out untouched, nothing leaked. It is
+ * polled once every KM_STOP_POLL_UNITS curve evaluations. */
+km_status km_signature_compute_until(const km_curve *c, double tol,
+                                     const km_stop *stop, km_signature *out,
+                                     km_error *err);
 
 /* Tangent angle theta(s) (corner turns at s included from the right). */
 double km_signature_theta(const km_signature *sig, double s);
