@@ -25,6 +25,7 @@ void api_config_default(api_config *cfg) {
   cfg->max_frames_job = 10000;
   cfg->max_samples = 100000;
   cfg->max_json_depth = 64;
+  cfg->max_output_bytes = 64u * 1024u * 1024u;
 }
 
 void api_response_init(api_response *r) {
@@ -739,6 +740,13 @@ int api_handle(const api_config *cfg, const api_request *req,
     int st = api_morph_prepare(cfg, req, cfg->max_frames_sync, &plan, out);
     if (st != 0)
       return st;
+    /* frames under the request's stop; a stopped or failed one is
+     * reported by api_morph_result */
+    for (size_t i = 0; req->stop != NULL && i < api_morph_frame_count(plan);
+         i++)
+      if (api_morph_render_frame_until(plan, i, req->stop, req->stop_ctx) ==
+          503)
+        break;
     st = api_morph_result(plan, out);
     api_morph_plan_free(plan);
     return st;

@@ -39,6 +39,7 @@
 #define API_P_TOO_LARGE "/problems/body-too-large"
 #define API_P_NOT_FOUND "/problems/not-found"
 #define API_P_INTERNAL "/problems/internal"
+#define API_P_STOPPED "/problems/stopped"
 
 /* The request being handled and the first error found in it. */
 typedef struct api_ctx {
@@ -84,6 +85,28 @@ bool api__core_fail(api_ctx *ctx, km_status st, const km_error *err,
 
 /* Out-of-memory in the api layer itself (503). */
 bool api__oom(api_ctx *ctx);
+
+/* The caller's stop said stop (503 /problems/stopped; the server puts its
+ * own reason in its place). */
+static inline bool api__stopped(api_ctx *ctx) {
+  return api__fail(ctx, 503, API_P_STOPPED, "Stopped", NULL,
+                   "the computation was stopped before it finished");
+}
+
+/* A request's stop as the core takes it; NULL when it has none. */
+static inline const km_stop *api__km_stop(const api_request *req,
+                                          km_stop *buf) {
+  if (req->stop == NULL)
+    return NULL;
+  buf->requested = req->stop;
+  buf->ctx = req->stop_ctx;
+  return buf;
+}
+
+/* Bytes a curve takes in the JSON answer, at most: n control points of
+ * the given degree (weights if rational), plus its "svg_d" when asked. */
+size_t api__curve_json_bytes(size_t n, int degree, bool rational,
+                             bool svg_d);
 
 /* Write "<base>/<key>" or "<base>/<index>" into buf (API_POINTER_MAX). */
 void api__ptr_key(char *buf, const char *base, const char *key);

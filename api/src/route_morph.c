@@ -16,6 +16,7 @@
 #include <ctype.h>
 #include <limits.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -55,6 +56,7 @@ struct api_morph_plan {
   double tol;
   api_svg_options svgopt;
   char stroke[COLOUR_MAX], from_color[COLOUR_MAX], to_color[COLOUR_MAX];
+  size_t predicted; /* upper bound on the result's bytes */
 };
 
 static const char *const method_names[] = {"curvature", "linear"};
@@ -372,12 +374,14 @@ static bool parse_options(api_ctx *ctx, const cJSON *root,
 
 /* The signature of a curve input, so that its failures name the input. */
 static bool input_signature(api_ctx *ctx, api_input *in, const char *ptr,
-                            double tol) {
+                            double tol, const km_stop *stop) {
   km_error err;
   km_status st;
   if (in->is_signature)
     return true;
-  st = km_signature_compute(&in->curve, tol, &in->sig, &err);
+  st = km_signature_compute_until(&in->curve, tol, stop, &in->sig, &err);
+  if (st == KM_ECANCELLED)
+    return api__stopped(ctx);
   if (st != KM_OK)
     return api__core_fail(ctx, st, &err, ptr, in->kind);
   return true;
@@ -389,6 +393,178 @@ static km_morph_input morph_input(const api_input *in) {
   /* For curve inputs the signature is there only if computed above. */
   mi.sig = in->is_signature || in->sig.length > 0 ? &in->sig : NULL;
   return mi;
+}
+
+/* -------------------------------------------------- predicted output size */
+
+/* A number as api__number prints it, with its comma: %.17g is at most 24
+ * characters (sign, 17 digits, point, "e-308"). */
+#define JSON_NUM_BYTES 25
+/* A number of an SVG path as api_svg_path_d prints it (the shorter of its
+ * %e and %f forms, at most 26 characters) with its separator. */
+#define SVG_NUM_BYTES 27
+/* A pixel coordinate of an SVG document (canvases of at most 1e5 px, to
+ * PX_BUDGET: "-100000.005") with its separator. */
+#define PX_NUM_BYTES 12
+/* Members, keys and punctuation of a frame besides its numbers (its
+ * metrics' five numbers included), and of the document around them. */
+#define FRAME_FIXED_BYTES 400
+#define DOC_FIXED_BYTES 4096
+
+/* Numbers of cubic pieces' points a curve of n control points puts in a
+ * path. Curvature frames are Hermite splines: a cubic's knots are double
+ * (a span per two control points, three Bezier points a span), a
+ * quintic's at least triple, each span drawn as up to four cubics (halved
+ * until within the tolerance). Other curves (linear frames) have a span
+ * per control point. */
+static size_t path_numbers(size_t n, int degree, bool hermite) {
+  if (hermite)
+    return (degree <= 3 ? 3 : 8) * n + 2;
+  return (degree <= 3 ? 6 : 24) * n + 2;
+}
+
+/* Bytes of a path number of magnitude up to M printed within budget (the
+ * shorter of its fixed and scientific forms, at most SVG_NUM_BYTES),
+ * with its separator. */
+static size_t svg_num_bytes(double M, double budget) {
+  if (!(M > 0) || !(budget > 0) || !isfinite(M / budget))
+    return SVG_NUM_BYTES;
+  double ints = fmax(1.0, floor(log10(M)) + 1);
+  double decs = fmax(0.0, ceil(log10(0.5 / budget)));
+  double b = 3 + ints + decs; /* sign, point, separator */
+  return b < SVG_NUM_BYTES ? (size_t)b : SVG_NUM_BYTES;
+}
+
+/* Largest coordinate a frame may have: frames lie within a length of the
+ * inputs' points (placement keeps them there), so the inputs' largest
+ * coordinate plus both lengths. */
+static double frames_extent(const api_morph_plan *pl) {
+  double m = 0;
+  const api_input *in[2] = {&pl->from, &pl->to};
+  for (int k = 0; k < 2; k++) {
+    if (in[k]->is_signature || in[k]->curve.cp == NULL) {
+      m = fmax(m, fabs(in[k]->sig.start[0]) + fabs(in[k]->sig.start[1]));
+      continue;
+    }
+    for (size_t i = 0; i < 2 * in[k]->curve.n; i++)
+      m = fmax(m, fabs(in[k]->curve.cp[i]));
+  }
+  return m + pl->from.length + pl->to.length;
+}
+
+size_t api__curve_json_bytes(size_t n, int degree, bool rational,
+                             bool svg_d) {
+  size_t knots = n + (size_t)degree + 1;
+  size_t b = 128 + JSON_NUM_BYTES * (knots + 2 * n + (rational ? n : 0)) +
+             3 * n;
+  if (svg_d)
+    b += 16 + SVG_NUM_BYTES * path_numbers(n, degree, false);
+  return b;
+}
+
+/* Control points of the frames at most: the frames of a planned morph
+ * share one count, known exactly; others are counted at the first, middle
+ * and last requested times (without building the curves) and given a
+ * quarter more, as the count moves smoothly with t. */
+static km_status frame_points(const api_morph_plan *pl, const km_stop *stop,
+                              size_t *points, km_error *err) {
+  km_frame_parts parts = pl->metrics || pl->want_sig ? KM_FRAME_WITH_METRICS
+                                                     : KM_FRAME_CURVE;
+  size_t idx[3] = {0, pl->nframes / 2, pl->nframes - 1}, most = 0;
+  size_t first = 0, last = 0;
+  for (int k = 0; k < 3; k++) {
+    size_t n = 0;
+    km_status st = km_morph_frame_points(pl->morph, pl->frames[idx[k]].t,
+                                         parts, stop, &n, err);
+    if (st != KM_OK)
+      return st;
+    if (k == 0)
+      first = n;
+    if (k == 2)
+      last = n;
+    most = n > most ? n : most;
+  }
+  /* equal counts at both ends and the middle: a planned (constant) count */
+  *points = most == first && most == last ? most : most + most / 4 + 8;
+  return KM_OK;
+}
+
+/* Upper bound on the result's bytes for frames of `points` control
+ * points. */
+static size_t predict_bytes(const api_morph_plan *pl, size_t points) {
+  int degree = pl->opt.degree;
+  bool rational = false;
+  size_t per, n = pl->nframes;
+  if (pl->opt.method == KM_METHOD_LINEAR) {
+    degree = pl->from.curve.degree > pl->to.curve.degree
+                 ? pl->from.curve.degree
+                 : pl->to.curve.degree;
+    rational = pl->from.curve.w != NULL || pl->to.curve.w != NULL;
+  }
+  bool hermite = pl->opt.method == KM_METHOD_CURVATURE;
+  size_t numbers = path_numbers(points, degree, hermite);
+  if (pl->svg) {
+    /* one path a frame, the animation's values repeat every frame's */
+    size_t per_path = 64 + PX_NUM_BYTES * numbers;
+    per = FRAME_FIXED_BYTES + per_path;
+    if (pl->svgopt.layout == API_SVG_ANIMATE)
+      per += per_path;
+    if (pl->want_sig) {
+      /* kappa samples as svg_render.c takes them: a budget per frame
+       * shared by the spans of kappa (fewer than the control points), at
+       * least three a span, at most 4,002 */
+      size_t budget = n > 0 ? 400000 / n : 1600;
+      budget = budget > 1600 ? 1600 : budget < 100 ? 100 : budget;
+      size_t samples = budget + points > 3 * points ? budget + points
+                                                    : 3 * points;
+      samples = samples + 2 > 4002 ? 4002 : samples + 2;
+      per += samples * 2 * PX_NUM_BYTES;
+    }
+  } else {
+    double M = frames_extent(pl);
+    per = FRAME_FIXED_BYTES +
+          api__curve_json_bytes(points, degree, rational, false);
+    if (pl->inc.svg_d) /* printed within a quarter of the tolerance */
+      per += 16 + svg_num_bytes(M, 0.25 * pl->tol) * numbers;
+    if (pl->inc.animate_d) /* to 1e-6 of the frame's extent */
+      per += 16 + svg_num_bytes(M, 1e-6 * M) * numbers;
+  }
+  /* matches_used: at most max_control_points pairs */
+  size_t matches = pl->opt.auto_matches ? 64 : pl->opt.nmatches;
+  size_t fixed = DOC_FIXED_BYTES + (2 * JSON_NUM_BYTES + 3) * matches;
+  if (n > 0 && per > (SIZE_MAX - fixed) / n)
+    return SIZE_MAX;
+  return fixed + per * n;
+}
+
+/* Refuse, before any frame is rendered, a result larger than
+ * max_output_bytes: naming the tolerance when even the fewest frames (2)
+ * would not fit, else the frames. */
+static bool check_output_size(api_ctx *ctx, api_morph_plan *pl,
+                              const km_stop *stop) {
+  size_t points = 0, limit = pl->cfg.max_output_bytes;
+  km_error err;
+  km_status st = frame_points(pl, stop, &points, &err);
+  if (st == KM_ECANCELLED)
+    return api__stopped(ctx);
+  if (st != KM_OK)
+    return api__core_fail(ctx, st, &err, "", API_KIND_REQUEST);
+  pl->predicted = predict_bytes(pl, points);
+  if (limit == 0 || pl->predicted <= limit)
+    return true;
+  size_t nframes = pl->nframes;
+  pl->nframes = 2;
+  bool tol_dominates = predict_bytes(pl, points) > limit;
+  pl->nframes = nframes;
+  return api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded",
+                    tol_dominates ? "/tolerance"
+                                  : api_morph_frames_pointer(pl),
+                    "the answer would take up to %zu bytes (%zu frames of "
+                    "up to %zu control points); the limit is %zu bytes: "
+                    "%s",
+                    pl->predicted, nframes, points, limit,
+                    tol_dominates ? "loosen the tolerance"
+                                  : "ask for fewer frames");
 }
 
 /* ----------------------------------------------------------------- public */
@@ -419,6 +595,8 @@ int api_morph_prepare(const api_config *cfg, const api_request *req,
   km_morph_input fi, ti;
   km_error err;
   km_status st;
+  km_stop stop_buf;
+  const km_stop *stop = api__km_stop(req, &stop_buf);
 
   if (cfg == NULL) {
     api_config_default(&defaults);
@@ -471,16 +649,24 @@ int api_morph_prepare(const api_config *cfg, const api_request *req,
   /* frames are curves of the answer: held to the limit on curves */
   pl->opt.max_points = pl->cfg.max_control_points;
   if (pl->opt.method == KM_METHOD_CURVATURE &&
-      (!input_signature(&ctx, &pl->from, "/from", pl->tol) ||
-       !input_signature(&ctx, &pl->to, "/to", pl->tol)))
+      (!input_signature(&ctx, &pl->from, "/from", pl->tol, stop) ||
+       !input_signature(&ctx, &pl->to, "/to", pl->tol, stop)))
     goto fail;
   fi = morph_input(&pl->from);
   ti = morph_input(&pl->to);
+  pl->opt.stop = stop;
   st = km_morph_create(&pl->morph, &fi, &ti, &pl->opt, &err);
+  pl->opt.stop = NULL;
+  if (st == KM_ECANCELLED) {
+    api__stopped(&ctx);
+    goto fail;
+  }
   if (st != KM_OK) {
     api__core_fail(&ctx, st, &err, "", API_KIND_REQUEST);
     goto fail;
   }
+  if (!check_output_size(&ctx, pl, stop))
+    goto fail;
   *plan = pl;
   return 0;
 fail:
@@ -499,7 +685,17 @@ const char *api_morph_frames_pointer(const api_morph_plan *plan) {
 }
 
 int api_morph_render_frame(api_morph_plan *plan, size_t i) {
+  return api_morph_render_frame_until(plan, i, NULL, NULL);
+}
+
+size_t api_morph_predicted_bytes(const api_morph_plan *plan) {
+  return plan != NULL ? plan->predicted : 0;
+}
+
+int api_morph_render_frame_until(api_morph_plan *plan, size_t i,
+                                 api_stop_fn stop, void *ctx) {
   frame_slot *f;
+  km_stop ks = {stop, ctx};
   if (plan == NULL || i >= plan->nframes)
     return 404;
   f = &plan->frames[i];
@@ -508,12 +704,12 @@ int api_morph_render_frame(api_morph_plan *plan, size_t i) {
   km_curve_free(&f->curve);
   km_signature_free(&f->sig);
   memset(&f->err, 0, sizeof f->err);
-  f->st = km_morph_frame(plan->morph, f->t, &f->curve,
-                         plan->metrics ? &f->metrics : NULL,
-                         plan->want_sig ? &f->sig : NULL, &f->err);
+  f->st = km_morph_frame_until(plan->morph, f->t, stop != NULL ? &ks : NULL,
+                               &f->curve, plan->metrics ? &f->metrics : NULL,
+                               plan->want_sig ? &f->sig : NULL, &f->err);
   if (f->st != KM_OK) {
     f->state = -1;
-    return f->st == KM_ENOMEM ? 503 : 422;
+    return f->st == KM_ENOMEM || f->st == KM_ECANCELLED ? 503 : 422;
   }
   f->state = 1;
   return 0;
@@ -698,6 +894,11 @@ int api_morph_result(api_morph_plan *plan, api_response *out) {
       api_morph_render_frame(plan, i);
     if (f->state == 1)
       continue;
+    if (f->st == KM_ECANCELLED) {
+      api__stopped(&ctx);
+      api__ctx_problem(&ctx, out, plan->request_id);
+      return out->status;
+    }
     /* Name the frame: its entry of "times", or the request as a whole. */
     if (plan->times_given)
       api__ptr_idx(base, "/times", i);

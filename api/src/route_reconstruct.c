@@ -19,6 +19,8 @@ int api__route_reconstruct(api_ctx *ctx, const api_request *req,
   api_include inc;
   km_error err;
   km_status st;
+  km_stop stop_buf;
+  size_t predicted;
 
   km_signature_init(&sig);
   km_curve_init(&curve);
@@ -37,11 +39,29 @@ int api__route_reconstruct(api_ctx *ctx, const api_request *req,
       !api__parse_signature(ctx, js, "/signature", &sig))
     goto fail;
   /* the answer's curve is held to the limit on curves, as inputs are */
-  st = km_reconstruct_within(&sig, (int)degree, tol,
-                             ctx->cfg->max_control_points, &curve, &bound,
-                             &err);
+  st = km_reconstruct_until(&sig, (int)degree, tol,
+                            ctx->cfg->max_control_points,
+                            api__km_stop(req, &stop_buf), &curve, &bound,
+                            &err);
+  if (st == KM_ECANCELLED) {
+    api__stopped(ctx);
+    goto fail;
+  }
   if (st != KM_OK) {
     api__core_fail(ctx, st, &err, "/signature", API_KIND_SIGNATURE);
+    goto fail;
+  }
+  /* the answer's size from its control points, before it is printed */
+  predicted = api__curve_json_bytes(curve.n, curve.degree, curve.w != NULL,
+                                    inc.svg_d) +
+              64;
+  if (ctx->cfg->max_output_bytes > 0 &&
+      predicted > ctx->cfg->max_output_bytes) {
+    api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded", "/tolerance",
+               "the answer would take up to %zu bytes (a curve of %zu "
+               "control points); the limit is %zu bytes: loosen the "
+               "tolerance",
+               predicted, curve.n, ctx->cfg->max_output_bytes);
     goto fail;
   }
   res = cJSON_CreateObject();

@@ -53,7 +53,13 @@ int api__route_signature(api_ctx *ctx, const api_request *req,
   if (in.is_signature) {
     use = &in.sig;
   } else {
-    st = km_signature_compute(&in.curve, tol, &sig, &err);
+    km_stop stop_buf;
+    st = km_signature_compute_until(&in.curve, tol,
+                                    api__km_stop(req, &stop_buf), &sig, &err);
+    if (st == KM_ECANCELLED) {
+      api__stopped(ctx);
+      goto fail;
+    }
     if (st != KM_OK) {
       api__core_fail(ctx, st, &err, "/curve", in.kind);
       goto fail;
