@@ -1162,45 +1162,57 @@ static bool bern_interp(const double *u, double *val, int n) {
   return km__solve_dense(A, val, n + 1);
 }
 
-/* Returns KM_EINVAL when the smooth map is not monotone for these matches
- * (the caller then keeps the piecewise-linear correspondence). */
-static km_status blend_smooth(const km_morph *m, double t, km_pp *out,
-                              corner_list *cl) {
-  const input *a = &m->in[0], *b = &m->in[1];
-  double La = a->sig.length, Lb = b->sig.length;
-  size_t K = m->nk - 1; /* segments */
-  double *buf = malloc((5 * K + 3) * sizeof(double));
-  if (!buf) return KM_ENOMEM;
-  double *rho = buf, *len = buf + K, *S = buf + 2 * K, *node = buf + 3 * K + 1,
-         *mid = buf + 4 * K + 2;
-  S[0] = 0.0;
-  for (size_t k = 0; k < K; k++) {
-    double la = (m->ra[k + 1] - m->ra[k]) * La, lb = (m->rb[k + 1] - m->rb[k]) * Lb;
-    len[k] = (1 - t) * la + t * lb;
-    rho[k] = la / len[k];
-    S[k + 1] = S[k] + len[k];
+/* How much a segment of frame length lk moves alpha at the end of its
+ * neighbour (length lj) at their common match: fully (one value there,
+ * G2) unless it is shorter than SMOOTH_SHARE of the neighbour, then in
+ * proportion (G1 there). A match next to an end or to another match makes
+ * a segment 1e-300 of its neighbour, whose ratio to it may be anything:
+ * fully shared, it would bend the neighbour's correspondence over half the
+ * neighbour, and the frames would not tend to the morph without that match
+ * as it approaches the end (a circle into a circle with the match (1e-9,
+ * 1e-7) gave a frame 4.7e-2 off the circle of radius 1 + t). */
+#define SMOOTH_SHARE 1e-3
+static double influence(double lk, double lj) {
+  return lk >= SMOOTH_SHARE * lj ? 1.0 : lk / (SMOOTH_SHARE * lj);
+}
+
+/* alpha at the end of a segment (ratio rho_k, length lk) beside a
+ * neighbour (ratio rho_j, length lj): their mean, or toward rho_k as the
+ * neighbour is shorter (see influence) */
+static double end_value(double rho_k, double lk, double rho_j, double lj) {
+  double w = influence(lj, lk), mean = 0.5 * (rho_k + rho_j);
+  return w == 1.0 ? mean : rho_k + w * (mean - rho_k);
+}
+
+/* alpha = ds_a/ds_t at both ends of each segment (nl[k], nr[k]) and at its
+ * middle (mid[k]), the middle chosen so the segment covers exactly its part
+ * of a: (nl + 2 mid + nr) / 4 = rho[k]. Returns KM_EINVAL when alpha and
+ * beta cannot be kept positive. */
+static km_status smooth_nodes(const double *rho, const double *len, size_t K,
+                              bool closed, double t, double *nl, double *nr,
+                              double *mid) {
+  for (size_t k = 0; k + 1 < K; k++) {
+    nr[k] = end_value(rho[k], len[k], rho[k + 1], len[k + 1]);
+    nl[k + 1] = end_value(rho[k + 1], len[k + 1], rho[k], len[k]);
   }
-  for (size_t k = 1; k < K; k++) node[k] = 0.5 * (rho[k - 1] + rho[k]);
-  if (m->closed) {
-    node[0] = node[K] = 0.5 * (rho[0] + rho[K - 1]);
+  if (closed) {
+    nl[0] = end_value(rho[0], len[0], rho[K - 1], len[K - 1]);
+    nr[K - 1] = end_value(rho[K - 1], len[K - 1], rho[0], len[0]);
   } else {
-    node[0] = rho[0];
-    node[K] = rho[K - 1];
+    nl[0] = rho[0];
+    nr[K - 1] = rho[K - 1];
   }
   double amax = 1.0 / (1 - t);
   km_status st = KM_EINVAL;
   /* alpha and beta must stay positive at the middle nodes too: where a
    * segment's ratio differs much from its neighbours', pull its end nodes
-   * toward its own ratio (at the ratio itself the segment is feasible).
-   * Each pull halves the nodes' distance from the ratio as often as this
-   * segment alone needs: a match next to an end or to another match makes
-   * a ratio 1e-300 of its neighbours', a thousand halvings, and with fewer
-   * the map would turn piecewise linear (G1) only below some ratio, a jump
-   * in the frames as the match approaches the end. */
+   * toward its own ratio (at the ratio itself the segment is feasible), by
+   * as many halvings of their distance as this segment alone needs (a
+   * ratio 1e-300 of its neighbours' needs a thousand) */
   for (int round = 0; round < 64 && st; round++) {
     st = KM_OK;
     for (size_t k = 0; k < K; k++) {
-      mid[k] = 2 * rho[k] - 0.5 * (node[k] + node[k + 1]);
+      mid[k] = 2 * rho[k] - 0.5 * (nl[k] + nr[k]);
       double lo = 0.02 * fmin(rho[k], amax - rho[k]);
       if (mid[k] > lo && mid[k] < amax - lo) continue;
       st = KM_EINVAL;
@@ -1209,12 +1221,43 @@ static km_status blend_smooth(const km_morph *m, double t, km_pp *out,
       int halvings = 1;
       if (room > 0 && fabs(dev) > room) frexp(fabs(dev) / room, &halvings);
       if (halvings < 1) halvings = 1;
-      node[k] = rho[k] + ldexp(node[k] - rho[k], -halvings);
-      node[k + 1] = rho[k] + ldexp(node[k + 1] - rho[k], -halvings);
-      if (m->closed && k == 0) node[K] = node[0];
-      if (m->closed && k == K - 1) node[0] = node[K];
+      double l0 = nl[k], r0 = nr[k];
+      nl[k] = rho[k] + ldexp(nl[k] - rho[k], -halvings);
+      nr[k] = rho[k] + ldexp(nr[k] - rho[k], -halvings);
+      if (k > 0 || closed) {
+        size_t j = k > 0 ? k - 1 : K - 1;
+        double w = influence(len[k], len[j]);
+        nr[j] = w == 1.0 ? nl[k] : nr[j] + w * (nl[k] - l0);
+      }
+      if (k + 1 < K || closed) {
+        size_t j = k + 1 < K ? k + 1 : 0;
+        double w = influence(len[k], len[j]);
+        nl[j] = w == 1.0 ? nr[k] : nl[j] + w * (nr[k] - r0);
+      }
     }
   }
+  return st;
+}
+
+/* Returns KM_EINVAL when the smooth map is not monotone for these matches
+ * (the caller then keeps the piecewise-linear correspondence). */
+static km_status blend_smooth(const km_morph *m, double t, km_pp *out,
+                              corner_list *cl) {
+  const input *a = &m->in[0], *b = &m->in[1];
+  double La = a->sig.length, Lb = b->sig.length;
+  size_t K = m->nk - 1; /* segments */
+  double *buf = malloc((6 * K + 1) * sizeof(double));
+  if (!buf) return KM_ENOMEM;
+  double *rho = buf, *len = buf + K, *S = buf + 2 * K, *nl = buf + 3 * K + 1,
+         *nr = buf + 4 * K + 1, *mid = buf + 5 * K + 1;
+  S[0] = 0.0;
+  for (size_t k = 0; k < K; k++) {
+    double la = (m->ra[k + 1] - m->ra[k]) * La, lb = (m->rb[k + 1] - m->rb[k]) * Lb;
+    len[k] = (1 - t) * la + t * lb;
+    rho[k] = la / len[k];
+    S[k + 1] = S[k] + len[k];
+  }
+  km_status st = smooth_nodes(rho, len, K, m->closed, t, nl, nr, mid);
   if (st) {
     free(buf);
     return st;
@@ -1233,9 +1276,9 @@ static km_status blend_smooth(const km_morph *m, double t, km_pp *out,
   double sa_at = 0.0;
   for (size_t k = 0; k < K; k++) {
     double h = 0.5 * len[k];
-    qm[2 * k] = (quad_map){S[k], h, sa_at, node[k], mid[k]};
+    qm[2 * k] = (quad_map){S[k], h, sa_at, nl[k], mid[k]};
     sa_at = qm_sa(&qm[2 * k], S[k] + h);
-    qm[2 * k + 1] = (quad_map){S[k] + h, h, sa_at, mid[k], node[k + 1]};
+    qm[2 * k + 1] = (quad_map){S[k] + h, h, sa_at, mid[k], nr[k]};
     sa_at = m->ra[k + 1] * La; /* exact at the match */
     br[nb++] = S[k];
     br[nb++] = S[k] + h;
@@ -1349,6 +1392,75 @@ done:
   return st;
 }
 
+/* Pieces of a frame's curvature shorter than this fraction of its length
+ * are merged into a neighbour: ten times below the smallest tolerance
+ * honoured (KM_MIN_RELATIVE_TOLERANCE), some forty ulps of the length, so
+ * the breaks kept are distinct after rounding (a knot of the curvature
+ * that repeated would have multiplicity 2 (d + 1), an invalid spline). */
+#define SHORT_PIECE 1e-14
+
+/* Pieces of p restricted to [x0, x1], or where a match difference
+ * underflows to x1 == x0 (a subnormal fraction of a length below 1) the
+ * one value there as a constant: its length is only a ratio to the
+ * blend. */
+static km_status slice_or_point(km_pp *out, const km_pp *p, double x0,
+                                double x1) {
+  if (x1 > x0) return pp_slice(out, p, x0, x1);
+  km_status st = km__pp_alloc(out, 0, 1);
+  if (st) return st;
+  out->x[0] = 0.0;
+  out->x[1] = 1.0;
+  out->c[0] = km__pp_eval(p, x0);
+  return KM_OK;
+}
+
+/* The blended curvature on segment k of frame t, over [S, S + l] of the
+ * frame (l > 0), under the piecewise-linear correspondence. */
+static km_status blend_segment(const km_morph *m, double t, size_t k,
+                               double S, double l, km_pp *out) {
+  const input *a = &m->in[0], *b = &m->in[1];
+  double La = a->sig.length, Lb = b->sig.length;
+  double la = (m->ra[k + 1] - m->ra[k]) * La, lb = (m->rb[k + 1] - m->rb[k]) * Lb;
+  double wa = 1 - t, wb = t;
+  if (m->opt.blend != KM_BLEND_PAPER) {
+    wa = (1 - t) * la / l;
+    wb = t * lb / l;
+  }
+  km_pp sa, sb;
+  km__pp_init(&sa);
+  km__pp_init(&sb);
+  km_status st = slice_or_point(&sa, &a->kappa, m->ra[k] * La, m->ra[k + 1] * La);
+  if (!st) st = slice_or_point(&sb, &b->kappa, m->rb[k] * Lb, m->rb[k + 1] * Lb);
+  if (!st) st = km__pp_blend(out, &sa, wa, &sb, wb, S, S + l);
+  km__pp_free(&sa);
+  km__pp_free(&sb);
+  return st;
+}
+
+/* Paper blend: a corner's delta scales with the frame's length over the
+ * input's on its segment; an input segment of no length (a subnormal
+ * match difference) scales it past any bound, which the caller clamps. */
+static double corner_scale(double l, double lin) {
+  return lin > 0 ? l / lin : INFINITY;
+}
+
+/* Merge pieces of p shorter than h into a neighbour (the one before, or
+ * after for the first): the neighbour's polynomial covers them, stretched
+ * by at most h, which moves the function by under h times its slope. */
+static void drop_short_pieces(km_pp *p, double h) {
+  size_t q = 0, stride = (size_t)(p->degree + 1);
+  double end = p->x[p->m];
+  for (size_t i = 0; i < p->m; i++) {
+    if (!(p->x[i + 1] - p->x[i] > h)) continue;
+    p->x[q] = q == 0 ? p->x[0] : p->x[i];
+    if (q != i) memmove(p->c + q * stride, p->c + i * stride, stride * sizeof(double));
+    q++;
+  }
+  if (q == 0) q = 1; /* all short (a frame of rounding's length) */
+  p->x[q] = end;
+  p->m = q;
+}
+
 /* The blended signature of frame t (before closure), placed at the origin
  * with the blended start angle. */
 static km_status blend_signature(const km_morph *m, double t,
@@ -1375,28 +1487,20 @@ static km_status blend_signature(const km_morph *m, double t,
   for (size_t k = 0; !st && !smooth && k + 1 < m->nk; k++) {
     double la = (m->ra[k + 1] - m->ra[k]) * La, lb = (m->rb[k + 1] - m->rb[k]) * Lb;
     double l = (1 - t) * la + t * lb;
-    double wa, wb;
-    if (m->opt.blend == KM_BLEND_PAPER) {
-      wa = 1 - t;
-      wb = t;
-    } else {
-      wa = (1 - t) * la / l;
-      wb = t * lb / l;
+    /* a segment shorter than the frame resolves (a match next to an end or
+     * to another match, on the side t weighs) is a point of the frame:
+     * its corners stay, its pieces would end within rounding of where
+     * they start */
+    bool point = !(l > SHORT_PIECE * Lt);
+    if (!point) {
+      st = blend_segment(m, t, k, S, l, &segs[k]);
+      if (st) break;
+      total += segs[k].m;
+      if (segs[k].degree > deg) deg = segs[k].degree;
     }
-    km_pp sa, sb;
-    km__pp_init(&sa);
-    km__pp_init(&sb);
-    st = pp_slice(&sa, &a->kappa, m->ra[k] * La, m->ra[k + 1] * La);
-    if (!st) st = pp_slice(&sb, &b->kappa, m->rb[k] * Lb, m->rb[k + 1] * Lb);
-    if (!st) st = km__pp_blend(&segs[k], &sa, wa, &sb, wb, S, S + l);
-    km__pp_free(&sa);
-    km__pp_free(&sb);
-    if (st) break;
-    total += segs[k].m;
-    if (segs[k].degree > deg) deg = segs[k].degree;
     /* corners of both inputs inside this segment */
-    double cwa = m->opt.blend == KM_BLEND_PAPER ? (1 - t) * l / la : (1 - t);
-    double cwb = m->opt.blend == KM_BLEND_PAPER ? t * l / lb : t;
+    double cwa = m->opt.blend == KM_BLEND_PAPER ? (1 - t) * corner_scale(l, la) : (1 - t);
+    double cwb = m->opt.blend == KM_BLEND_PAPER ? t * corner_scale(l, lb) : t;
     for (int w = 0; w < 2 && !st; w++) {
       const input *in = w ? b : a;
       double L = w ? Lb : La, r0 = w ? m->rb[k] : m->ra[k], r1 = w ? m->rb[k + 1] : m->ra[k + 1];
@@ -1409,7 +1513,7 @@ static km_status blend_signature(const km_morph *m, double t,
         double turn = cw * in->sig.corners[i].turn;
         if (turn >= KM_PI) turn = KM_PI - 1e-9;
         if (turn <= -KM_PI) turn = -KM_PI + 1e-9;
-        st = corner_push(&cl, S + (r - r0) / (r1 - r0) * l, turn);
+        st = corner_push(&cl, point ? S : S + (r - r0) / (r1 - r0) * l, turn);
       }
     }
     S += l;
@@ -1446,6 +1550,7 @@ static km_status blend_signature(const km_morph *m, double t,
     if (fabs(cl.c[i].turn) > 1e-15) cl.c[keep++] = cl.c[i];
   km_fn kf;
   km_fn_init(&kf);
+  drop_short_pieces(&whole, SHORT_PIECE * Lt);
   st = km__pp_to_fn(&kf, &whole);
   if (st) goto done;
   double phia = a->sig.angle, phib = b->sig.angle;
