@@ -30,6 +30,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "http_guard.h"
 #include "jobs.h"
 #include "jobstore.h"
 #include "kmapi/api.h"
@@ -81,6 +82,11 @@ typedef struct srv_req {
   int status;
   size_t bytes;
   const char *cut; /* why the connection was closed without an answer */
+  srv_http_target target; /* the raw request target (URI log callback) */
+  bool begun;        /* req_new has run: the handler saw the headers */
+  bool must_close;   /* the framing was refused: no keep-alive */
+  bool http11;       /* the client may be sent an interim 1xx */
+  bool probed;       /* a FIN was seen and answered with a probe */
 } srv_req;
 
 static const char *const ALLOW_GET = "GET, HEAD, OPTIONS";
@@ -120,6 +126,13 @@ static srv_route parse_route(srv_req *r, const char *url)
                {"/v1/reconstruct", SRV_R_RECONSTRUCT},
                {"/v1/morph", SRV_R_MORPH},
                {"/v1/jobs", SRV_R_JOBS}};
+  /* The absolute form (RFC 9112 3.2.2) names this origin's resource by
+   * the path after the authority; an empty path is "/". */
+  if (strncasecmp(url, "http://", 7) == 0 ||
+      strncasecmp(url, "https://", 8) == 0) {
+    const char *path = strchr(strstr(url, "//") + 2, '/');
+    url = path != NULL ? path : "/";
+  }
   for (size_t i = 0; i < sizeof FIXED / sizeof FIXED[0]; i++)
     if (strcmp(url, FIXED[i].path) == 0)
       return FIXED[i].route;
@@ -242,7 +255,7 @@ static void add_common_headers(srv_req *r, struct MHD_Response *resp,
       r->route == SRV_R_JOB_RESULT || r->route == SRV_R_METRICS ||
       r->route == SRV_R_HEALTHZ || r->route == SRV_R_READYZ)
     MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
-  if (atomic_load(&s->draining))
+  if (atomic_load(&s->draining) || r->must_close)
     MHD_add_response_header(resp, MHD_HTTP_HEADER_CONNECTION, "close");
 }
 
@@ -388,9 +401,12 @@ static void create_job(srv_req *r, const api_request *req)
   srv_pool_kick(s->pool);
 }
 
-/* True if the client has closed or reset its connection while its
+/* True if the client has reset its connection, or closed it, while its
  * request waited: its answer could not be delivered, so no work is done
- * for it (a FIN counts too, as it does for common proxies). */
+ * for it. A FIN alone is not enough: a client that half-closed its
+ * sending side still reads its answer; srv_http_fin_probe tells the two
+ * apart (the probe goes out once; a closed peer's reset is then seen
+ * here as an error). */
 static bool client_gone(srv_req *r)
 {
   const union MHD_ConnectionInfo *ci =
@@ -400,7 +416,7 @@ static bool client_gone(srv_req *r)
   char b;
   ssize_t n = recv(ci->connect_fd, &b, 1, MSG_PEEK | MSG_DONTWAIT);
   if (n == 0)
-    return true;
+    return srv_http_fin_probe(ci->connect_fd, r->http11, &r->probed);
   return n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR;
 }
 
@@ -874,12 +890,14 @@ static enum MHD_Result on_body(srv_req *r, const char *data, size_t size)
   return MHD_YES;
 }
 
+/* The record of a request whose headers are in: r is the one the URI log
+ * callback started (NULL if it ran out of memory). */
 static srv_req *req_new(srv_server *s, struct MHD_Connection *c,
-                        const char *url, const char *method)
+                        const char *url, const char *method, srv_req *r)
 {
-  srv_req *r = calloc(1, sizeof *r);
-  if (r == NULL)
+  if (r == NULL && (r = calloc(1, sizeof *r)) == NULL)
     return NULL;
+  r->begun = true;
   r->srv = s;
   r->conn = c;
   r->t0 = srv_now();
@@ -888,7 +906,8 @@ static srv_req *req_new(srv_server *s, struct MHD_Connection *c,
   snprintf(r->method, sizeof r->method, "%s", method);
   snprintf(r->path, sizeof r->path, "%s", url);
   for (char *p = r->path; *p; p++)
-    if ((unsigned char)*p < 0x21 || (unsigned char)*p > 0x7e || *p == '"')
+    if ((unsigned char)*p < 0x21 || (unsigned char)*p > 0x7e || *p == '"' ||
+        *p == '\\')
       *p = '?';
   r->is_head = strcmp(method, "HEAD") == 0;
   const char *rid =
@@ -909,12 +928,25 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c,
 {
   srv_server *s = cls;
   srv_req *r = *req_cls;
-  (void)version;
-  if (r == NULL) {
-    r = req_new(s, c, url, method);
+  if (r == NULL || !r->begun) {
+    r = req_new(s, c, url, method, r);
     if (r == NULL)
       return MHD_NO;
     *req_cls = r;
+    r->http11 = version != NULL && strcmp(version, "HTTP/1.1") == 0;
+    /* Framing first: a request framed one way here and another way by a
+     * proxy must not be answered as if it were understood. */
+    srv_http_verdict v;
+    srv_http_check(c, method, version, r->target.raw ? &r->target : NULL,
+                   &v);
+    if (v.status != 0) {
+      r->must_close = true;
+      return v.status == 501
+                 ? problem(r, 501, "/problems/not-implemented",
+                           "Not implemented", v.detail, NULL, NULL)
+                 : problem(r, 400, "/problems/bad-request", "Bad request",
+                           v.detail, NULL, NULL);
+    }
     return on_headers(r);
   }
   if (*upload_size > 0) {
@@ -938,6 +970,20 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c,
   return MHD_YES;
 }
 
+/* The raw request target, before libmicrohttpd splits and decodes it;
+ * the request's record starts here (the value returned is the handler's
+ * first *req_cls). */
+static void *on_uri(void *cls, const char *uri, struct MHD_Connection *c)
+{
+  (void)c;
+  srv_req *r = calloc(1, sizeof *r);
+  if (r == NULL)
+    return NULL;
+  r->srv = cls;
+  srv_http_target_scan(&r->target, uri);
+  return r;
+}
+
 /* --------------------------------------------------------- log and stats */
 
 static void on_completed(void *cls, struct MHD_Connection *c, void **req_cls,
@@ -949,6 +995,10 @@ static void on_completed(void *cls, struct MHD_Connection *c, void **req_cls,
   if (r == NULL)
     return;
   *req_cls = NULL;
+  if (!r->begun) { /* refused by libmicrohttpd before the handler ran */
+    free(r);
+    return;
+  }
   /* A client that left while its request computed: MHD completes the
    * resumed connection without calling the handler again. (Completion
    * never happens while a worker still owns the request: MHD does not
@@ -969,10 +1019,12 @@ static void on_completed(void *cls, struct MHD_Connection *c, void **req_cls,
     struct tm tm;
     gmtime_r(&now, &tm);
     strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", &tm);
+    char method[sizeof r->method];
+    srv_http_log_token(method, sizeof method, r->method);
     fprintf(s->log,
             "%s access method=%s path=\"%s\" status=%d bytes=%zu "
             "duration_ms=%.3f request_id=%s%s%s%s\n",
-            when, r->method, r->path, r->status, r->bytes, dt * 1e3, r->rid,
+            when, method, r->path, r->status, r->bytes, dt * 1e3, r->rid,
             why ? " closed=\"" : "", why ? why : "", why ? "\"" : "");
   }
   api_response_free(&r->resp);
@@ -1054,7 +1106,8 @@ int srv_server_start(srv_server *s)
       MHD_OPTION_THREAD_POOL_SIZE, (unsigned int)s->cfg.io_threads,
       MHD_OPTION_CONNECTION_LIMIT, (unsigned int)s->cfg.max_connections,
       MHD_OPTION_CONNECTION_TIMEOUT, (unsigned int)s->cfg.timeout,
-      MHD_OPTION_NOTIFY_COMPLETED, &on_completed, s, MHD_OPTION_END);
+      MHD_OPTION_NOTIFY_COMPLETED, &on_completed, s,
+      MHD_OPTION_URI_LOG_CALLBACK, &on_uri, s, MHD_OPTION_END);
   if (s->daemon == NULL) {
     fprintf(s->log, "kmorphd: cannot listen on %s port %u (in use?)\n",
             s->cfg.bind, s->cfg.port);
