@@ -1545,6 +1545,11 @@ static km_status blend_signature(const km_morph *m, double t,
     else
       cl.c[nc++] = cl.c[i];
   }
+  /* the paper blend's deltas are clamped below a half turn one by one;
+   * two at one place (where a segment of one input has almost no length
+   * and scales its corners past any bound) must not sum beyond it */
+  for (size_t i = 0; i < nc; i++)
+    cl.c[i].turn = fmax(fmin(cl.c[i].turn, KM_PI - 1e-9), -KM_PI + 1e-9);
   size_t keep = 0;
   for (size_t i = 0; i < nc; i++)
     if (fabs(cl.c[i].turn) > 1e-15) cl.c[keep++] = cl.c[i];
