@@ -116,9 +116,58 @@ void api__ptr_idx(char *buf, const char *base, size_t index);
 void api__ctx_problem(const api_ctx *ctx, api_response *out,
                       const char *request_id);
 
-/* Parse a request body: size limit (413), depth limit and syntax (400),
- * top level must be an object (422). NULL with the error in ctx. */
+/* Parse a request body (json_parse.c): more than cfg->max_body_bytes, or
+ * a tree that would take more than api__tree_budget(length) bytes, is 413
+ * /problems/body-too-large; syntax, invalid UTF-8, nesting deeper than
+ * cfg->max_json_depth and a member name repeated in one object are 400
+ * /problems/malformed-json (the detail gives the byte offset, and for a
+ * repeat the name and its object's pointer); an array longer than any
+ * field may be is 422 /problems/limit-exceeded; a top level that is not an
+ * object is 422. NULL with the error in ctx; otherwise the caller frees
+ * the tree with cJSON_Delete. Arrays of numbers in it are packed: read
+ * them with api__array_* and api__elems_* below. Thread-safe. */
 cJSON *api__parse_body(api_ctx *ctx, const char *body, size_t length);
+
+/* The tree of a body may take at most API_TREE_FACTOR times the body's
+ * bytes plus API_TREE_SLACK. Packed numbers cost at most 4 times their
+ * text (`0,` becomes 8 bytes) and strings about once, while a cJSON item
+ * is 80 bytes of heap: a body of short strings or small objects is refused
+ * rather than let 8 MiB become hundreds of megabytes. The slack lets small
+ * bodies be anything. */
+#define API_TREE_FACTOR 8
+#define API_TREE_SLACK ((size_t)1 << 20)
+size_t api__tree_budget(size_t length);
+
+/* ---- arrays of a parsed body. An array whose elements are all numbers,
+ * or all arrays of the same count (1..API_PACK_WIDTH_MAX) of numbers, is
+ * one packed item without children: cJSON_ArrayForEach and
+ * cJSON_GetArraySize see it as empty, so readers use these. ---- */
+#define API_PACK_WIDTH_MAX 4
+
+/* Elements of an array, packed or not; 0 for anything else. */
+size_t api__array_len(const cJSON *a);
+/* The numbers of a packed array, row-major (borrowed from a), with
+ * *width (optional) the numbers per element, 0 when each element is a
+ * number; NULL when a is not a packed array. */
+const double *api__array_packed(const cJSON *a, size_t *width);
+
+/* A walk over an array's elements in order, packed or not. */
+typedef struct api_elems {
+  const cJSON *item;    /* the current element; NULL when packed */
+  const double *packed; /* the array's numbers when packed, else NULL */
+  size_t width;         /* numbers per packed element; 0: each a number */
+  size_t index;         /* the current element */
+} api_elems;
+/* Start at element 0 of a (an array with api__array_len(a) elements). */
+void api__elems_start(api_elems *it, const cJSON *a);
+/* Step to the next element; only while index + 1 < the length. */
+void api__elems_next(api_elems *it);
+/* The current element as a finite number or a point [x, y]; ptr names the
+ * array, errors name the element (ptr/index) or its coordinate. */
+bool api__elems_num(api_ctx *ctx, const api_elems *it, const char *ptr,
+                    double *out);
+bool api__elems_point(api_ctx *ctx, const api_elems *it, const char *ptr,
+                      double out[2]);
 
 /* ---- typed readers. Each returns true on success; on failure the error
  * is recorded in ctx (with `ptr` naming the value) and false returned.

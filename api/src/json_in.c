@@ -139,37 +139,83 @@ bool api__member_enum(api_ctx *ctx, const cJSON *obj, const char *base,
 
 static bool check_count(api_ctx *ctx, const cJSON *v, const char *ptr,
                         size_t max, size_t *n) {
-  int size;
+  size_t size;
   if (!cJSON_IsArray(v))
     return api__invalid(ctx, ptr, "must be an array, not %s", type_name(v));
-  size = cJSON_GetArraySize(v);
-  if (size <= 0)
+  size = api__array_len(v);
+  if (size == 0)
     return api__invalid(ctx, ptr, "must not be empty");
-  if ((size_t)size > max)
+  if (size > max)
     return api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded", ptr,
-                      "has %d elements; the limit is %zu", size, max);
-  *n = (size_t)size;
+                      "has %zu elements; the limit is %zu", size, max);
+  *n = size;
   return true;
+}
+
+void api__elems_start(api_elems *it, const cJSON *a) {
+  it->packed = api__array_packed(a, &it->width);
+  it->item = it->packed == NULL && a != NULL ? a->child : NULL;
+  it->index = 0;
+}
+
+void api__elems_next(api_elems *it) {
+  if (it->item != NULL)
+    it->item = it->item->next;
+  it->index++;
+}
+
+/* Packed number k of the walk's array at pointer p, checked finite. */
+static bool packed_num(api_ctx *ctx, const api_elems *it, size_t k,
+                       const char *p, double *out) {
+  /* strtod turns 1e999 into inf; the contract has no infinities. */
+  if (!isfinite(it->packed[k]))
+    return api__invalid(ctx, p, "must be a finite number");
+  *out = it->packed[k];
+  return true;
+}
+
+bool api__elems_num(api_ctx *ctx, const api_elems *it, const char *ptr,
+                    double *out) {
+  char p[API_POINTER_MAX];
+  api__ptr_idx(p, ptr, it->index);
+  if (it->packed == NULL)
+    return api__num(ctx, it->item, p, out);
+  if (it->width > 0)
+    return api__invalid(ctx, p, "must be a number, not an array");
+  return packed_num(ctx, it, it->index, p, out);
+}
+
+bool api__elems_point(api_ctx *ctx, const api_elems *it, const char *ptr,
+                      double out[2]) {
+  char p[API_POINTER_MAX], q[API_POINTER_MAX];
+  api__ptr_idx(p, ptr, it->index);
+  if (it->packed == NULL)
+    return api__point(ctx, it->item, p, out);
+  if (it->width != 2)
+    return api__invalid(ctx, p, "must be a point [x, y]");
+  api__ptr_idx(q, p, 0);
+  if (!packed_num(ctx, it, 2 * it->index, q, &out[0]))
+    return false;
+  api__ptr_idx(q, p, 1);
+  return packed_num(ctx, it, 2 * it->index + 1, q, &out[1]);
 }
 
 bool api__num_array(api_ctx *ctx, const cJSON *v, const char *ptr,
                     size_t max, double **out, size_t *n) {
-  size_t count, i = 0;
+  size_t count;
   double *a;
-  const cJSON *e;
-  char p[API_POINTER_MAX];
+  api_elems it;
   if (!check_count(ctx, v, ptr, max, &count))
     return false;
   a = malloc(count * sizeof *a);
   if (a == NULL)
     return api__oom(ctx);
-  cJSON_ArrayForEach(e, v) {
-    api__ptr_idx(p, ptr, i);
-    if (!api__num(ctx, e, p, &a[i])) {
+  api__elems_start(&it, v);
+  for (size_t i = 0; i < count; i++, api__elems_next(&it)) {
+    if (!api__elems_num(ctx, &it, ptr, &a[i])) {
       free(a);
       return false;
     }
-    i++;
   }
   *out = a;
   *n = count;
@@ -178,34 +224,32 @@ bool api__num_array(api_ctx *ctx, const cJSON *v, const char *ptr,
 
 bool api__point(api_ctx *ctx, const cJSON *v, const char *ptr,
                 double out[2]) {
-  char p[API_POINTER_MAX];
-  if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 2)
+  api_elems it;
+  if (!cJSON_IsArray(v) || api__array_len(v) != 2)
     return api__invalid(ctx, ptr, "must be a point [x, y]");
-  api__ptr_idx(p, ptr, 0);
-  if (!api__num(ctx, v->child, p, &out[0]))
+  api__elems_start(&it, v);
+  if (!api__elems_num(ctx, &it, ptr, &out[0]))
     return false;
-  api__ptr_idx(p, ptr, 1);
-  return api__num(ctx, v->child->next, p, &out[1]);
+  api__elems_next(&it);
+  return api__elems_num(ctx, &it, ptr, &out[1]);
 }
 
 bool api__point_array(api_ctx *ctx, const cJSON *v, const char *ptr,
                       size_t max, double **out, size_t *n) {
-  size_t count, i = 0;
+  size_t count;
   double *a;
-  const cJSON *e;
-  char p[API_POINTER_MAX];
+  api_elems it;
   if (!check_count(ctx, v, ptr, max, &count))
     return false;
   a = malloc(2 * count * sizeof *a);
   if (a == NULL)
     return api__oom(ctx);
-  cJSON_ArrayForEach(e, v) {
-    api__ptr_idx(p, ptr, i);
-    if (!api__point(ctx, e, p, &a[2 * i])) {
+  api__elems_start(&it, v);
+  for (size_t i = 0; i < count; i++, api__elems_next(&it)) {
+    if (!api__elems_point(ctx, &it, ptr, &a[2 * i])) {
       free(a);
       return false;
     }
-    i++;
   }
   *out = a;
   *n = count;
@@ -615,14 +659,13 @@ bool api__parse_signature(api_ctx *ctx, const cJSON *v, const char *ptr,
     goto done;
   jcorners = cJSON_GetObjectItemCaseSensitive(v, "corners");
   if (jcorners != NULL && !cJSON_IsNull(jcorners)) {
-    const cJSON *e;
-    size_t i = 0;
+    api_elems it;
     api__ptr_key(p, ptr, "corners");
     if (!cJSON_IsArray(jcorners)) {
       api__invalid(ctx, p, "must be an array, not %s", type_name(jcorners));
       goto done;
     }
-    ncorners = (size_t)cJSON_GetArraySize(jcorners);
+    ncorners = api__array_len(jcorners);
     if (ncorners > ctx->cfg->max_control_points) {
       api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded", p,
                  "has %zu elements; the limit is %zu", ncorners,
@@ -634,7 +677,10 @@ bool api__parse_signature(api_ctx *ctx, const cJSON *v, const char *ptr,
       api__oom(ctx);
       goto done;
     }
-    cJSON_ArrayForEach(e, jcorners) {
+    /* a packed element (a number or an array) is no object: item NULL */
+    api__elems_start(&it, jcorners);
+    for (size_t i = 0; i < ncorners; i++, api__elems_next(&it)) {
+      const cJSON *e = it.item;
       api__ptr_idx(q, p, i);
       if (!cJSON_IsObject(e)) {
         api__invalid(ctx, q, "must be an object {\"s\", \"turn\"}");
@@ -643,7 +689,6 @@ bool api__parse_signature(api_ctx *ctx, const cJSON *v, const char *ptr,
       if (!api__member_num(ctx, e, q, "s", true, &corners[i].s, NULL) ||
           !api__member_num(ctx, e, q, "turn", true, &corners[i].turn, NULL))
         goto done;
-      i++;
     }
   }
   if (!api__member_bool(ctx, v, ptr, "closed", false, &closed, NULL))
@@ -747,8 +792,8 @@ bool api__parse_tolerance(api_ctx *ctx, const cJSON *root, double *tol) {
 bool api__parse_include(api_ctx *ctx, const cJSON *root, bool allow_animate,
                         api_include *inc) {
   const cJSON *v = cJSON_GetObjectItemCaseSensitive(root, "include");
-  const cJSON *e;
-  size_t i = 0;
+  api_elems it;
+  size_t n;
   char p[API_POINTER_MAX];
   inc->svg_d = false;
   inc->animate_d = false;
@@ -756,7 +801,11 @@ bool api__parse_include(api_ctx *ctx, const cJSON *root, bool allow_animate,
     return true;
   if (!cJSON_IsArray(v))
     return api__invalid(ctx, "/include", "must be an array of strings");
-  cJSON_ArrayForEach(e, v) {
+  n = api__array_len(v);
+  api__elems_start(&it, v);
+  /* a packed element (a number or an array) is no string: item NULL */
+  for (size_t i = 0; i < n; i++, api__elems_next(&it)) {
+    const cJSON *e = it.item;
     api__ptr_idx(p, "/include", i);
     if (cJSON_IsString(e) && strcmp(e->valuestring, "svg_d") == 0)
       inc->svg_d = true;
@@ -767,7 +816,6 @@ bool api__parse_include(api_ctx *ctx, const cJSON *root, bool allow_animate,
       return api__invalid(ctx, p, allow_animate
                                       ? "must be \"svg_d\" or \"animate_d\""
                                       : "must be \"svg_d\"");
-    i++;
   }
   return true;
 }

@@ -221,7 +221,7 @@ static bool parse_svg_options(api_ctx *ctx, const cJSON *root,
 static bool parse_matches(api_ctx *ctx, const cJSON *root,
                           api_morph_plan *pl) {
   const cJSON *v = cJSON_GetObjectItemCaseSensitive(root, "matches");
-  const cJSON *e;
+  api_elems it;
   char p[API_POINTER_MAX], q[API_POINTER_MAX];
   size_t n, i = 0;
   if (v == NULL || cJSON_IsNull(v))
@@ -238,7 +238,7 @@ static bool parse_matches(api_ctx *ctx, const cJSON *root,
     return api__invalid(ctx, "/matches",
                         "must be \"auto\" or an array of [r_from, r_to] "
                         "pairs");
-  n = (size_t)cJSON_GetArraySize(v);
+  n = api__array_len(v);
   if (n == 0)
     return true;
   if (n > pl->cfg.max_control_points)
@@ -248,10 +248,11 @@ static bool parse_matches(api_ctx *ctx, const cJSON *root,
   pl->matches = malloc(2 * n * sizeof *pl->matches);
   if (pl->matches == NULL)
     return api__oom(ctx);
-  cJSON_ArrayForEach(e, v) {
+  api__elems_start(&it, v);
+  for (; i < n; i++, api__elems_next(&it)) {
     double *m = &pl->matches[2 * i];
     api__ptr_idx(p, "/matches", i);
-    if (!api__point(ctx, e, p, m))
+    if (!api__elems_point(ctx, &it, "/matches", m))
       return false;
     for (int k = 0; k < 2; k++) {
       api__ptr_idx(q, p, (size_t)k);
@@ -264,7 +265,6 @@ static bool parse_matches(api_ctx *ctx, const cJSON *root,
                             "must be greater than the previous pair's (matches "
                             "are strictly increasing)");
     }
-    i++;
   }
   pl->opt.matches = pl->matches;
   pl->opt.nmatches = n;
