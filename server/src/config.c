@@ -177,6 +177,9 @@ void srv_config_usage(FILE *out)
   }
   fprintf(out, "\n  --help                                    this text\n"
                "  --version                                 version\n");
+  fprintf(out, "\nSignals: SIGTERM, SIGINT drain and stop; SIGHUP reopens "
+               "--log-file;\nSIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM are logged "
+               "and ignored.\n");
 }
 
 static int set_value(srv_config *cfg, const opt_def *o, const char *v,

@@ -34,6 +34,7 @@
 #include "jobs.h"
 #include "jobstore.h"
 #include "kmapi/api.h"
+#include "log.h"
 #include "metrics.h"
 #include "pool.h"
 #include "util.h"
@@ -41,7 +42,8 @@
 struct srv_server {
   srv_config cfg;
   api_config api;
-  FILE *log;
+  FILE *log;        /* srv_log_stream(logger): the same FILE for life */
+  srv_log *logger;  /* rate-limits libmicrohttpd's messages */
   struct MHD_Daemon *daemon;
   MHD_socket quiesced_fd;
   unsigned port;
@@ -1034,6 +1036,16 @@ static void on_completed(void *cls, struct MHD_Connection *c, void **req_cls,
   atomic_fetch_sub(&s->inflight, 1);
 }
 
+/* Seconds an I/O thread with no connection waits after accept failed for
+ * want of descriptors (nginx pauses 500 ms). */
+static const double ACCEPT_PAUSE = 0.25;
+
+/* libmicrohttpd's messages, one line a second per kind (its format
+ * string): accept failing with EMFILE repeats as fast as the loop spins.
+ * With connections open, libmicrohttpd stops accepting by itself until one
+ * closes; an I/O thread without any would retry at once for ever ("at
+ * FIRST connection"), so that thread, having nothing else to serve,
+ * pauses here. */
 static void mhd_log(void *cls, const char *fmt, va_list ap)
 {
   srv_server *s = cls;
@@ -1042,18 +1054,27 @@ static void mhd_log(void *cls, const char *fmt, va_list ap)
   size_t n = strlen(msg);
   while (n > 0 && msg[n - 1] == '\n')
     msg[--n] = '\0';
-  fprintf(s->log, "kmorphd: http: %s\n", msg);
+  unsigned long more = 0;
+  if (srv_log_admit(s->logger, fmt, msg, &more)) {
+    if (more > 0)
+      fprintf(s->log, "kmorphd: http: %s (%lu more suppressed)\n", msg, more);
+    else
+      fprintf(s->log, "kmorphd: http: %s\n", msg);
+  }
+  if (strstr(fmt, "resource limit at FIRST") != NULL)
+    srv_sleep(ACCEPT_PAUSE);
 }
 
 /* ------------------------------------------------------------- lifecycle */
 
-srv_server *srv_server_create(const srv_config *cfg, FILE *log)
+srv_server *srv_server_create(const srv_config *cfg, srv_log *logger)
 {
   srv_server *s = calloc(1, sizeof *s);
   if (s == NULL)
     return NULL;
   s->cfg = *cfg;
-  s->log = log;
+  s->logger = logger;
+  s->log = srv_log_stream(logger);
   s->quiesced_fd = MHD_INVALID_SOCKET;
   atomic_init(&s->draining, false);
   atomic_init(&s->suspended, 0);
@@ -1072,7 +1093,7 @@ srv_server *srv_server_create(const srv_config *cfg, FILE *log)
                                       srv_jobs_work, s->jobs)
                     : NULL;
   if (s->metrics == NULL || s->pool == NULL) {
-    fprintf(log, "kmorphd: cannot create the compute pool (%u workers)\n",
+    fprintf(s->log, "kmorphd: cannot create the compute pool (%u workers)\n",
             cfg->workers);
     srv_server_destroy(s);
     return NULL;

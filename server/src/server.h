@@ -9,13 +9,16 @@
 #include <stdio.h>
 
 #include "config.h"
+#include "log.h"
 
 typedef struct srv_server srv_server;
 
 /* Create the server (pools, job store, metrics) from cfg (copied; workers
- * must be > 0 already). log receives the access log and notices. NULL if
- * memory or threads are short (a message is printed to log). */
-srv_server *srv_server_create(const srv_config *cfg, FILE *log);
+ * must be > 0 already). log (borrowed; it must outlive the server)
+ * receives the access log and notices, libmicrohttpd's messages rate-
+ * limited. NULL if memory or threads are short (a message is printed to
+ * log). */
+srv_server *srv_server_create(const srv_config *cfg, srv_log *log);
 
 /* Bind and start serving. Returns 0, or -1 with a message in the log
  * (address in use, bad bind address). */
