@@ -52,6 +52,7 @@ struct srv_server {
   srv_jobs *jobs;
   srv_metrics *metrics;
   atomic_bool draining;
+  atomic_bool abort_compute; /* grace over: every computation stops now */
   atomic_size_t suspended; /* connections waiting for a worker */
   atomic_size_t inflight;  /* requests begun and not yet completed */
 };
@@ -1077,6 +1078,7 @@ srv_server *srv_server_create(const srv_config *cfg, srv_log *logger)
   s->log = srv_log_stream(logger);
   s->quiesced_fd = MHD_INVALID_SOCKET;
   atomic_init(&s->draining, false);
+  atomic_init(&s->abort_compute, false);
   atomic_init(&s->suspended, 0);
   atomic_init(&s->inflight, 0);
   api_config_default(&s->api);
@@ -1166,23 +1168,50 @@ static bool requests_done(srv_server *s)
   return atomic_load(&s->inflight) == 0;
 }
 
+/* Seconds the computations still running when the grace ends get, once
+ * told to stop (abort_compute), to answer 503 and resume their
+ * connection: they check the flag between frames and within their long
+ * loops, far more often than this. */
+static const double ABORT_WAIT = 2.0;
+
+/* Refuse new connections at once, so that load balancers and clients
+ * move on: libmicrohttpd stops polling the listening socket, and
+ * shutdown() takes it out of the LISTEN state (connect gets ECONNREFUSED,
+ * connections not yet accepted are reset). The descriptor itself stays
+ * open until the HTTP daemon stops, as libmicrohttpd's threads may still
+ * hold its number. */
+static void stop_listening(srv_server *s)
+{
+  s->quiesced_fd = MHD_quiesce_daemon(s->daemon);
+  if (s->quiesced_fd != MHD_INVALID_SOCKET)
+    shutdown(s->quiesced_fd, SHUT_RDWR);
+}
+
 int srv_server_shutdown(srv_server *s)
 {
   double deadline = srv_now() + s->cfg.shutdown_grace;
   atomic_store(&s->draining, true);
   if (s->daemon == NULL)
     return 0;
-  s->quiesced_fd = MHD_quiesce_daemon(s->daemon);
+  stop_listening(s);
   /* Jobs stop between frames; queued requests are answered 503 by the
-   * workers; requests already computing run to their end. */
+   * workers; requests already computing have the grace to finish. */
   srv_jobs_cancel_all(s->jobs);
   srv_pool_stop(s->pool);
   if (!wait_until(s, compute_idle, deadline)) {
     fprintf(s->log,
             "kmorphd: shutdown grace of %g s passed with %zu requests still "
-            "computing\n",
+            "computing: stopping them\n",
             s->cfg.shutdown_grace, (size_t)atomic_load(&s->suspended));
-    return -1;
+    atomic_store(&s->abort_compute, true);
+    deadline = srv_now() + ABORT_WAIT;
+    if (!wait_until(s, compute_idle, deadline)) {
+      fprintf(s->log,
+              "kmorphd: %zu requests still computing %g s after being "
+              "stopped\n",
+              (size_t)atomic_load(&s->suspended), ABORT_WAIT);
+      return -1;
+    }
   }
   /* Give answers already queued (or bodies still arriving) until the
    * deadline to complete; idle keep-alive connections do not count. */

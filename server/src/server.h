@@ -27,12 +27,15 @@ int srv_server_start(srv_server *s);
 /* The port actually bound (useful with --port 0). */
 unsigned srv_server_port(const srv_server *s);
 
-/* Graceful stop: stop accepting, answer queued compute with 503, cancel
- * jobs, let running requests finish, resume every suspended connection,
- * then stop the HTTP daemon - all within cfg.shutdown_grace seconds.
- * Returns 0 when everything stopped cleanly; -1 when the deadline passed
- * with work still running (the HTTP daemon is then left running and the
- * caller should exit the process at once). */
+/* Graceful stop: close the listening socket (new connections are refused
+ * at once; open ones get /readyz 503 and Connection: close), answer
+ * queued compute with 503, cancel jobs, and give running requests
+ * cfg.shutdown_grace seconds to finish. When the grace runs out, every
+ * computation still running is told to stop and answers 503, within a
+ * further 2 s; then the HTTP daemon stops. Returns 0 when everything
+ * stopped cleanly; -1 when computations outlived even that (the HTTP
+ * daemon is then left running and the caller should exit the process at
+ * once). Call from one thread, once. */
 int srv_server_shutdown(srv_server *s);
 
 /* Free everything (after srv_server_shutdown returned 0, or if never

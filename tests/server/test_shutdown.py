@@ -1,5 +1,9 @@
 """test_shutdown.py - SIGTERM drains and exits 0 within the grace period,
-also while a job is running and while a request computes."""
+also while a job is running and while a request computes: new
+connections are refused at once, open ones are told 503 on /readyz, and
+computations still running when the grace ends are stopped and answered
+503."""
+import http.client
 import shutil
 import subprocess
 import tempfile
@@ -11,7 +15,8 @@ import threading
 import time
 import unittest
 
-from kmtest import HOST, ContractCase, Daemon, heavy_morph_body, wait_for
+from kmtest import (HOST, ContractCase, Daemon, Reply, heavy_morph_body,
+                    wait_for)
 
 
 class GracefulShutdown(ContractCase):
@@ -74,6 +79,98 @@ class GracefulShutdown(ContractCase):
             rc, dt = d.terminate(timeout=20)
             self.assertEqual(rc, 0)
             self.assertLess(dt, 3.0)
+            self.assertNotIn("forced", d.text())
+        finally:
+            d.stop()
+
+    def test_draining_refuses_new_connections_and_answers_open_ones(self):
+        # Given a synchronous morph of a few seconds computing, and a
+        # keep-alive connection opened before the stop,
+        d = Daemon("--threads", "1", "--shutdown-grace", "20",
+                   "--max-frames", "100000", "--max-output", "1000000000")
+        try:
+            keep = http.client.HTTPConnection(HOST, d.port, timeout=5)
+            keep.request("GET", "/healthz")
+            self.assertEqual(keep.getresponse().read(), b'{"status":"ok"}')
+            out = {}
+
+            def client():
+                out["r"] = d.request("POST", "/v1/morph",
+                                     body=heavy_morph_body(16000), timeout=60)
+
+            t = threading.Thread(target=client)
+            t.start()
+            self.assertTrue(wait_for(
+                lambda: "kmorph_workers_busy 1" in d.request(
+                    "GET", "/metrics").body.decode(), 10))
+            # when SIGTERM starts the drain,
+            d.proc.send_signal(signal.SIGTERM)
+            self.assertTrue(wait_for(lambda: "shutting down" in d.text(), 5))
+
+            def refused():
+                try:
+                    socket.create_connection((HOST, d.port), timeout=1).close()
+                    return False
+                except ConnectionRefusedError:
+                    return True
+            # then a new connection is refused at once (load balancers
+            # move on; nothing waits in an unserved backlog),
+            self.assertTrue(wait_for(refused, 1.0),
+                            "new connections are still accepted")
+            # the open connection is told the instance is not ready and
+            # is closed after the answer,
+            keep.request("GET", "/readyz")
+            raw = keep.getresponse()
+            reply = Reply(raw.status, raw.getheaders(), raw.read())
+            self.assertProblem(reply, 503, "/readyz", "GET")
+            self.assertEqual((reply.header("Connection") or "").lower(),
+                             "close")
+            keep.close()
+            # and the morph in flight still gets its whole answer.
+            t.join(timeout=60)
+            self.assertEqual(out["r"].status, 200, out["r"].body[:300])
+            self.assertEqual(len(out["r"].json()["frames"]), 16000)
+            self.assertEqual(d.proc.wait(timeout=20), 0)
+        finally:
+            d.stop()
+
+    def test_the_end_of_the_grace_stops_computations_and_answers_503(self):
+        # Given two synchronous morphs that would compute for many
+        # seconds, and a grace of 1 s,
+        d = Daemon("--threads", "2", "--shutdown-grace", "1",
+                   "--max-frames", "1000000", "--max-output", "1000000000",
+                   "--morph-time", "600")
+        try:
+            out = [None, None]
+
+            def client(i):
+                try:
+                    out[i] = d.request("POST", "/v1/morph",
+                                       body=heavy_morph_body(40000),
+                                       headers={"X-Request-Id": "late-%d" % i},
+                                       timeout=60)
+                except OSError as e:
+                    out[i] = e
+            ts = [threading.Thread(target=client, args=(i,)) for i in (0, 1)]
+            for t in ts:
+                t.start()
+            self.assertTrue(wait_for(
+                lambda: "kmorph_workers_busy 2" in d.request(
+                    "GET", "/metrics").body.decode(), 10))
+            # when SIGTERM comes and the grace runs out,
+            rc, dt = d.terminate(timeout=20)
+            for t in ts:
+                t.join(timeout=20)
+            # then each computation is stopped and its client answered
+            # 503 (no connection closed without an answer), and the daemon
+            # exits 0 soon after the grace, not forced.
+            for i, r in enumerate(out):
+                self.assertNotIsInstance(r, OSError, "client %d: %r" % (i, r))
+                doc = self.assertProblem(r, 503, "/v1/morph", "POST",
+                                         rid="late-%d" % i)
+                self.assertEqual(doc["type"], "/problems/shutting-down")
+            self.assertEqual(rc, 0)
+            self.assertLess(dt, 1.0 + 2.0 + 1.0)
             self.assertNotIn("forced", d.text())
         finally:
             d.stop()
