@@ -1107,7 +1107,9 @@ static int cmp_corner(const void *x, const void *y) {
  * every match, and with it the blended curvature: the join would be G1
  * only. Here ds_a/ds_t = alpha(x) is piecewise linear in the frame's arc
  * length x - continuous at the matches (the mean of the neighbouring
- * segments' ratios), with a middle node per segment chosen so the segment
+ * segments' ratios; beside a segment under a thousandth of its
+ * neighbour's length the neighbour keeps nearer its own, see influence),
+ * with a middle node per segment chosen so the segment
  * still covers exactly its part of a - so s_a(x) is a C1 piecewise
  * quadratic and s_b(x) = (x - (1-t) s_a(x)) / t follows. Then
  *   kappa_t(x) = (1-t) kappa_a(s_a(x)) alpha(x) + t kappa_b(s_b(x)) beta(x)
