@@ -3,6 +3,7 @@
 #include "jobs.h"
 
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,6 +16,7 @@ typedef struct job {
   api_morph_plan *plan;
   size_t total, next_frame, done, in_flight;
   bool started, cancelled, failed, finishing;
+  atomic_bool stop; /* cancelled or failed: frames in flight give up */
   int fail_status;
   char fail_msg[200];
   double deadline;
@@ -62,8 +64,10 @@ bool srv_jobs_full(srv_jobs *j)
   return full;
 }
 
-int srv_jobs_start(srv_jobs *j, api_morph_plan *plan,
-                   char id[SRV_JOB_ID_LEN + 1])
+double srv_jobs_time_limit(const srv_jobs *j) { return j->job_time; }
+
+int srv_jobs_start(srv_jobs *j, api_morph_plan *plan, double deadline,
+                   size_t result_bytes, char id[SRV_JOB_ID_LEN + 1])
 {
   job *nj = calloc(1, sizeof *nj);
   if (nj == NULL)
@@ -71,8 +75,9 @@ int srv_jobs_start(srv_jobs *j, api_morph_plan *plan,
   srv_random_hex(nj->id, SRV_JOB_ID_LEN);
   nj->plan = plan;
   nj->total = api_morph_frame_count(plan);
+  atomic_init(&nj->stop, false);
   double now = srv_now();
-  nj->deadline = now + j->job_time;
+  nj->deadline = deadline;
   pthread_mutex_lock(&j->mu);
   if (j->closed || count_active(j) >= j->max_active) {
     int rc = j->closed ? -3 : -1;
@@ -80,10 +85,12 @@ int srv_jobs_start(srv_jobs *j, api_morph_plan *plan,
     free(nj);
     return rc;
   }
-  if (j->store->ops->create(j->store, nj->id, nj->total, now) != 0) {
+  int st = j->store->ops->create(j->store, nj->id, nj->total, result_bytes,
+                                 now);
+  if (st != SRV_STORE_OK) {
     pthread_mutex_unlock(&j->mu);
     free(nj);
-    return -2;
+    return st == SRV_STORE_FULL ? -4 : -2;
   }
   job **tail = &j->first;
   while (*tail)
@@ -114,10 +121,29 @@ static void fail_locked(srv_jobs *j, job *x, int status, const char *msg,
   if (x->failed || x->cancelled)
     return;
   x->failed = true;
+  atomic_store(&x->stop, true);
   x->fail_status = status;
   snprintf(x->fail_msg, sizeof x->fail_msg, "%s", msg);
   j->store->ops->finish(j->store, x->id, SRV_JOB_FAILED, x->done, NULL,
                         status, x->fail_msg, now);
+}
+
+static void out_of_time_locked(srv_jobs *j, job *x, double now)
+{
+  char msg[160];
+  snprintf(msg, sizeof msg,
+           "the job ran out of time: wall-time limit %g s "
+           "(KMORPH_JOB_TIME) reached after %zu of %zu frames",
+           j->job_time, x->done, x->total);
+  fail_locked(j, x, 503, msg, now);
+}
+
+/* A frame's stop condition, polled inside its computation: the job was
+ * cancelled or failed, or its time is up. Reads no lock-guarded field. */
+static bool job_should_stop(void *ctx)
+{
+  job *x = ctx;
+  return atomic_load(&x->stop) || srv_now() > x->deadline;
 }
 
 /* If nothing of x is in flight and it needs no more frames, take it off
@@ -169,12 +195,7 @@ bool srv_jobs_work(void *ctx)
     if (p->cancelled || p->failed || p->next_frame >= p->total)
       continue;
     if (now > p->deadline) {
-      char msg[160];
-      snprintf(msg, sizeof msg,
-               "the job ran out of time: wall-time limit %g s "
-               "(KMORPH_JOB_TIME) reached after %zu of %zu frames",
-               j->job_time, p->done, p->total);
-      fail_locked(j, p, 503, msg, now);
+      out_of_time_locked(j, p, now);
       if (take_if_over(j, p)) {
         over = p;
         break;
@@ -200,7 +221,7 @@ bool srv_jobs_work(void *ctx)
   if (x == NULL)
     return false;
 
-  int rc = api_morph_render_frame(x->plan, i);
+  int rc = api_morph_render_frame_until(x->plan, i, job_should_stop, x);
 
   now = srv_now();
   pthread_mutex_lock(&j->mu);
@@ -209,6 +230,10 @@ bool srv_jobs_work(void *ctx)
     x->done++;
     if (!x->cancelled && !x->failed)
       j->store->ops->progress(j->store, x->id, SRV_JOB_RUNNING, x->done, now);
+  } else if (x->cancelled || x->failed) {
+    /* stopped because it was cancelled or failed meanwhile */
+  } else if (now > x->deadline) {
+    out_of_time_locked(j, x, now);
   } else {
     char msg[96];
     snprintf(msg, sizeof msg, "frame %zu could not be built", i);
@@ -226,6 +251,7 @@ static void cancel_locked(srv_jobs *j, job *x, double now)
   if (x->cancelled || x->failed || x->finishing)
     return;
   x->cancelled = true;
+  atomic_store(&x->stop, true);
   j->store->ops->finish(j->store, x->id, SRV_JOB_CANCELLED, x->done, NULL, 0,
                         NULL, now);
 }

@@ -5,7 +5,8 @@
  * call srv_jobs_work, which takes the next frame of the oldest live job
  * and renders it, so the frames of one job spread over all workers and
  * progress is frames done / frames total. Cancellation and the wall-time
- * limit are checked between frames; the last frame to finish assembles
+ * limit are checked between frames and, through the frame's stop
+ * callback, inside a frame's computation; the last frame to finish assembles
  * the result (api_morph_result) and hands it to the job store.
  *
  * Thread-safety: all functions may be called from any thread.
@@ -30,11 +31,19 @@ srv_jobs *srv_jobs_create(srv_jobstore *store, size_t max_active,
 bool srv_jobs_full(srv_jobs *j);
 
 /* Admit a prepared plan: on success (0) the runner owns plan and id
- * (SRV_JOB_ID_LEN hex digits + NUL) names the new queued job. Returns -1
- * when max_active jobs are live, -2 when out of memory, -3 after
- * srv_jobs_cancel_all (shutting down); then the caller still owns plan. The caller kicks the pool afterwards. */
-int srv_jobs_start(srv_jobs *j, api_morph_plan *plan,
-                   char id[SRV_JOB_ID_LEN + 1]);
+ * (SRV_JOB_ID_LEN hex digits + NUL) names the new queued job. deadline
+ * (srv_now() seconds) is when the job fails for lack of time: the
+ * request's start plus the job time limit, so that preparing counts.
+ * result_bytes is the predicted size of its result, reserved in the
+ * store. Returns -1 when max_active jobs are live, -2 when out of
+ * memory, -3 after srv_jobs_cancel_all (shutting down), -4 when the
+ * store cannot reserve result_bytes; then the caller still owns plan.
+ * The caller kicks the pool afterwards. */
+int srv_jobs_start(srv_jobs *j, api_morph_plan *plan, double deadline,
+                   size_t result_bytes, char id[SRV_JOB_ID_LEN + 1]);
+
+/* Seconds a job may take (the limit srv_jobs_create was given). */
+double srv_jobs_time_limit(const srv_jobs *j);
 
 /* Render one frame of some live job. Returns false when there is no frame
  * to render (the pool's srv_idle_fn; ctx is the srv_jobs). */

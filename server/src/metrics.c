@@ -27,13 +27,20 @@ static const double BUCKETS[] = {0.0005, 0.001, 0.0025, 0.005, 0.01, 0.025,
                                  5,      10,    30};
 #define NBUCKET (sizeof BUCKETS / sizeof BUCKETS[0])
 
+/* Why requests are refused to protect the daemon; an unknown reason counts
+ * as the first. */
+static const char *const REASONS[] = {
+    "queue_full",    "jobs_full",    "morph_time",      "compute_time",
+    "body_memory",   "result_memory", "connections_full"};
+#define NREASON (sizeof REASONS / sizeof REASONS[0])
+
 struct srv_metrics {
   pthread_mutex_t mu;
   unsigned long long count[SRV_R_COUNT][NSTATUS];
   unsigned long long bucket[SRV_R_COUNT][NBUCKET];
   unsigned long long observed[SRV_R_COUNT];
   double sum[SRV_R_COUNT];
-  unsigned long long rejected_queue, rejected_jobs, rejected_time;
+  unsigned long long rejected[NREASON];
 };
 
 const char *srv_route_name(srv_route r)
@@ -78,13 +85,12 @@ void srv_metrics_observe(srv_metrics *m, srv_route route, int status,
 
 void srv_metrics_reject(srv_metrics *m, const char *reason)
 {
+  size_t k = 0;
+  for (size_t i = 0; i < NREASON; i++)
+    if (strcmp(reason, REASONS[i]) == 0)
+      k = i;
   pthread_mutex_lock(&m->mu);
-  if (strcmp(reason, "jobs_full") == 0)
-    m->rejected_jobs++;
-  else if (strcmp(reason, "morph_time") == 0)
-    m->rejected_time++;
-  else
-    m->rejected_queue++;
+  m->rejected[k]++;
   pthread_mutex_unlock(&m->mu);
 }
 
@@ -161,13 +167,13 @@ char *srv_metrics_render(srv_metrics *m, const srv_gauges *g, size_t *len)
   }
   put(&b,
       "# HELP kmorph_rejected_total Requests refused to protect the daemon: "
-      "at once because it was full, or a synchronous morph stopped at its "
-      "compute time limit.\n"
-      "# TYPE kmorph_rejected_total counter\n"
-      "kmorph_rejected_total{reason=\"queue_full\"} %llu\n"
-      "kmorph_rejected_total{reason=\"jobs_full\"} %llu\n"
-      "kmorph_rejected_total{reason=\"morph_time\"} %llu\n",
-      m->rejected_queue, m->rejected_jobs, m->rejected_time);
+      "at once because it was full (queue, jobs, memory for bodies or "
+      "results, connection slots), or a computation stopped at its time "
+      "limit.\n"
+      "# TYPE kmorph_rejected_total counter\n");
+  for (size_t i = 0; i < NREASON; i++)
+    put(&b, "kmorph_rejected_total{reason=\"%s\"} %llu\n", REASONS[i],
+        m->rejected[i]);
   pthread_mutex_unlock(&m->mu);
   put(&b,
       "# HELP kmorph_queue_depth Compute requests waiting for a worker.\n"
@@ -186,10 +192,25 @@ char *srv_metrics_render(srv_metrics *m, const srv_gauges *g, size_t *len)
       "# HELP kmorph_connections Open HTTP connections.\n"
       "# TYPE kmorph_connections gauge\n"
       "kmorph_connections %zu\n"
+      "# HELP kmorph_body_bytes Bytes of request bodies held now "
+      "(KMORPH_BODY_MEMORY bounds it).\n"
+      "# TYPE kmorph_body_bytes gauge\n"
+      "kmorph_body_bytes %zu\n"
+      "# HELP kmorph_result_bytes Bytes of job results kept or reserved "
+      "(KMORPH_RESULT_MEMORY bounds it).\n"
+      "# TYPE kmorph_result_bytes gauge\n"
+      "kmorph_result_bytes %zu\n"
+      "# HELP kmorph_connections_cut_total Connections cut at a deadline: "
+      "a request that did not arrive in time (answered 408), an answer not "
+      "read in time.\n"
+      "# TYPE kmorph_connections_cut_total counter\n"
+      "kmorph_connections_cut_total{reason=\"late_request\"} %zu\n"
+      "kmorph_connections_cut_total{reason=\"late_send\"} %zu\n"
       "# HELP kmorph_jobs Jobs known to the job store, by state.\n"
       "# TYPE kmorph_jobs gauge\n",
       g->queue_depth, g->queue_capacity, g->workers_busy, g->workers,
-      g->connections);
+      g->connections, g->body_bytes, g->result_bytes, g->late_requests,
+      g->late_sends);
   for (int s = 0; s < 5; s++)
     put(&b, "kmorph_jobs{state=\"%s\"} %zu\n", g->job_state_names[s],
         g->jobs[s]);

@@ -38,6 +38,7 @@
 #include "metrics.h"
 #include "pool.h"
 #include "util.h"
+#include "watch.h"
 
 struct srv_server {
   srv_config cfg;
@@ -51,10 +52,12 @@ struct srv_server {
   srv_jobstore *store;
   srv_jobs *jobs;
   srv_metrics *metrics;
+  srv_watch *watch;
   atomic_bool draining;
   atomic_bool abort_compute; /* grace over: every computation stops now */
   atomic_size_t suspended; /* connections waiting for a worker */
   atomic_size_t inflight;  /* requests begun and not yet completed */
+  atomic_size_t body_bytes; /* buffers of request bodies held now */
 };
 
 typedef enum phase {
@@ -76,12 +79,17 @@ typedef struct srv_req {
   char *accept;
   char *body;
   size_t len, cap, seen;
+  size_t held;       /* bytes of body buffer counted in srv->body_bytes */
+  bool no_memory;    /* the body did not fit the budget of bodies */
   bool too_large, is_head;
   double t0;
   atomic_int phase;
   api_response resp; /* written by the worker before resuming */
   bool location;     /* add Location for a created job */
   bool counted;      /* included in srv->suspended */
+  double deadline;   /* compute stops here (srv_now() seconds) */
+  double next_gone_check;
+  int stopped;       /* why the compute stop condition fired: STOP_* */
   int status;
   size_t bytes;
   const char *cut; /* why the connection was closed without an answer */
@@ -202,6 +210,22 @@ static bool is_compute(srv_route route)
          route == SRV_R_MORPH || route == SRV_R_JOBS;
 }
 
+/* Probes a load balancer or an operator sends: answered from a reserved
+ * slot when every ordinary one is taken. */
+static bool is_probe(srv_route route)
+{
+  return route == SRV_R_HEALTHZ || route == SRV_R_READYZ ||
+         route == SRV_R_METRICS;
+}
+
+/* The watch record of r's connection (NULL if it is not watched). */
+static srv_conn *conn_of(const srv_req *r)
+{
+  const union MHD_ConnectionInfo *ci =
+      MHD_get_connection_info(r->conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+  return ci ? ci->socket_context : NULL;
+}
+
 /* ------------------------------------------------------------- answering */
 
 /* The origin to allow for this request, or NULL for no CORS headers. */
@@ -262,6 +286,25 @@ static void add_common_headers(srv_req *r, struct MHD_Response *resp,
     MHD_add_response_header(resp, MHD_HTTP_HEADER_CONNECTION, "close");
 }
 
+/* Add the common headers to resp and queue it (resp is released). */
+static enum MHD_Result queue(srv_req *r, int status,
+                             struct MHD_Response *resp, size_t len)
+{
+  add_common_headers(r, resp, status);
+  if (r->location) {
+    char loc[64];
+    snprintf(loc, sizeof loc, "/v1/jobs/%s", r->job_id);
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_LOCATION, loc);
+  }
+  enum MHD_Result ok = MHD_queue_response(r->conn, (unsigned)status, resp);
+  MHD_destroy_response(resp);
+  r->status = status;
+  r->bytes = len;
+  atomic_store(&r->phase, PH_ANSWERED);
+  srv_watch_answer_queued(conn_of(r), srv_now());
+  return ok;
+}
+
 /* Queue an answer. body is malloc'd (freed by MHD) when owned, else
  * static. Never fails to record the status for the log. */
 static enum MHD_Result answer(srv_req *r, int status, const char *ctype,
@@ -277,18 +320,7 @@ static enum MHD_Result answer(srv_req *r, int status, const char *ctype,
   }
   if (ctype != NULL)
     MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, ctype);
-  add_common_headers(r, resp, status);
-  if (r->location) {
-    char loc[64];
-    snprintf(loc, sizeof loc, "/v1/jobs/%s", r->job_id);
-    MHD_add_response_header(resp, MHD_HTTP_HEADER_LOCATION, loc);
-  }
-  enum MHD_Result ok = MHD_queue_response(r->conn, (unsigned)status, resp);
-  MHD_destroy_response(resp);
-  r->status = status;
-  r->bytes = len;
-  atomic_store(&r->phase, PH_ANSWERED);
-  return ok;
+  return queue(r, status, resp, len);
 }
 
 static enum MHD_Result answer_api(srv_req *r, api_response *res)
@@ -314,6 +346,18 @@ static enum MHD_Result problem(srv_req *r, int status, const char *type,
   api_response_init(&res);
   api_problem(&res, status, type, title, detail, pointer, message, r->rid);
   return answer_api(r, &res);
+}
+
+/* A request other than a probe on a reserved slot: every ordinary slot is
+ * taken. */
+static enum MHD_Result reserved_refusal(srv_req *r)
+{
+  srv_metrics_reject(r->srv->metrics, "connections_full");
+  return problem(r, 503, "/problems/overloaded", "Overloaded",
+                 "every connection slot is taken (KMORPH_MAX_CONNECTIONS); "
+                 "the slots beyond it serve /healthz, /readyz and /metrics "
+                 "only; retry after the time in Retry-After",
+                 NULL, NULL);
 }
 
 static enum MHD_Result answer_json(srv_req *r, int status, const char *fmt,
@@ -359,43 +403,150 @@ static int job_created_body(api_response *out, const char *id, size_t total)
   return 0;
 }
 
-/* POST /v1/jobs on a worker: validate and plan, then admit the job. */
-static void create_job(srv_req *r, const api_request *req)
+/* Free the request's body and give its bytes back to the budget of
+ * bodies in flight. */
+static void release_body(srv_req *r)
+{
+  free(r->body);
+  r->body = NULL;
+  r->len = r->cap = 0;
+  atomic_fetch_sub(&r->srv->body_bytes, r->held);
+  r->held = 0;
+}
+
+enum { STOP_NONE, STOP_TIME, STOP_GONE, STOP_SHUTDOWN };
+
+static bool client_gone(srv_req *r);
+
+/* The stop condition of a request's computation, polled by the core at
+ * short intervals of work (api_request.stop): the shutdown's grace ran
+ * out, the compute time limit passed, or the client left (looked at every
+ * 20 ms: a recv on the socket). Runs on the worker that owns r. */
+static bool request_should_stop(void *ctx)
+{
+  srv_req *r = ctx;
+  if (r->stopped != STOP_NONE)
+    return true;
+  if (atomic_load(&r->srv->abort_compute))
+    r->stopped = STOP_SHUTDOWN;
+  double now = srv_now();
+  if (r->stopped == STOP_NONE && now > r->deadline)
+    r->stopped = STOP_TIME;
+  if (r->stopped == STOP_NONE && now >= r->next_gone_check) {
+    r->next_gone_check = now + 0.02;
+    if (client_gone(r))
+      r->stopped = STOP_GONE;
+  }
+  return r->stopped != STOP_NONE;
+}
+
+/* The answer to a computation stopped by request_should_stop. limit and
+ * name describe the time limit; pointer is the member that makes the
+ * request long (a time limit is a limit like the frame limit: 422). */
+static void stopped_problem(srv_req *r, double limit, const char *name,
+                            const char *pointer, const char *message,
+                            const char *progress)
+{
+  api_response_free(&r->resp);
+  if (r->stopped == STOP_GONE) {
+    api_problem(&r->resp, 503, "/problems/client-gone", "Client gone",
+                "the client closed the connection during the work", NULL,
+                NULL, r->rid);
+    return;
+  }
+  if (r->stopped == STOP_SHUTDOWN) {
+    api_problem(&r->resp, 503, "/problems/shutting-down", "Shutting down",
+                "the service stopped this computation at the end of its "
+                "shutdown grace; retry on another instance",
+                NULL, NULL, r->rid);
+    return;
+  }
+  char detail[400];
+  snprintf(detail, sizeof detail,
+           "%s: the computation ran past its time limit of %g s (%s)%s%s",
+           pointer, limit, name, progress,
+           r->route == SRV_R_MORPH
+               ? "; POST /v1/jobs computes long morphs asynchronously"
+               : "");
+  srv_metrics_reject(r->srv->metrics, r->route == SRV_R_MORPH
+                                          ? "morph_time"
+                                          : "compute_time");
+  api_problem(&r->resp, 422, "/problems/limit-exceeded", "Limit exceeded",
+              detail, pointer, message, r->rid);
+}
+
+/* POST /v1/jobs on a worker: validate and plan (within the job's time),
+ * then admit the job with the rest of that time. */
+static void create_job(srv_req *r, api_request *req)
 {
   srv_server *s = r->srv;
   api_morph_plan *plan = NULL;
   api_response err;
   api_response_init(&err);
+  double limit = srv_jobs_time_limit(s->jobs);
+  r->deadline = r->t0 + limit;
   int rc = api_morph_prepare(&s->api, req, s->cfg.max_job_frames, &plan, &err);
   if (rc != 0 || plan == NULL) {
-    if (err.body == NULL)
-      api_problem(&err, rc >= 400 ? rc : 500, "/problems/internal",
+    r->resp = err;
+    if (r->stopped != STOP_NONE) {
+      char message[160];
+      snprintf(message, sizeof message,
+               "preparing the morph takes longer than the %g s a job may "
+               "take", limit);
+      stopped_problem(r, limit, "KMORPH_JOB_TIME", "/tolerance", message,
+                      " while preparing the morph");
+    } else if (r->resp.body == NULL) {
+      api_problem(&r->resp, rc >= 400 ? rc : 500, "/problems/internal",
                   "Internal error", "the morph could not be prepared", NULL,
                   NULL, r->rid);
-    r->resp = err;
+    }
     return;
   }
   api_response_free(&err);
   size_t total = api_morph_frame_count(plan);
-  int st = srv_jobs_start(s->jobs, plan, r->job_id);
-  if (st == -1) {
+  size_t predicted = api_morph_predicted_bytes(plan);
+  if (predicted > s->cfg.result_memory) {
+    /* It could never be kept: a limit of the request, like its frames. */
+    const char *ptr = api_morph_frames_pointer(plan);
+    char message[200], detail[400];
+    snprintf(message, sizeof message,
+             "the result would take up to %zu bytes; job results are kept "
+             "within %zu", predicted, s->cfg.result_memory);
+    snprintf(detail, sizeof detail,
+             "%s: the result would take up to %zu bytes, more than the %zu "
+             "kept for job results (KMORPH_RESULT_MEMORY); ask for fewer "
+             "frames or a looser tolerance",
+             ptr, predicted, s->cfg.result_memory);
     api_morph_plan_free(plan);
+    api_problem(&r->resp, 422, "/problems/limit-exceeded", "Limit exceeded",
+                detail, ptr, message, r->rid);
+    return;
+  }
+  int st = srv_jobs_start(s->jobs, plan, r->deadline, predicted, r->job_id);
+  if (st != 0)
+    api_morph_plan_free(plan);
+  if (st == -1) {
     srv_metrics_reject(s->metrics, "jobs_full");
     api_problem(&r->resp, 429, "/problems/too-many-jobs", "Too many jobs",
                 "the job limit (KMORPH_MAX_JOBS) is reached; retry later",
                 NULL, NULL, r->rid);
     return;
   }
+  if (st == -4) {
+    srv_metrics_reject(s->metrics, "result_memory");
+    api_problem(&r->resp, 503, "/problems/overloaded", "Overloaded",
+                "the results of the jobs running now would fill the memory "
+                "kept for job results (KMORPH_RESULT_MEMORY); retry later",
+                NULL, NULL, r->rid);
+    return;
+  }
   if (st == -3) {
-    api_morph_plan_free(plan);
     api_problem(&r->resp, 503, "/problems/shutting-down", "Shutting down",
                 "the service is stopping; retry on another instance", NULL,
                 NULL, r->rid);
     return;
   }
   if (st != 0 || job_created_body(&r->resp, r->job_id, total) != 0) {
-    if (st != 0)
-      api_morph_plan_free(plan);
     api_problem(&r->resp, 500, "/problems/internal", "Out of memory", NULL,
                 NULL, NULL, r->rid);
     return;
@@ -423,72 +574,72 @@ static bool client_gone(srv_req *r)
   return n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR;
 }
 
-/* The answer to a synchronous morph stopped at its compute time limit:
- * the request is valid but more work than a synchronous answer may take,
- * a limit like the frame limit (422, named by the member that chose the
- * frames), with the way out: an asynchronous job. */
-static void morph_time_problem(srv_req *r, const api_morph_plan *plan,
-                               size_t done)
-{
-  double limit = r->srv->cfg.morph_time;
-  size_t n = api_morph_frame_count(plan);
-  const char *ptr = api_morph_frames_pointer(plan);
-  char message[160], detail[400];
-  snprintf(message, sizeof message,
-           "%zu frames take longer than the %g s a synchronous morph may "
-           "compute",
-           n, limit);
-  snprintf(detail, sizeof detail,
-           "%s: the morph ran past its compute time limit of %g s "
-           "(KMORPH_MORPH_TIME) with %zu of %zu frames done; POST /v1/jobs "
-           "computes long morphs asynchronously",
-           ptr, limit, done, n);
-  srv_metrics_reject(r->srv->metrics, "morph_time");
-  api_problem(&r->resp, 422, "/problems/limit-exceeded", "Limit exceeded",
-              detail, ptr, message, r->rid);
-}
-
 /* POST /v1/morph on a worker, frame by frame the way api_handle does it,
- * so that the work stops between frames when the client leaves or the
- * compute time limit passes. The time counts from the start of the work,
- * since preparing (the signatures) can be most of it, and is checked
- * before each frame: a morph whose last frame ends late is still
- * answered, its work being done. */
-static void morph_sync(srv_req *r, const api_request *req)
+ * so that the work stops when the client leaves or the compute time limit
+ * passes - between frames, and inside preparing and each frame through
+ * the stop condition. The time counts from the start of the work. */
+static void morph_sync(srv_req *r, api_request *req)
 {
   srv_server *s = r->srv;
-  double deadline = srv_now() + s->cfg.morph_time;
   api_morph_plan *plan = NULL;
+  double limit = s->cfg.morph_time;
+  r->deadline = srv_now() + limit;
+  char message[160];
   if (api_morph_prepare(&s->api, req, s->api.max_frames_sync, &plan,
-                        &r->resp) != 0)
+                        &r->resp) != 0) {
+    if (r->stopped != STOP_NONE) {
+      snprintf(message, sizeof message,
+               "preparing the morph takes longer than the %g s a "
+               "synchronous morph may compute", limit);
+      stopped_problem(r, limit, "KMORPH_MORPH_TIME", "/tolerance", message,
+                      " while preparing the morph");
+    }
     return;
+  }
   size_t n = api_morph_frame_count(plan);
   size_t done = 0;
-  bool gone = false, late = false;
-  while (done < n && !gone) {
-    if (srv_now() > deadline) {
-      late = true;
-      break;
-    }
-    api_morph_render_frame(plan, done++);
-    if (done % 8 == 0)
-      gone = client_gone(r);
+  /* A frame that fails for its own reason leaves its problem in the plan
+   * for api_morph_result; one that was stopped ends the work. */
+  while (done < n && !request_should_stop(r)) {
+    api_morph_render_frame_until(plan, done, request_should_stop, r);
+    if (r->stopped == STOP_NONE)
+      done++;
   }
-  if (gone)
-    api_problem(&r->resp, 503, "/problems/client-gone", "Client gone",
-                "the client closed the connection during the work", NULL,
-                NULL, r->rid);
-  else if (late)
-    morph_time_problem(r, plan, done);
-  else
+  if (r->stopped != STOP_NONE) {
+    char progress[80];
+    snprintf(message, sizeof message,
+             "%zu frames take longer than the %g s a synchronous morph may "
+             "compute", n, limit);
+    snprintf(progress, sizeof progress, " with %zu of %zu frames done", done,
+             n);
+    stopped_problem(r, limit, "KMORPH_MORPH_TIME",
+                    api_morph_frames_pointer(plan), message, progress);
+  } else {
     api_morph_result(plan, &r->resp);
+  }
   api_morph_plan_free(plan);
+}
+
+/* POST /v1/signature or /v1/reconstruct on a worker, within the compute
+ * time limit. */
+static void compute_sync(srv_req *r, api_request *req)
+{
+  double limit = r->srv->cfg.compute_time;
+  r->deadline = srv_now() + limit;
+  api_handle(&r->srv->api, req, &r->resp);
+  if (r->stopped != STOP_NONE) {
+    char message[160];
+    snprintf(message, sizeof message,
+             "the computation takes longer than the %g s a request may "
+             "compute", limit);
+    stopped_problem(r, limit, "KMORPH_COMPUTE_TIME", "/tolerance", message,
+                    "");
+  }
 }
 
 static void compute_task(void *arg, bool cancelled)
 {
   srv_req *r = arg;
-  srv_server *s = r->srv;
   api_response_init(&r->resp);
   if (!cancelled && client_gone(r)) {
     api_problem(&r->resp, 503, "/problems/client-gone", "Client gone",
@@ -505,18 +656,24 @@ static void compute_task(void *arg, bool cancelled)
     req.length = r->len;
     req.accept = r->accept;
     req.request_id = r->rid;
+    req.stop = request_should_stop;
+    req.stop_ctx = r;
+    r->next_gone_check = srv_now() + 0.02;
     if (r->route == SRV_R_JOBS) {
       req.route = API_ROUTE_MORPH;
       create_job(r, &req);
     } else if (r->route == SRV_R_SIGNATURE || r->route == SRV_R_RECONSTRUCT) {
       req.route = r->route == SRV_R_SIGNATURE ? API_ROUTE_SIGNATURE
                                               : API_ROUTE_RECONSTRUCT;
-      api_handle(&s->api, &req, &r->resp);
+      compute_sync(r, &req);
     } else {
       req.route = API_ROUTE_MORPH;
       morph_sync(r, &req);
     }
   }
+  /* The body is no longer needed: give its memory back to the budget of
+   * bodies in flight before the answer is sent. */
+  release_body(r);
   atomic_store(&r->phase, PH_READY);
   MHD_resume_connection(r->conn);
 }
@@ -545,6 +702,7 @@ static enum MHD_Result hand_off(srv_req *r)
   atomic_store(&r->phase, PH_WAIT);
   atomic_fetch_add(&s->suspended, 1);
   r->counted = true;
+  srv_watch_body_done(conn_of(r));
   MHD_suspend_connection(r->conn);
   srv_pool_submit(s->pool, compute_task, r);
   return MHD_YES;
@@ -650,6 +808,9 @@ static enum MHD_Result serve_metrics(srv_req *r)
          : NULL;
   g.connections = info ? info->num_connections : 0;
   s->store->ops->counts(s->store, srv_now(), g.jobs);
+  g.body_bytes = atomic_load(&s->body_bytes);
+  g.result_bytes = s->store->ops->result_bytes(s->store);
+  srv_watch_counts(s->watch, &g.late_requests, &g.late_sends);
   g.job_state_names = names;
   size_t len = 0;
   char *text = srv_metrics_render(s->metrics, &g, &len);
@@ -657,6 +818,22 @@ static enum MHD_Result serve_metrics(srv_req *r)
     return MHD_NO;
   return answer(r, 200, "text/plain; version=0.0.4; charset=utf-8", text, len,
                 true);
+}
+
+/* 404 for a job never known (or deleted), 410 for one that was known and
+ * is no longer kept, with why: a client must not take an expired or
+ * evicted job for a mistyped id, nor resubmit blindly. */
+static enum MHD_Result job_missing(srv_req *r, int rc, const srv_job_view *v)
+{
+  if (rc == SRV_STORE_GONE) {
+    char detail[400];
+    snprintf(detail, sizeof detail, "job %s is no longer kept: %s", r->job_id,
+             v->error);
+    return problem(r, 410, "/problems/job-gone", "Job gone", detail, NULL,
+                   NULL);
+  }
+  return problem(r, 404, "/problems/job-not-found", "Job not found",
+                 "no such job", NULL, NULL);
 }
 
 static enum MHD_Result serve_job(srv_req *r)
@@ -674,10 +851,9 @@ static enum MHD_Result serve_job(srv_req *r)
                    "no such job (finished jobs are forgotten after a while)",
                    NULL, NULL);
   }
-  if (s->store->ops->get(s->store, r->job_id, now, &v) != 0)
-    return problem(r, 404, "/problems/job-not-found", "Job not found",
-                   "no such job (finished jobs are forgotten after a while)",
-                   NULL, NULL);
+  int rc = s->store->ops->get(s->store, r->job_id, now, &v);
+  if (rc != SRV_STORE_OK)
+    return job_missing(r, rc, &v);
   double progress =
       v.frames_total ? (double)v.frames_done / (double)v.frames_total : 0.0;
   if (v.state == SRV_JOB_DONE)
@@ -699,19 +875,39 @@ static enum MHD_Result serve_job(srv_req *r)
       v.frames_total, v.age, v.id, v.id, err);
 }
 
+static void drop_result_ref(void *cls) { srv_result_unref(cls); }
+
+/* A job's result, sent from the store's own copy: the answer holds a
+ * reference until libmicrohttpd has sent it, so a slow reader costs no
+ * memory of its own and an eviction meanwhile frees nothing under it. */
+static enum MHD_Result answer_result(srv_req *r, srv_result *res)
+{
+  size_t len = srv_result_length(res);
+  struct MHD_Response *resp =
+      MHD_create_response_from_buffer_with_free_callback_cls(
+          len, (void *)srv_result_body(res), drop_result_ref, res);
+  if (resp == NULL) {
+    srv_result_unref(res);
+    r->cut = "out of memory";
+    return MHD_NO;
+  }
+  MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE,
+                          srv_result_type(res));
+  int status = srv_result_status(res);
+  return queue(r, status, resp, len);
+}
+
 static enum MHD_Result serve_result(srv_req *r)
 {
   srv_server *s = r->srv;
   srv_job_view v;
-  api_response res;
-  api_response_init(&res);
-  if (s->store->ops->result(s->store, r->job_id, srv_now(), &v, &res) != 0)
-    return problem(r, 404, "/problems/job-not-found", "Job not found",
-                   "no such job (finished jobs are forgotten after a while)",
-                   NULL, NULL);
-  if (v.state == SRV_JOB_DONE && res.body != NULL)
-    return answer_api(r, &res);
-  api_response_free(&res);
+  srv_result *res = NULL;
+  int rc = s->store->ops->result(s->store, r->job_id, srv_now(), &v, &res);
+  if (rc != SRV_STORE_OK)
+    return job_missing(r, rc, &v);
+  if (v.state == SRV_JOB_DONE && res != NULL)
+    return answer_result(r, res);
+  srv_result_unref(res);
   char detail[400];
   if (v.state == SRV_JOB_FAILED)
     snprintf(detail, sizeof detail, "the job failed: %s", v.error);
@@ -737,6 +933,14 @@ static enum MHD_Result dispatch(srv_req *r)
              r->seen, s->cfg.max_body);
     return problem(r, 413, "/problems/body-too-large", "Body too large",
                    detail, NULL, NULL);
+  }
+  if (r->no_memory) {
+    srv_metrics_reject(s->metrics, "body_memory");
+    return problem(r, 503, "/problems/overloaded", "Overloaded",
+                   "the request bodies being received fill the memory kept "
+                   "for them (KMORPH_BODY_MEMORY); retry after the time in "
+                   "Retry-After",
+                   NULL, NULL);
   }
   switch (r->route) {
   case SRV_R_INDEX:
@@ -853,6 +1057,21 @@ static enum MHD_Result on_headers(srv_req *r)
   return MHD_YES;
 }
 
+/* Count a body buffer of cap bytes in the budget of bodies in flight
+ * (the whole daemon's): false, with nothing counted, if it does not fit. */
+static bool hold_body_bytes(srv_req *r, size_t cap)
+{
+  srv_server *s = r->srv;
+  size_t extra = cap > r->held ? cap - r->held : 0;
+  size_t cur = atomic_load(&s->body_bytes);
+  do {
+    if (cur + extra > s->cfg.body_memory)
+      return false;
+  } while (!atomic_compare_exchange_weak(&s->body_bytes, &cur, cur + extra));
+  r->held += extra;
+  return true;
+}
+
 /* Collect a body chunk (for compute routes) or count it (others). */
 static enum MHD_Result on_body(srv_req *r, const char *data, size_t size)
 {
@@ -866,12 +1085,10 @@ static enum MHD_Result on_body(srv_req *r, const char *data, size_t size)
   r->seen += size;
   if (r->too_large || r->seen > s->cfg.max_body) {
     r->too_large = true;
-    free(r->body);
-    r->body = NULL;
-    r->len = 0;
+    release_body(r);
     return MHD_YES;
   }
-  if (!is_compute(r->route))
+  if (!is_compute(r->route) || r->no_memory)
     return MHD_YES;
   if (r->len + size + 1 > r->cap) {
     size_t ncap = r->cap ? r->cap : 4096;
@@ -879,6 +1096,13 @@ static enum MHD_Result on_body(srv_req *r, const char *data, size_t size)
       ncap *= 2;
     if (ncap > s->cfg.max_body + 1)
       ncap = s->cfg.max_body + 1;
+    if (!hold_body_bytes(r, ncap)) {
+      /* Counted and dropped like a body over the size limit; answered
+       * 503 when it has arrived. */
+      release_body(r);
+      r->no_memory = true;
+      return MHD_YES;
+    }
     char *nb = realloc(r->body, ncap);
     if (nb == NULL) {
       r->cut = "out of memory";
@@ -937,6 +1161,7 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c,
       return MHD_NO;
     *req_cls = r;
     r->http11 = version != NULL && strcmp(version, "HTTP/1.1") == 0;
+    srv_watch_header_done(conn_of(r), r->t0);
     /* Framing first: a request framed one way here and another way by a
      * proxy must not be answered as if it were understood. */
     srv_http_verdict v;
@@ -950,6 +1175,8 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c,
                  : problem(r, 400, "/problems/bad-request", "Bad request",
                            v.detail, NULL, NULL);
     }
+    if (srv_conn_reserved(conn_of(r)) && !is_probe(r->route))
+      return reserved_refusal(r);
     return on_headers(r);
   }
   if (*upload_size > 0) {
@@ -989,6 +1216,23 @@ static void *on_uri(void *cls, const char *uri, struct MHD_Connection *c)
 
 /* --------------------------------------------------------- log and stats */
 
+/* Connections open and close: their watch records (watch.h). */
+static void on_connection(void *cls, struct MHD_Connection *c,
+                          void **socket_context,
+                          enum MHD_ConnectionNotificationCode code)
+{
+  srv_server *s = cls;
+  if (code == MHD_CONNECTION_NOTIFY_STARTED) {
+    const union MHD_ConnectionInfo *ci =
+        MHD_get_connection_info(c, MHD_CONNECTION_INFO_CONNECTION_FD);
+    *socket_context =
+        ci ? srv_watch_open(s->watch, ci->connect_fd, srv_now()) : NULL;
+  } else if (code == MHD_CONNECTION_NOTIFY_CLOSED) {
+    srv_watch_close(s->watch, *socket_context);
+    *socket_context = NULL;
+  }
+}
+
 static void on_completed(void *cls, struct MHD_Connection *c, void **req_cls,
                          enum MHD_RequestTerminationCode toe)
 {
@@ -1008,6 +1252,7 @@ static void on_completed(void *cls, struct MHD_Connection *c, void **req_cls,
    * process suspended connections.) */
   if (r->counted)
     atomic_fetch_sub(&s->suspended, 1);
+  srv_watch_request_done(conn_of(r), srv_now());
   double dt = srv_now() - r->t0;
   const char *why = r->cut;
   if (why == NULL && toe != MHD_REQUEST_TERMINATED_COMPLETED_OK)
@@ -1031,7 +1276,7 @@ static void on_completed(void *cls, struct MHD_Connection *c, void **req_cls,
             why ? " closed=\"" : "", why ? why : "", why ? "\"" : "");
   }
   api_response_free(&r->resp);
-  free(r->body);
+  release_body(r);
   free(r->accept);
   free(r);
   atomic_fetch_sub(&s->inflight, 1);
@@ -1081,20 +1326,32 @@ srv_server *srv_server_create(const srv_config *cfg, srv_log *logger)
   atomic_init(&s->abort_compute, false);
   atomic_init(&s->suspended, 0);
   atomic_init(&s->inflight, 0);
+  atomic_init(&s->body_bytes, 0);
   api_config_default(&s->api);
   s->api.max_body_bytes = cfg->max_body;
   s->api.max_control_points = cfg->max_points;
   s->api.max_frames_sync = cfg->max_frames;
   s->api.max_frames_job = cfg->max_job_frames;
   s->api.max_samples = cfg->max_samples;
+  s->api.max_output_bytes = cfg->max_output;
   s->metrics = srv_metrics_create();
-  s->store = srv_jobstore_memory_create(cfg->job_ttl, cfg->job_keep);
+  srv_watch_limits wl = {
+      .header_time = cfg->header_time,
+      .request_time = cfg->request_time,
+      .send_time = cfg->send_time,
+      .idle_time = (double)cfg->timeout,
+      /* a probe sends its few header bytes at once */
+      .reserved_header_time = cfg->header_time < 1.0 ? cfg->header_time : 1.0,
+      .normal = cfg->max_connections};
+  s->watch = srv_watch_create(&wl, s->log);
+  s->store = srv_jobstore_memory_create(cfg->job_ttl, cfg->job_keep,
+                                        cfg->result_memory);
   s->jobs = s->store ? srv_jobs_create(s->store, cfg->max_jobs, cfg->job_time)
                      : NULL;
   s->pool = s->jobs ? srv_pool_create(cfg->workers, cfg->queue,
                                       srv_jobs_work, s->jobs)
                     : NULL;
-  if (s->metrics == NULL || s->pool == NULL) {
+  if (s->metrics == NULL || s->pool == NULL || s->watch == NULL) {
     fprintf(s->log, "kmorphd: cannot create the compute pool (%u workers)\n",
             cfg->workers);
     srv_server_destroy(s);
@@ -1127,8 +1384,11 @@ int srv_server_start(srv_server *s)
       flags, (uint16_t)s->cfg.port, NULL, NULL, &on_request, s,
       MHD_OPTION_EXTERNAL_LOGGER, &mhd_log, s, MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&ss,
       MHD_OPTION_THREAD_POOL_SIZE, (unsigned int)s->cfg.io_threads,
-      MHD_OPTION_CONNECTION_LIMIT, (unsigned int)s->cfg.max_connections,
+      MHD_OPTION_CONNECTION_LIMIT,
+      (unsigned int)(s->cfg.max_connections + s->cfg.reserved),
+      MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned int)s->cfg.per_ip,
       MHD_OPTION_CONNECTION_TIMEOUT, (unsigned int)s->cfg.timeout,
+      MHD_OPTION_NOTIFY_CONNECTION, &on_connection, s,
       MHD_OPTION_NOTIFY_COMPLETED, &on_completed, s,
       MHD_OPTION_URI_LOG_CALLBACK, &on_uri, s, MHD_OPTION_END);
   if (s->daemon == NULL) {
@@ -1237,5 +1497,6 @@ void srv_server_destroy(srv_server *s)
   if (s->store)
     s->store->ops->destroy(s->store);
   srv_metrics_destroy(s->metrics);
+  srv_watch_destroy(s->watch); /* after the HTTP daemon: it closes records */
   free(s);
 }

@@ -1,11 +1,14 @@
 """test_jobs.py - the asynchronous job life cycle: queued -> running ->
-done, result 409 before done, cancel, 429 at the job limit, 404 after
+done, result 409 before done, cancel, 429 at the job limit, 410 after
 expiry."""
+import json
+import threading
 import time
 import unittest
 
-from kmtest import (ContractCase, Daemon, close_to, heavy_morph_body, metric,
-                    morph_body, run_job, wait_for)
+from kmtest import (ContractCase, Daemon, circle_svg, close_to,
+                    heavy_morph_body, metric, morph_body, request, run_job,
+                    wait_for)
 
 import math
 
@@ -87,13 +90,15 @@ class JobLifeCycle(ContractCase):
         self.assertGreaterEqual(metric(m, "kmorph_jobs", {"state": "done"}), 1)
         self.assertEqual(metric(m, "kmorph_workers_busy"), 0,
                          "no worker still renders the cancelled job")
-        # Finally, after the time to live both are forgotten.
+        # Finally, after the time to live both are forgotten, and said to
+        # be gone (410, with the limit that let them go), not unknown.
         time.sleep(self.TTL + 0.3)
         for jid in (a["id"], b["id"]):
             r = self.d.request("GET", "/v1/jobs/" + jid)
-            self.assertProblem(r, 404, "/v1/jobs/{id}", "get")
+            doc = self.assertProblem(r, 410, "/v1/jobs/{id}", "get")
+            self.assertIn("KMORPH_JOB_TTL", doc["detail"])
             r = self.d.request("GET", "/v1/jobs/%s/result" % jid)
-            self.assertProblem(r, 404, "/v1/jobs/{id}/result", "get")
+            self.assertProblem(r, 410, "/v1/jobs/{id}/result", "get")
 
     def test_unknown_job_is_404_for_every_method(self):
         for method, path in (("GET", "/v1/jobs/%s"),
@@ -143,6 +148,49 @@ class JobWallTime(ContractCase):
             ["state"], "failed")
         r = self.d.request("GET", "/v1/jobs/%s/result" % jid)
         self.assertProblem(r, 409, "/v1/jobs/{id}/result", "get")
+
+
+class JobIds(ContractCase):
+    """The id of a new job is copied while the job cannot be freed: under
+    thousands of tiny jobs from several threads every answer names a job
+    that exists (it was heap garbage in some answers)."""
+
+    def test_ids_of_tiny_jobs_name_real_jobs(self):
+        d = Daemon("--max-jobs", "100000", "--job-keep", "100000",
+                   "--queue", "1000", "--access-log", "0")
+        try:
+            body = json.dumps({"from": circle_svg(1.0),
+                               "to": circle_svg(2.0),
+                               "frames": 2}).encode()
+            bad, ids, lock = [], [], threading.Lock()
+
+            def worker():
+                for _ in range(250):
+                    r = request(d.port, "POST", "/v1/jobs", body,
+                                {"Content-Type": "application/json"})
+                    if r.status != 202:
+                        continue
+                    jid = r.json()["id"]
+                    with lock:
+                        ids.append(jid)
+                        if (len(jid) != 32 or
+                                any(c not in "0123456789abcdef"
+                                    for c in jid) or
+                                r.header("Location") != "/v1/jobs/" + jid):
+                            bad.append((jid, r.header("Location")))
+            ts = [threading.Thread(target=worker) for _ in range(8)]
+            for t in ts:
+                t.start()
+            for t in ts:
+                t.join(timeout=300)
+            self.assertGreater(len(ids), 1000)
+            self.assertEqual(bad, [], "ids and Location are the job's")
+            missing = [j for j in ids[::7]
+                       if d.request("GET", "/v1/jobs/" + j).status != 200]
+            self.assertEqual(missing, [], "every answered id is a job")
+        finally:
+            d.stop()
+
 
 
 if __name__ == "__main__":
