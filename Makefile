@@ -54,7 +54,7 @@ SUPPORT_SRC := $(wildcard tests/support/*.c)
 
 .PHONY: all deps build run test test-unit test-asan test-server test-clients check-layers \
         bench bench-http fuzz fuzz-svg clean format examples \
-        test-fuzz test-hardening bench-load
+        test-fuzz test-hardening bench-load bench-hostile
 
 all: build
 
@@ -254,6 +254,10 @@ test-hardening: build
 
 bench-load: build
 	@HARDENING_LONG=1 tests/hardening/run.sh load faults
+
+# Peak RSS and time of kmorphd under hostile clients (bench/hostile.py).
+bench-hostile: build
+	@python3 bench/hostile.py --daemon $(DAEMON)
 
 clean:
 	rm -rf build
