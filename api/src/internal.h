@@ -107,6 +107,8 @@ static inline const km_stop *api__km_stop(const api_request *req,
  * the given degree (weights if rational), plus its "svg_d" when asked. */
 size_t api__curve_json_bytes(size_t n, int degree, bool rational,
                              bool svg_d);
+/* The same bound for a signature as api__signature_json prints it. */
+size_t api__signature_json_bytes(const km_signature *sig);
 
 /* Write "<base>/<key>" or "<base>/<index>" into buf (API_POINTER_MAX). */
 void api__ptr_key(char *buf, const char *base, const char *key);

@@ -462,6 +462,12 @@ size_t api__curve_json_bytes(size_t n, int degree, bool rational,
   return b;
 }
 
+size_t api__signature_json_bytes(const km_signature *sig) {
+  size_t knots = sig->kappa.n + (size_t)sig->kappa.degree + 1;
+  return 256 + (JSON_NUM_BYTES + 1) * (knots + sig->kappa.n) +
+         (2 * JSON_NUM_BYTES + 16) * sig->ncorners;
+}
+
 /* Control points of the frames at most: the frames of a planned morph
  * share one count, known exactly; others are counted at the first, middle
  * and last requested times (without building the curves) and given a

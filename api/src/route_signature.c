@@ -66,6 +66,26 @@ int api__route_signature(api_ctx *ctx, const api_request *req,
     }
     use = &sig;
   }
+  {
+    /* the answer's size from the signature's pieces, before it is
+     * printed: a curve of many spans at a tight tolerance answers with
+     * many times its own size */
+    size_t per_sample = 2 * 25 + 4;
+    size_t sig_bytes = api__signature_json_bytes(use);
+    size_t sample_bytes = has_samples ? (size_t)samples * per_sample : 0;
+    size_t predicted = sig_bytes + sample_bytes + 64;
+    if (ctx->cfg->max_output_bytes > 0 &&
+        predicted > ctx->cfg->max_output_bytes) {
+      api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded",
+                 sample_bytes > sig_bytes ? "/samples" : "/tolerance",
+                 "the answer would take up to %zu bytes (a signature of "
+                 "%zu curvature coefficients%s); the limit is %zu bytes",
+                 predicted, use->kappa.n,
+                 sample_bytes > sig_bytes ? " and its samples" : "",
+                 ctx->cfg->max_output_bytes);
+      goto fail;
+    }
+  }
   res = cJSON_CreateObject();
   if (res == NULL) {
     api__oom(ctx);

@@ -13,6 +13,7 @@
 #ifndef FUZZ_API_H
 #define FUZZ_API_H
 
+#include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -72,16 +73,65 @@ static void fuzz_check_response(const api_response *r) {
   }
 }
 
+/* A stop that fires at its n-th poll: the daemon's time limits, a client
+ * leaving and the shutdown all stop computations this way, at any point
+ * of their work. */
+typedef struct fuzz_countdown {
+  unsigned long left;
+} fuzz_countdown;
+
+static bool fuzz_stop_at(void *ctx) {
+  fuzz_countdown *c = ctx;
+  if (c->left == 0)
+    return true;
+  c->left--;
+  return false;
+}
+
+/* The same request stopped part way: the answer is what the unstopped one
+ * was, or the 503 "stopped" problem, and whatever was built is freed
+ * (LeakSanitizer). The poll at which it stops comes from the input, so
+ * that every stopping point can be reached. */
+static void fuzz_stopped_request(const api_config *cfg, const uint8_t *data,
+                                 size_t size, int unstopped) {
+  unsigned long h = 5381;
+  for (size_t i = 0; i < size; i++)
+    h = h * 33 + data[i];
+  fuzz_countdown c = {h % 64};
+  api_request req = {.route = FUZZ_ROUTE,
+                     .body = (const char *)data,
+                     .length = size,
+                     .request_id = "fuzz-2",
+                     .stop = fuzz_stop_at,
+                     .stop_ctx = &c};
+  api_response out;
+  api_response_init(&out);
+  api_handle(cfg, &req, &out);
+  if (out.status == 503) {
+    if (out.body == NULL || strstr(out.body, "/problems/stopped") == NULL)
+      fuzz_fail("a stopped request answered another 503", &out);
+  } else {
+    fuzz_check_response(&out);
+    if (out.status != unstopped)
+      fuzz_fail("a stop changed the answer without stopping it", &out);
+  }
+  api_response_free(&out);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   api_config cfg;
   fuzz_api_config(&cfg);
-  api_request req = {FUZZ_ROUTE, (const char *)data, size, NULL, "fuzz-1"};
+  api_request req = {.route = FUZZ_ROUTE,
+                     .body = (const char *)data,
+                     .length = size,
+                     .request_id = "fuzz-1"};
   api_response out;
   api_response_init(&out);
   int st = api_handle(&cfg, &req, &out);
   if (st != out.status)
     fuzz_fail("returned status differs from the response's", &out);
   fuzz_check_response(&out);
+  fuzz_stopped_request(&cfg, data, size, out.status);
 
 #ifdef FUZZ_JOB_PATH
   /* The asynchronous path (POST /v1/jobs) prepares, renders frame by frame

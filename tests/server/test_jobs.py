@@ -156,8 +156,10 @@ class JobIds(ContractCase):
     that exists (it was heap garbage in some answers)."""
 
     def test_ids_of_tiny_jobs_name_real_jobs(self):
+        # More workers than cores, so that a worker creating a job is
+        # preempted while others render and free it.
         d = Daemon("--max-jobs", "100000", "--job-keep", "100000",
-                   "--queue", "1000", "--access-log", "0")
+                   "--queue", "1000", "--access-log", "0", "--threads", "8")
         try:
             body = json.dumps({"from": circle_svg(1.0),
                                "to": circle_svg(2.0),
@@ -165,7 +167,7 @@ class JobIds(ContractCase):
             bad, ids, lock = [], [], threading.Lock()
 
             def worker():
-                for _ in range(250):
+                for _ in range(500):
                     r = request(d.port, "POST", "/v1/jobs", body,
                                 {"Content-Type": "application/json"})
                     if r.status != 202:
