@@ -66,7 +66,8 @@ asan_contract() {
   out=$(cd tests/server && KMORPHD=../../build/asan/kmorphd \
         ASAN_OPTIONS="log_path=$logdir/asan:detect_leaks=1" \
         UBSAN_OPTIONS="log_path=$logdir/ubsan:print_stacktrace=1" \
-        timeout 900 "$PY" -m unittest test_contract test_jobs test_load 2>&1)
+        timeout 900 "$PY" -m unittest test_contract test_jobs test_load test_bounds \
+          test_http_framing 2>&1)
   rc=$?
   ran=$(printf '%s\n' "$out" | sed -n 's/^Ran \([0-9]*\) test.*/\1/p' | tail -n 1)
   bad=$(printf '%s\n' "$out" | grep -cE '^(FAIL|ERROR): ')
