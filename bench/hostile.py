@@ -24,6 +24,7 @@ import argparse
 import json
 import math
 import os
+import re
 import resource
 import selectors
 import signal
@@ -143,10 +144,17 @@ def json_of(reply):
 
 
 def kind(reply):
-    """How a request ended, in a few characters: its status, or how the
-    connection ended without one."""
+    """How a request ended, in a few words: its status (with the limit or
+    field a problem names), or how the connection ended without one."""
     if reply["status"] is not None:
-        return str(reply["status"])
+        doc = json_of(reply) if reply["status"] >= 400 else None
+        if not isinstance(doc, dict):
+            return str(reply["status"])
+        m = re.search(r"KMORPH_[A-Z_]+", str(doc.get("detail", "")))
+        errs = doc.get("errors") or [{}]
+        why = m.group(0) if m else errs[0].get("pointer") or doc.get("title")
+        return "%d %s" % (reply["status"], why) if why else \
+            str(reply["status"])
     return {"closed": "closed", "reset": "reset",
             "timeout": "no answer"}[reply["end"]]
 
@@ -412,10 +420,13 @@ def s4_heavy_signature(d, limit):
 
 
 def s5_slow_readers(d, limit):
-    """Eight readers of one large job result, each with a small receive
+    """Eight readers of one large job result (about 18 MB: 6,000 frames,
+    under a 64 MiB bound on predicted answers), each with a small receive
     buffer reading 1 KiB a second."""
     t0 = time.monotonic()
-    r, jid = post_job(d, huge_morph_body(), t0 + limit)
+    body = {"from": circle_svg(10.0), "to": square_svg(15.0),
+            "frames": 6000, "tolerance": 1e-4}
+    r, jid = post_job(d, body, t0 + limit)
     if jid is None:
         return {"seconds": None, "answers": "job POST %s" % kind(r)}
     state, _ = wait_job(d, jid, t0 + limit)
@@ -519,15 +530,20 @@ def s6_half_bodies(d, limit):
 
 def tally(ends, n):
     """Seconds until every connection was answered or refused (None if some
-    were still open at the limit) and the outcomes counted."""
-    counts = {}
+    were still open at the limit) and the outcomes counted, each with the
+    time of its last one."""
+    counts, last = {}, {}
     for e in ends:
         k = str(e[0]) if e else "still open"
         counts[k] = counts.get(k, 0) + 1
+        if e:
+            last[k] = max(last.get(k, 0.0), e[1])
     done = [e[1] for e in ends if e]
     return {"seconds": max(done) if len(done) == n else None,
-            "answers": ", ".join("%d %s" % (c, k)
-                                 for k, c in sorted(counts.items()))}
+            "answers": ", ".join(
+                "%d %s" % (c, k) + (" by %.1f s" % last[k] if k in last
+                                    else "")
+                for k, c in sorted(counts.items()))}
 
 
 def flood_body(size, per_array=100000):
@@ -552,10 +568,8 @@ def s7_json_flood(d, limit):
     data, pairs = flood_body(8 * MIB)
     r = exchange(d.port, post_bytes("/v1/signature", data),
                  time.monotonic() + limit, keep=4096)
-    doc = json_of(r) or {}
     return {"seconds": r["seconds"] if r["status"] is not None else None,
-            "answers": kind(r) + (" (%s)" % doc["title"]
-                                  if doc.get("title") else ""),
+            "answers": kind(r),
             "note": "about %d [0,0] pairs in %d bytes" % (pairs, len(data))}
 
 
