@@ -46,7 +46,7 @@ LIBAPI  := $(BUILD)/libkmapi.a
 CLI     := $(BUILD)/kmorph
 DAEMON  := $(BUILD)/kmorphd
 
-UNIT_SRC  := $(wildcard tests/unit/test_*.c)
+UNIT_SRC  := $(wildcard tests/core/test_*.c)
 APIT_SRC  := $(wildcard tests/api/test_*.c)
 UNIT_BIN  := $(UNIT_SRC:%.c=$(BUILD)/%)
 APIT_BIN  := $(APIT_SRC:%.c=$(BUILD)/%)
@@ -100,7 +100,7 @@ $(DAEMON): $(SRV_OBJ) $(LIBAPI) $(LIBCORE)
 	@mkdir -p $(@D)
 	$(CC) $(SRV_OBJ) -o $@ $(LIBAPI) $(LIBCORE) $(MHD_LIBS) $(CJSON_LIBS) -lm -lpthread $(LDFLAGS)
 
-$(BUILD)/tests/unit/%: tests/unit/%.c $(SUPPORT_SRC) $(LIBCORE)
+$(BUILD)/tests/core/%: tests/core/%.c $(SUPPORT_SRC) $(LIBCORE)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) $(CORE_INC) -Itests/support $(CJSON_CFLAGS) $< $(SUPPORT_SRC) -o $@ $(LIBCORE) -lcmocka $(CJSON_LIBS) -lm $(LDFLAGS)
 

@@ -363,7 +363,7 @@ static void linear_theta(double th0, double th1, double *coef) {
  * term by term with int T_j = T_(j+1) / (2 (j+1)) - T_(j-1) / (2 (j-1)))
  * and rounded to double: applying it costs 225 products where the series
  * cost four transforms. Row k integrates x^j exactly for j <= 14
- * (tests/unit/test_numerics.c). */
+ * (tests/core/test_numerics.c). */
 static const double CHEB_CUMULATIVE[NPTS][NPTS] = {
     {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0},
     {0.010165958539869667, 0.016168943650997653, -0.0017426011461854757, 0.00073470309120945033, -0.00041562931584010953, 0.00027345764196991614, -0.00019797355730203698, 0.00015339668143268933, -0.00012520518137240758, 0.00010659709039090615, -9.4057211937823273e-05, 8.5643559655247662e-05, -8.0242848903362829e-05, 7.7219916975469793e-05, -3.8123092783393159e-05},
