@@ -126,7 +126,7 @@ int main(int argc, char **argv) {
   bool pretty = false, svg = false, too_big = false;
   size_t len = 0;
   char *body;
-  int status;
+  api_status status;
 
   for (int i = 1; i < argc; i++) {
     if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {

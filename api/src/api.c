@@ -35,7 +35,7 @@ void api_response_free(api_response *r) {
 
 /* ---------------------------------------------------------------- problems */
 
-static const char *default_type(int status) {
+static const char *default_type(api_status status) {
   switch (status) {
   case 400: return API_P_MALFORMED;
   case 404: return API_P_NOT_FOUND;
@@ -50,7 +50,7 @@ static const char *default_type(int status) {
   }
 }
 
-static const char *default_title(int status) {
+static const char *default_title(api_status status) {
   switch (status) {
   case 400: return "Malformed JSON";
   case 404: return "Not found";
@@ -78,7 +78,7 @@ static bool sane_request_id(const char *id) {
 }
 
 /* Last resort when cJSON cannot allocate: a fixed body, still valid JSON. */
-static void problem_fallback(api_response *out, int status) {
+static void problem_fallback(api_response *out, api_status status) {
   static const char fmt[] =
       "{\"type\":\"%s\",\"title\":\"%s\",\"status\":%d}";
   char buf[256];
@@ -97,7 +97,7 @@ static void problem_fallback(api_response *out, int status) {
   }
 }
 
-void api_problem(api_response *out, int status, const char *type,
+void api_problem(api_response *out, api_status status, const char *type,
                  const char *title, const char *detail, const char *pointer,
                  const char *message, const char *request_id) {
   cJSON *root = cJSON_CreateObject();
@@ -146,8 +146,8 @@ void api__ctx_init(api_ctx *ctx, const api_config *cfg) {
   ctx->cfg = cfg;
 }
 
-bool api__fail(api_ctx *ctx, int status, const char *type, const char *title,
-               const char *pointer, const char *message) {
+bool api__fail(api_ctx *ctx, api_status status, const char *type,
+               const char *title, const char *pointer, const char *message) {
   if (ctx->status != 0)
     return false;
   ctx->status = status;
@@ -169,7 +169,7 @@ bool api__fail(api_ctx *ctx, int status, const char *type, const char *title,
   return false;
 }
 
-bool api__failf(api_ctx *ctx, int status, const char *type,
+bool api__failf(api_ctx *ctx, api_status status, const char *type,
                 const char *title, const char *pointer, const char *fmt,
                 ...) {
   char msg[API_TEXT_MAX];
@@ -209,15 +209,15 @@ void api__ptr_idx(char *buf, const char *base, size_t index) {
 
 void api__ctx_problem(const api_ctx *ctx, api_response *out,
                       const char *request_id) {
-  int status = ctx->status != 0 ? ctx->status : 500;
+  api_status status = ctx->status != 0 ? ctx->status : 500;
   api_problem(out, status, ctx->type, ctx->title,
               ctx->status != 0 ? ctx->detail : "unknown failure",
               ctx->has_pointer ? ctx->pointer : NULL, ctx->message,
               request_id);
 }
 
-int api__respond_json(api_ctx *ctx, cJSON *root, int status,
-                      api_response *out, const char *request_id) {
+api_status api__respond_json(api_ctx *ctx, cJSON *root, api_status status,
+                             api_response *out, const char *request_id) {
   char *text = root != NULL ? cJSON_PrintUnformatted(root) : NULL;
   cJSON_Delete(root);
   if (text == NULL) {
@@ -234,8 +234,8 @@ int api__respond_json(api_ctx *ctx, cJSON *root, int status,
 
 /* ---------------------------------------------------------------- dispatch */
 
-int api_handle(const api_config *cfg, const api_request *req,
-               api_response *out) {
+api_status api_handle(const api_config *cfg, const api_request *req,
+                      api_response *out) {
   api_config defaults;
   api_ctx ctx;
   if (cfg == NULL) {
@@ -251,8 +251,9 @@ int api_handle(const api_config *cfg, const api_request *req,
     return api__route_reconstruct(&ctx, req, out);
   case API_ROUTE_MORPH: {
     api_morph_plan *plan = NULL;
-    int st = api_morph_prepare(cfg, req, cfg->max_frames_sync, &plan, out);
-    if (st != 0)
+    api_status st =
+        api_morph_prepare(cfg, req, cfg->max_frames_sync, &plan, out);
+    if (st != API_STEP_DONE)
       return st;
     /* frames under the request's stop; a stopped or failed one is
      * reported by api_morph_result */

@@ -44,7 +44,7 @@
 /* The request being handled and the first error found in it. */
 typedef struct api_ctx {
   const api_config *cfg;
-  int status; /* 0 while no error */
+  api_status status; /* 0 while no error */
   const char *type;
   const char *title;
   char detail[API_POINTER_MAX + API_TEXT_MAX + 4];
@@ -58,10 +58,10 @@ void api__ctx_init(api_ctx *ctx, const api_config *cfg);
 /* Record an error unless one is recorded already. pointer may be NULL (no
  * errors[] entry); the message is also used as the detail when detail_fmt
  * is NULL. Returns false so callers can `return api__fail(...)`. */
-bool api__fail(api_ctx *ctx, int status, const char *type, const char *title,
-               const char *pointer, const char *message);
+bool api__fail(api_ctx *ctx, api_status status, const char *type,
+               const char *title, const char *pointer, const char *message);
 /* Same with a formatted message (printf-style). */
-bool api__failf(api_ctx *ctx, int status, const char *type,
+bool api__failf(api_ctx *ctx, api_status status, const char *type,
                 const char *title, const char *pointer, const char *fmt, ...)
     __attribute__((format(printf, 6, 7)));
 
@@ -250,13 +250,14 @@ cJSON *api__curve_json(api_ctx *ctx, const km_curve *c, bool svg_d,
 cJSON *api__signature_json(api_ctx *ctx, const km_signature *sig);
 
 /* Render root into a 2xx JSON response; takes ownership of root. */
-int api__respond_json(api_ctx *ctx, cJSON *root, int status,
-                      api_response *out, const char *request_id);
+api_status api__respond_json(api_ctx *ctx, cJSON *root, api_status status,
+                             api_response *out, const char *request_id);
 
 /* Routes. */
-int api__route_signature(api_ctx *ctx, const api_request *req,
-                         api_response *out);
-int api__route_reconstruct(api_ctx *ctx, const api_request *req,
-                           api_response *out);
+/* Routes: the answer into *out, its status returned (as api_handle). */
+api_status api__route_signature(api_ctx *ctx, const api_request *req,
+                                api_response *out);
+api_status api__route_reconstruct(api_ctx *ctx, const api_request *req,
+                                  api_response *out);
 
 #endif

@@ -591,9 +591,9 @@ void api_morph_plan_free(api_morph_plan *plan) {
   free(plan);
 }
 
-int api_morph_prepare(const api_config *cfg, const api_request *req,
-                      size_t max_frames, api_morph_plan **plan,
-                      api_response *error) {
+api_status api_morph_prepare(const api_config *cfg, const api_request *req,
+                             size_t max_frames, api_morph_plan **plan,
+                             api_response *error) {
   api_config defaults;
   api_ctx ctx;
   api_morph_plan *pl;
@@ -674,7 +674,7 @@ int api_morph_prepare(const api_config *cfg, const api_request *req,
   if (!check_output_size(&ctx, pl, stop))
     goto fail;
   *plan = pl;
-  return 0;
+  return API_STEP_DONE;
 fail:
   cJSON_Delete(root);
   api__ctx_problem(&ctx, error, req->request_id);
@@ -690,7 +690,7 @@ const char *api_morph_frames_pointer(const api_morph_plan *plan) {
   return plan != NULL && plan->times_given ? "/times" : "/frames";
 }
 
-int api_morph_render_frame(api_morph_plan *plan, size_t i) {
+api_status api_morph_render_frame(api_morph_plan *plan, size_t i) {
   return api_morph_render_frame_until(plan, i, NULL, NULL);
 }
 
@@ -698,15 +698,15 @@ size_t api_morph_predicted_bytes(const api_morph_plan *plan) {
   return plan != NULL ? plan->predicted : 0;
 }
 
-int api_morph_render_frame_until(api_morph_plan *plan, size_t i,
-                                 api_stop_fn stop, void *ctx) {
+api_status api_morph_render_frame_until(api_morph_plan *plan, size_t i,
+                                        api_stop_fn stop, void *ctx) {
   frame_slot *f;
   km_stop ks = {stop, ctx};
   if (plan == NULL || i >= plan->nframes)
     return 404;
   f = &plan->frames[i];
   if (f->state == 1)
-    return 0;
+    return API_STEP_DONE;
   km_curve_free(&f->curve);
   km_signature_free(&f->sig);
   memset(&f->err, 0, sizeof f->err);
@@ -718,7 +718,7 @@ int api_morph_render_frame_until(api_morph_plan *plan, size_t i,
     return f->st == KM_ENOMEM || f->st == KM_ECANCELLED ? 503 : 422;
   }
   f->state = 1;
-  return 0;
+  return API_STEP_DONE;
 }
 
 /* Number of cubic pieces in an SVG path written as "M x y C ..." with the
@@ -794,7 +794,8 @@ static cJSON *animate_json(api_ctx *ctx, const api_morph_plan *pl) {
   return a;
 }
 
-static int result_json(api_ctx *ctx, api_morph_plan *pl, api_response *out) {
+static api_status result_json(api_ctx *ctx, api_morph_plan *pl,
+                              api_response *out) {
   cJSON *root = cJSON_CreateObject(), *frames, *mu;
   double *pairs = NULL;
   size_t npairs;
@@ -857,7 +858,8 @@ fail:
   return out->status;
 }
 
-static int result_svg(api_ctx *ctx, api_morph_plan *pl, api_response *out) {
+static api_status result_svg(api_ctx *ctx, api_morph_plan *pl,
+                             api_response *out) {
   api_svg_frame *fr = malloc(pl->nframes * sizeof *fr);
   char *doc;
   if (fr == NULL) {
@@ -884,7 +886,7 @@ static int result_svg(api_ctx *ctx, api_morph_plan *pl, api_response *out) {
   return 200;
 }
 
-int api_morph_result(api_morph_plan *plan, api_response *out) {
+api_status api_morph_result(api_morph_plan *plan, api_response *out) {
   api_ctx ctx;
   api_response_init(out);
   if (plan == NULL) {

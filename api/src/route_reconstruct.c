@@ -6,8 +6,8 @@
 
 #include "internal.h"
 
-int api__route_reconstruct(api_ctx *ctx, const api_request *req,
-                           api_response *out) {
+api_status api__route_reconstruct(api_ctx *ctx, const api_request *req,
+                                  api_response *out) {
   cJSON *root = api__parse_body(ctx, req->body, req->length);
   cJSON *res = NULL, *jc;
   const cJSON *js;

@@ -26,8 +26,8 @@ static cJSON *samples_json(api_ctx *ctx, const km_signature *sig, size_t n) {
   return a;
 }
 
-int api__route_signature(api_ctx *ctx, const api_request *req,
-                         api_response *out) {
+api_status api__route_signature(api_ctx *ctx, const api_request *req,
+                                api_response *out) {
   cJSON *root = api__parse_body(ctx, req->body, req->length);
   cJSON *res = NULL, *js;
   api_input in;
