@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "internal.h"
+#include "kernels.h"
 #include "km/limits.h"
 
 void km_curve_init(km_curve *c) {
@@ -171,25 +172,8 @@ void km_curve_domain(const km_curve *c, double *t0, double *t1) {
 size_t km__find_span(const km_curve *c, double t, int side) {
   size_t p = (size_t)c->degree, n = c->n;
   const double *U = c->knots;
-  if (t >= U[n]) {
-    size_t i = n - 1;
-    while (i > p && U[i] == U[n]) i--;
-    return i;
-  }
-  if (t <= U[p]) {
-    size_t i = p;
-    while (i < n - 1 && U[i + 1] == U[p]) i++;
-    return i;
-  }
-  size_t lo = p, hi = n; /* U[lo] <= t < U[hi] */
-  while (hi - lo > 1) {
-    size_t mid = (lo + hi) / 2;
-    if (t < U[mid])
-      hi = mid;
-    else
-      lo = mid;
-  }
-  if (side < 0 && U[lo] == t) {
+  size_t lo = km__knot_span(U, n, c->degree, t);
+  if (side < 0 && t > U[p] && t < U[n] && U[lo] == t) {
     /* left limit: the span ending at t */
     while (lo > p && U[lo] == t) lo--;
     while (lo < n - 1 && U[lo + 1] < t) lo++;

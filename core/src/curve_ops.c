@@ -18,6 +18,7 @@
 
 #include "bezier_util.h"
 #include "internal.h"
+#include "kernels.h"
 #include "km/curve.h"
 #include "km/limits.h"
 
@@ -105,25 +106,6 @@ km_status km__h_to_curve(km_curve *out, const km__hcurve *h, bool closed) {
   return KM_OK;
 }
 
-/* Span index i in [p, n-1] with U[i] <= u < U[i+1]; u at the domain end
- * gives the last non-empty span. */
-static size_t find_span(const double *U, size_t n, int p, double u) {
-  if (u >= U[n]) {
-    size_t i = n - 1;
-    while (i > (size_t)p && U[i] == U[n]) i--;
-    return i;
-  }
-  size_t lo = (size_t)p, hi = n;
-  while (hi - lo > 1) {
-    size_t mid = (lo + hi) / 2;
-    if (u < U[mid])
-      hi = mid;
-    else
-      lo = mid;
-  }
-  return lo;
-}
-
 km_status km__h_refine(km__hcurve *out, const km__hcurve *h, const double *x,
                        size_t nx) {
   int p = h->degree, d = h->dim;
@@ -142,8 +124,8 @@ km_status km__h_refine(km__hcurve *out, const km__hcurve *h, const double *x,
   }
   /* A5.4 with r = nx - 1 and n = last point index; all indices >= 0 */
   size_t r = nx - 1, nl = n - 1;
-  size_t a = find_span(U, n, p, x[0]);
-  size_t b = find_span(U, n, p, x[r]) + 1;
+  size_t a = km__knot_span(U, n, p, x[0]);
+  size_t b = km__knot_span(U, n, p, x[r]) + 1;
   for (size_t j = 0; j <= a - (size_t)p; j++)
     memcpy(Q + j * (size_t)d, P + j * (size_t)d, (size_t)d * sizeof(double));
   for (size_t j = b - 1; j <= nl; j++)

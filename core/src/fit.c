@@ -17,38 +17,8 @@
 #include <string.h>
 
 #include "internal.h"
+#include "kernels.h"
 #include "km/limits.h"
-
-/* the four cubic basis values on span i (U[i] <= u < U[i+1]) */
-static void basis4(const double *U, size_t i, double u, double N[4]) {
-  double left[4], right[4];
-  N[0] = 1.0;
-  for (int j = 1; j <= 3; j++) {
-    left[j] = u - U[i + 1 - (size_t)j];
-    right[j] = U[i + (size_t)j] - u;
-    double saved = 0.0;
-    for (int r = 0; r < j; r++) {
-      double den = right[r + 1] + left[j - r];
-      double tmp = den != 0 ? N[r] / den : 0.0;
-      N[r] = saved + right[r + 1] * tmp;
-      saved = left[j - r] * tmp;
-    }
-    N[j] = saved;
-  }
-}
-
-static size_t span_of(const double *U, size_t ncp, double u) {
-  size_t lo = 3, hi = ncp; /* U[lo] <= u < U[hi] */
-  if (u >= U[ncp]) return ncp - 1;
-  while (hi - lo > 1) {
-    size_t mid = (lo + hi) / 2;
-    if (u < U[mid])
-      hi = mid;
-    else
-      lo = mid;
-  }
-  return lo;
-}
 
 #define FIT_MAX_CP 400 /* dense normal equations beyond this cost too much */
 
@@ -138,9 +108,9 @@ km_status km_curve_fit_points(km_curve *out, const double *pts, size_t n,
     memset(A, 0, nu * nu * sizeof(double));
     memset(rhs, 0, 2 * nu * sizeof(double));
     for (size_t i = 0; i < n; i++) {
-      size_t s = span_of(U, ncp, u[i]);
+      size_t s = km__knot_span(U, ncp, 3, u[i]);
       double N[4];
-      basis4(U, s, u[i], N);
+      km__cubic_basis(U, s, u[i], N);
       double px = pts[2 * i], py = pts[2 * i + 1];
       size_t idx[4];
       double val[4];
@@ -199,8 +169,8 @@ km_status km_curve_fit_points(km_curve *out, const double *pts, size_t n,
     size_t first_in_span = 0;
     bool span_bad = false;
     for (size_t i = 0; i <= n; i++) {
-      size_t s = i < n ? span_of(U, ncp, u[i]) : (size_t)-1;
-      size_t s_prev = i > 0 ? span_of(U, ncp, u[i - 1]) : s;
+      size_t s = i < n ? km__knot_span(U, ncp, 3, u[i]) : (size_t)-1;
+      size_t s_prev = i > 0 ? km__knot_span(U, ncp, 3, u[i - 1]) : s;
       if (i > 0 && s != s_prev) {
         if (span_bad) {
           size_t cnt = i - first_in_span;
@@ -216,7 +186,7 @@ km_status km_curve_fit_points(km_curve *out, const double *pts, size_t n,
       }
       if (i == n) break;
       double N[4], x = 0, y = 0;
-      basis4(U, s, u[i], N);
+      km__cubic_basis(U, s, u[i], N);
       for (int a = 0; a < 4; a++) {
         x += N[a] * cp[2 * (s - 3 + (size_t)a)];
         y += N[a] * cp[2 * (s - 3 + (size_t)a) + 1];

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "internal.h"
+#include "kernels.h"
 #include "km/limits.h"
 
 #define FN_MAX_DEGREE KM_MAX_FN_DEGREE
@@ -113,30 +114,6 @@ void km_fn_domain(const km_fn *f, double *a, double *b) {
   *b = f->knots[f->n];
 }
 
-static size_t fn_span(const km_fn *f, double x) {
-  size_t p = (size_t)f->degree, n = f->n;
-  const double *U = f->knots;
-  if (x >= U[n]) {
-    size_t i = n - 1;
-    while (i > p && !(U[i + 1] > U[i])) i--;
-    return i;
-  }
-  if (x <= U[p]) {
-    size_t i = p;
-    while (i < n - 1 && !(U[i + 1] > U[i])) i++;
-    return i;
-  }
-  size_t lo = p, hi = n;
-  while (hi - lo > 1) {
-    size_t mid = (lo + hi) / 2;
-    if (x < U[mid])
-      hi = mid;
-    else
-      lo = mid;
-  }
-  return lo;
-}
-
 /* k-th derivative at x on span i: difference the local coefficients k
  * times, then de Boor on the lowered degree. */
 static double eval_local(const km_fn *f, size_t i, double x, int k) {
@@ -176,7 +153,7 @@ void km_fn_eval(const km_fn *f, double x, int nder, double *out) {
   km_fn_domain(f, &a, &b);
   if (x < a) x = a;
   if (x > b) x = b;
-  size_t i = fn_span(f, x);
+  size_t i = km__knot_span(f->knots, f->n, f->degree, x);
   for (int k = 0; k <= nder; k++) out[k] = eval_local(f, i, x, k);
 }
 

@@ -14,6 +14,7 @@
 #include "km/limits.h"
 #include "km/status.h"
 #include "km/stop.h"
+#include "kernels.h"
 
 #define KM_PI 3.14159265358979323846
 #define KM__BSPAN_MAX 10 /* KM_MAX_DEGREE + 1 */
@@ -116,19 +117,6 @@ double km__bspan_noise(const km__bspan *sp);
 /* Span index i with knots[i] <= t < knots[i+1] (last non-empty span at the
  * domain end); side < 0 picks knots[i] < t <= knots[i+1]. */
 size_t km__find_span(const km_curve *c, double t, int side);
-
-/* Solve the dense n x n system A x = y in place (row-major A, x returned
- * in y) by Gaussian elimination with partial pivoting; false if singular. */
-bool km__solve_dense(double *A, double *y, int n);
-/* The d+1 Bernstein basis values B_k^d(u). */
-void km__bernstein_basis(double u, int d, double *row);
-/* qsort comparison of doubles. */
-int km__cmp_double(const void *a, const void *b);
-/* Discrete Fourier transform of n = 2^k complex values in place (X_m = sum
- * x_j e^(-2 pi i j m / n); inverse: with e^(+...) and divided by n), with
- * the n/2 twiddles e^(-2 pi i k / n) from km__fft_twiddles (2 per k). */
-void km__fft_twiddles(int n, double *tw);
-void km__fft(double *re, double *im, int n, const double *tw, bool inverse);
 
 /* F[k] = integral from -1 to x_k of the degree-14 interpolant of f at the
  * 15 Chebyshev-Lobatto points x_k = -cos(k pi / 14) of [-1, 1] (the

@@ -18,44 +18,9 @@
 #include <string.h>
 
 #include "internal.h"
+#include "kernels.h"
 #include "km/curve.h"
 #include "km/limits.h"
-
-/* Span i with T[i] <= u < T[i+1] within [p, n-1] (last span at the end). */
-static size_t span_of(const double *T, size_t n, double u) {
-  size_t lo = 3, hi = n;
-  if (u >= T[n]) {
-    lo = n - 1;
-    while (lo > 3 && T[lo] == T[n]) lo--;
-    return lo;
-  }
-  while (hi - lo > 1) {
-    size_t mid = (lo + hi) / 2;
-    if (u < T[mid])
-      hi = mid;
-    else
-      lo = mid;
-  }
-  return lo;
-}
-
-/* The four cubic basis functions N[i-3..i] at u on span i (Cox-de Boor,
- * Piegl & Tiller A2.2). */
-static void cubic_basis(const double *T, size_t i, double u, double N[4]) {
-  double left[4], right[4];
-  N[0] = 1.0;
-  for (int j = 1; j <= 3; j++) {
-    left[j] = u - T[i + 1 - (size_t)j];
-    right[j] = T[i + (size_t)j] - u;
-    double saved = 0.0;
-    for (int r = 0; r < j; r++) {
-      double tmp = N[r] / (right[r + 1] + left[j - r]);
-      N[r] = saved + right[r + 1] * tmp;
-      saved = left[j - r] * tmp;
-    }
-    N[j] = saved;
-  }
-}
 
 /* Open, N >= 4: not-a-knot collocation. cp receives N points. */
 static km_status solve_open(const double *Q, const double *u, size_t N,
@@ -71,9 +36,9 @@ static km_status solve_open(const double *Q, const double *u, size_t N,
   if (!A) return KM_ENOMEM;
   memcpy(cp, Q, 2 * N * sizeof(double));
   for (size_t k = 0; k < N; k++) {
-    size_t s = span_of(T, N, u[k]);
+    size_t s = km__knot_span(T, N, 3, u[k]);
     double Nb[4];
-    cubic_basis(T, s, u[k], Nb);
+    km__cubic_basis(T, s, u[k], Nb);
     for (int j = 0; j < 4; j++) {
       size_t col = s - 3 + (size_t)j;
       if (Nb[j] == 0.0) continue;

@@ -5,6 +5,7 @@
 #include <math.h>
 
 #include "internal.h"
+#include "kernels.h"
 
 bool km__solve_dense(double *A, double *y, int n) {
   for (int c = 0; c < n; c++) {
