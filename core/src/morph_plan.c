@@ -24,7 +24,7 @@
  * A frame is then a pass of sin/cos over the nodes, a pass turning them by
  * the closure's first change, a bounded first-order finish (close_frame)
  * and the Hermite control points: no piecewise-polynomial blending, no
- * planning, no allocation but the output. The closure is the one of morph.c (close_lsq): interior uniform
+ * planning, no allocation but the output. The closure is the one of morph_closure.c: interior uniform
  * cubic B-splines psi added to theta, minimum-norm steps in the metric
  * integral psi'^2 (the Gram matrix of their derivatives is Toeplitz with
  * entries 2/3, -1/8, -1/5, -1/120), so the seam stays G2.
@@ -36,47 +36,12 @@
 #include "internal.h"
 #include "km/limits.h"
 #include "morph_plan.h"
+#include "morph_plan_internal.h"
 
-#define NB KM__CLOSURE_INTERVALS
-#define NF (KM__CLOSURE_INTERVALS - 3)
 #define MAX_RULE 8      /* highest Gauss-Legendre order used */
-/* Gap (over the frame's length) at which the lsq closure stops: a tenth of
- * its promise, 1e-9 of the length (a hundredth cost U_to_S's 60-frame
- * morph 21 more passes over the nodes, 228 instead of 207) */
-#define CLOSED_GAP 1e-10
 #define NDER (2 * MAX_RULE)
-/* Closure corrections kept at t = k / WARM_POINTS, from which frames start
- * theirs (WARM_POINTS + 1 of them, zero at both ends) */
-#define WARM_POINTS 6
 #define MERGE_DEGREE 7   /* of theta on merged input pieces */
 #define MERGE_SHARE 0.1  /* of the tolerance, for merging them */
-
-typedef struct gnode {
-  double w;      /* weight in r */
-  double ta, tb; /* Ta(r), Tb(r) at the node */
-  int bi;        /* first closure basis function that may be nonzero */
-  double bv[4];  /* basis values bi .. bi+3 (0 where outside 0..NF-1) */
-} gnode;
-
-struct km__frame_plan {
-  double La, Lb, tol;
-  bool closed;
-  size_t np;            /* output pieces */
-  double *x;            /* np + 1 breaks in r */
-  unsigned char *corner; /* np + 1: theta jumps there (C0 junction) */
-  double *ta_l, *ta_r;  /* Ta left / right of each break */
-  double *tb_l, *tb_r;
-  size_t *first;        /* nodes of piece k: first[k] .. first[k+1] - 1 */
-  double wb[NF];        /* sum over the nodes of w B_i: integral of B_i */
-  gnode *at_break;      /* the closure basis at every break (bi, bv) */
-  gnode *node;
-  size_t nn;
-  double chol[NF * NF]; /* Cholesky factor of the closure metric */
-  double c_at[WARM_POINTS + 1][NF]; /* closure corrections at t = k / WARM_POINTS */
-  size_t *corner_at;    /* breaks (1 .. np - 1) that are corners */
-  size_t ncorners;
-  bool by_corners;      /* closed frames close by their corners */
-};
 
 /* ---- small numerics ---------------------------------------------------- */
 
@@ -127,23 +92,6 @@ static void bell(const double *x, int mmax, double *B) {
   }
 }
 
-double km__bspline3_d(double u) {
-  if (u <= 0 || u >= 4) return 0.0;
-  if (u < 1) return u * u / 2.0;
-  if (u < 2) return (-9 * u * u + 24 * u - 12) / 6.0;
-  if (u < 3) return (9 * u * u - 48 * u + 60) / 6.0;
-  double v = 4 - u;
-  return -v * v / 2.0;
-}
-
-double km__bspline3(double u) {
-  if (u <= 0 || u >= 4) return 0.0;
-  if (u < 1) return u * u * u / 6.0;
-  if (u < 2) return (-3 * u * u * u + 12 * u * u - 12 * u + 4) / 6.0;
-  if (u < 3) return (3 * u * u * u - 24 * u * u + 60 * u - 44) / 6.0;
-  double v = 4 - u;
-  return v * v * v / 6.0;
-}
 
 /* The closure basis at r: first index (-3 .. NF - 1) and four values,
  * zero for indices outside 0 .. NF - 1. */
@@ -158,73 +106,6 @@ static void basis_at(double r, int *bi, double bv[4]) {
     bv[k] = (i >= 0 && i < NF) ? km__bspline3(u - i) : 0.0;
   }
   *bi = i0;
-}
-
-/* psi at break k, from the basis values there (computed once per plan). */
-static double psi_at_break(const km__frame_plan *p, const double *c, size_t k) {
-  const gnode *b = &p->at_break[k];
-  double v = 0.0;
-  for (int q = 0; q < 4; q++)
-    if (b->bi + q >= 0 && b->bi + q < NF) v += c[b->bi + q] * b->bv[q];
-  return v;
-}
-
-void km__closure_metric_weighted(const double *w, double *M) {
-  /* per interval the four basis derivatives are quadratics: three Gauss
-   * points integrate their products exactly */
-  static const double X[3] = {0.11270166537925831, 0.5, 0.88729833462074169};
-  static const double W[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
-  memset(M, 0, NF * NF * sizeof(double));
-  for (int iv = 0; iv < NB; iv++)
-    for (int g = 0; g < 3; g++) {
-      double u = iv + X[g], d[NF];
-      for (int i = 0; i < NF; i++) d[i] = km__bspline3_d(u - i);
-      for (int i = 0; i < NF; i++) {
-        if (d[i] == 0.0) continue;
-        for (int j = 0; j < NF; j++) M[i * NF + j] += w[iv] * W[g] * d[i] * d[j];
-      }
-    }
-}
-
-void km__closure_metric(double *M) {
-  static const double band[4] = {2.0 / 3.0, -1.0 / 8.0, -1.0 / 5.0, -1.0 / 120.0};
-  for (int i = 0; i < NF; i++)
-    for (int j = 0; j < NF; j++) {
-      int d = i > j ? i - j : j - i;
-      M[i * NF + j] = d < 4 ? band[d] : 0.0;
-    }
-}
-
-/* Cholesky of the Toeplitz metric (exact entries, see DESIGN). */
-static bool metric_factor(double *Lc) {
-  double M[NF * NF];
-  km__closure_metric(M);
-  memset(Lc, 0, NF * NF * sizeof(double));
-  for (int i = 0; i < NF; i++)
-    for (int j = 0; j <= i; j++) {
-      double v = M[i * NF + j];
-      for (int k = 0; k < j; k++) v -= Lc[i * NF + k] * Lc[j * NF + k];
-      if (i == j) {
-        if (!(v > 0)) return false;
-        Lc[i * NF + i] = sqrt(v);
-      } else {
-        Lc[i * NF + j] = v / Lc[j * NF + j];
-      }
-    }
-  return true;
-}
-
-static void chol_solve(const double *Lc, double *y) {
-  for (int i = 0; i < NF; i++) {
-    double v = y[i];
-    for (int k = 0; k < i; k++) v -= Lc[i * NF + k] * y[k];
-    y[i] = v / Lc[i * NF + i];
-  }
-  for (int i = NF - 1; i >= 0; i--) {
-    double v = y[i];
-    for (int k = i + 1; k < NF; k++) v -= Lc[k * NF + i] * y[k];
-    y[i] = v / Lc[i * NF + i];
-  }
 }
 
 /* ---- one input over an interval of r --------------------------------- */
@@ -389,23 +270,6 @@ void km__frame_plan_free(km__frame_plan *p) {
   free(p);
 }
 
-static int cmp_dbl(const void *a, const void *b) {
-  double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
-
-/* Scratch a frame's closure needs: the pieces' sums (2 per piece) and
- * e^(i theta) at the nodes (2 per node). */
-static size_t frame_scratch(const km__frame_plan *p) {
-  return 2 * (p->np + p->nn);
-}
-
-static km_status close_frame(const km__frame_plan *p, double t, double theta0,
-                             bool close_lsq, bool project, double *c,
-                             double *sum, double *e, km__poll *poll);
-static bool corner_closure(const km__frame_plan *p, double t, double *sum,
-                           double *tau, double *delta, double *S,
-                           double *dp);
 
 km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const double length[2],
                                const double angle[2], bool closed, double tol,
@@ -446,7 +310,7 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
   p->Lb = length[1];
   p->tol = tol;
   p->closed = closed;
-  if (!metric_factor(p->chol)) {
+  if (!km__closure_metric_factor(p->chol)) {
     st = KM_ENOCONVERGE;
     goto fail;
   }
@@ -460,7 +324,7 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
   size_t q = 0;
   for (int w = 0; w < 2; w++)
     for (size_t i = 0; i <= mt[w].m; i++) br[q++] = mt[w].x[i] / length[w];
-  qsort(br, q, sizeof(double), cmp_dbl);
+  qsort(br, q, sizeof(double), km__cmp_double);
   size_t m = 0;
   for (size_t i = 0; i < q; i++) {
     double v = fmin(fmax(br[i], 0.0), 1.0);
@@ -649,17 +513,17 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
      * not switch between two closures (a frame where it fails takes the
      * smooth one). */
     size_t nc = p->ncorners;
-    double *buf = nc >= 3 ? malloc((frame_scratch(p) + 4 * nc + 2 + np) *
+    double *buf = nc >= 3 ? malloc((km__plan_frame_scratch(p) + 4 * nc + 2 + np) *
                                    sizeof(double))
                           : NULL;
     if (buf) {
-      double *tau = buf + frame_scratch(p), *delta = tau + nc, *S = delta + nc;
+      double *tau = buf + km__plan_frame_scratch(p), *delta = tau + nc, *S = delta + nc;
       double *dp = S + 2 * (nc + 1), c0[NF] = {0};
       p->by_corners = true;
       for (int k = 1; k <= 3 && p->by_corners; k++)
-        p->by_corners = close_frame(p, k / 4.0, 0.0, false, false, c0, buf,
+        p->by_corners = km__plan_close_frame(p, k / 4.0, 0.0, false, false, c0, buf,
                                     buf + 2 * np, poll) == KM_OK &&
-                        corner_closure(p, k / 4.0, buf, tau, delta, S, dp);
+                        km__plan_corner_closure(p, k / 4.0, buf, tau, delta, S, dp);
       free(buf);
     }
     /* The corrections frames start from, at t = k / WARM_POINTS: the
@@ -671,13 +535,13 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
      * (a frame they cannot close takes steps from zero). */
     memset(p->c_at, 0, sizeof p->c_at);
     if (!p->by_corners) {
-      double *sum = malloc(frame_scratch(p) * sizeof(double));
+      double *sum = malloc(km__plan_frame_scratch(p) * sizeof(double));
       if (!sum) {
         st = KM_ENOMEM;
         goto fail;
       }
       double c_half[NF] = {0};
-      st = close_frame(p, 0.5, 0.0, true, true, c_half, sum, sum + 2 * np,
+      st = km__plan_close_frame(p, 0.5, 0.0, true, true, c_half, sum, sum + 2 * np,
                        poll);
       if (st == KM_ENOCONVERGE) {
         memset(c_half, 0, sizeof c_half);
@@ -686,7 +550,7 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
       for (int k = 1; k < WARM_POINTS && !st; k++) {
         double t = (double)k / WARM_POINTS;
         for (int i = 0; i < NF; i++) p->c_at[k][i] = 4 * t * (1 - t) * c_half[i];
-        st = close_frame(p, t, 0.0, true, true, p->c_at[k], sum, sum + 2 * np,
+        st = km__plan_close_frame(p, t, 0.0, true, true, p->c_at[k], sum, sum + 2 * np,
                          poll);
         if (st == KM_ENOCONVERGE) {
           memset(p->c_at[k], 0, sizeof p->c_at[k]);
@@ -739,464 +603,3 @@ size_t km__frame_plan_points(const km__frame_plan *p) {
 const double *km__frame_plan_breaks(const km__frame_plan *p) { return p->x; }
 bool km__frame_plan_by_corners(const km__frame_plan *p) { return p->by_corners; }
 
-/* ---- closing by the corners ------------------------------------------- */
-
-bool km__close_by_corners(const double *S, const double *tau, size_t nc,
-                          double *delta) {
-  if (nc < 3) return false;
-  double *W = malloc((4 * nc + 1) * sizeof(double));
-  if (!W) return false;
-  double *D = W + nc, *J = W + 2 * nc + 1; /* J: 2 nc (suffix sums) */
-  double wsum = 0.0;
-  for (size_t k = 0; k < nc; k++) {
-    W[k] = fabs(tau[k]);
-    wsum += W[k];
-    delta[k] = 0.0;
-  }
-  bool ok = false;
-  for (int it = 0; it < 60 && wsum > 0; it++) {
-    /* D_m = delta_1 + ... + delta_m; G = sum_m e^(i D_m) S_m and the
-     * derivatives i sum_(m >= k) e^(i D_m) S_m (suffix sums) */
-    D[0] = 0.0;
-    for (size_t k = 0; k < nc; k++) D[k + 1] = D[k] + delta[k];
-    double gx = 0.0, gy = 0.0;
-    for (size_t m = nc + 1; m-- > 0;) {
-      double c = cos(D[m]), sn = sin(D[m]);
-      gx += c * S[2 * m] - sn * S[2 * m + 1];
-      gy += sn * S[2 * m] + c * S[2 * m + 1];
-      if (m >= 1) {
-        J[2 * (m - 1)] = -gy; /* d gx / d delta_m */
-        J[2 * (m - 1) + 1] = gx; /* d gy / d delta_m */
-      }
-    }
-    if (hypot(gx, gy) <= 1e-14) {
-      ok = true;
-      break;
-    }
-    /* least sum delta^2 / W with the linearised constraints
-     * A delta = A delta_old - (gx, gy, 0), A = (Jx; Jy; 1 ... 1):
-     * delta = W A^T (A W A^T)^-1 rhs */
-    double M[9] = {0}, rhs[3] = {-gx, -gy, 0.0};
-    for (size_t k = 0; k < nc; k++) {
-      double a[3] = {J[2 * k], J[2 * k + 1], 1.0};
-      for (int r = 0; r < 3; r++) {
-        rhs[r] += a[r] * delta[k];
-        for (int q = 0; q < 3; q++) M[r * 3 + q] += W[k] * a[r] * a[q];
-      }
-    }
-    if (!km__solve_dense(M, rhs, 3)) break;
-    for (size_t k = 0; k < nc; k++)
-      delta[k] = W[k] * (J[2 * k] * rhs[0] + J[2 * k + 1] * rhs[1] + rhs[2]);
-  }
-  /* a corner may change by at most half its turn: beyond that the shape
-   * would be closed by corners it hardly has */
-  for (size_t k = 0; ok && k < nc; k++)
-    if (fabs(delta[k]) > 0.5 * fabs(tau[k])) ok = false;
-  free(W);
-  return ok;
-}
-
-/* ---- frames ------------------------------------------------------------ */
-
-static double max_abs(const double *v, int n) {
-  double m = 0.0;
-  for (int i = 0; i < n; i++) m = fmax(m, fabs(v[i]));
-  return m;
-}
-
-/* e^(i d) for |d| <= 0.1 by its Taylor series (the remainder is below
- * 0.1^10 / 10! < 3e-17), beyond that by sin and cos. */
-static inline void exp_i_small(double d, double *cs, double *sn) {
-  if (fabs(d) > 0.1) {
-    km__sincos(d, sn, cs);
-    return;
-  }
-  /* reciprocals, not divisions: a division takes some 15 cycles, and
-   * these run at every node of every pass */
-  double d2 = d * d;
-  *cs = 1 - d2 * 0.5 * (1 - d2 * (1.0 / 12) * (1 - d2 * (1.0 / 30) *
-        (1 - d2 * (1.0 / 56) * (1 - d2 * (1.0 / 90)))));
-  *sn = d * (1 - d2 * (1.0 / 6) * (1 - d2 * (1.0 / 20) * (1 - d2 * (1.0 / 42) *
-        (1 - d2 * (1.0 / 72)))));
-}
-
-/* e^(i d) for |d| <= 0.01: the series to d^7 (the remainder is below
- * 0.01^8 / 8! < 3e-21), for passes whose change is bounded so. */
-static inline void exp_i_tiny(double d, double *cs, double *sn) {
-  double d2 = d * d;
-  *cs = 1 - d2 * 0.5 * (1 - d2 * (1.0 / 12) * (1 - d2 * (1.0 / 30)));
-  *sn = d * (1 - d2 * (1.0 / 6) * (1 - d2 * (1.0 / 20) * (1 - d2 * (1.0 / 42))));
-}
-
-/* One pass over the nodes: sum[2k], sum[2k+1] = integral over piece k of
- * e^(i (theta_t + psi)), G their total. On the first pass (e_known false)
- * e^(i theta) is computed at every node; later ones turn the stored e by
- * the change of psi (coefficients dcp), which is small. With J, d G / d c
- * is accumulated too. Coefficients are padded by three zeros each side, so
- * that every node reads its four basis functions without a test
- * (basis_at). */
-static void frame_pass(const km__frame_plan *p, double t, double theta0,
-                       const double *cp, const double *dcp, bool e_known,
-                       double *sum, double *e, double G[2], double J[2][NF],
-                       km__poll *poll) {
-  double al = 1 - t, be = t, Jp[2][NF + 6];
-  if (J) memset(Jp, 0, sizeof Jp);
-  G[0] = G[1] = 0.0;
-  /* nodes mostly share their basis functions with the previous one: the
-   * Jacobian is summed in registers while they do */
-  int run = -1;
-  double ax[4] = {0, 0, 0, 0}, ay[4] = {0, 0, 0, 0};
-  /* the change at a node is at most the largest coefficient's (the basis
-   * is a partition of unity): most passes need only the short series */
-  bool tiny = e_known && max_abs(dcp + 3, NF) <= 0.01;
-  for (size_t k = 0; k < p->np; k++) {
-    double sx = 0.0, sy = 0.0;
-    /* the caller sees poll->stopped: what was summed is then unused */
-    if (km__poll_stop(poll, (long)(p->first[k + 1] - p->first[k]) + 1)) return;
-    for (size_t j = p->first[k]; j < p->first[k + 1]; j++) {
-      const gnode *nd = &p->node[j];
-      const double *bv = nd->bv;
-      int o = nd->bi + 3;
-      double cs, sn;
-      if (!e_known) {
-        double th = theta0 + al * nd->ta + be * nd->tb + cp[o] * bv[0] +
-                    cp[o + 1] * bv[1] + cp[o + 2] * bv[2] + cp[o + 3] * bv[3];
-        km__sincos(th, &sn, &cs);
-      } else {
-        double d = dcp[o] * bv[0] + dcp[o + 1] * bv[1] + dcp[o + 2] * bv[2] +
-                   dcp[o + 3] * bv[3];
-        double dx, dy;
-        if (tiny)
-          exp_i_tiny(d, &dx, &dy);
-        else
-          exp_i_small(d, &dx, &dy);
-        cs = e[2 * j] * dx - e[2 * j + 1] * dy;
-        sn = e[2 * j] * dy + e[2 * j + 1] * dx;
-      }
-      e[2 * j] = cs;
-      e[2 * j + 1] = sn;
-      double wc = nd->w * cs, ws = nd->w * sn;
-      sx += wc;
-      sy += ws;
-      if (J) {
-        if (o != run) {
-          if (run >= 0)
-            for (int q = 0; q < 4; q++) {
-              Jp[0][run + q] += ax[q];
-              Jp[1][run + q] += ay[q];
-            }
-          run = o;
-          for (int q = 0; q < 4; q++) ax[q] = ay[q] = 0.0;
-        }
-        for (int q = 0; q < 4; q++) {
-          ax[q] -= ws * bv[q];
-          ay[q] += wc * bv[q];
-        }
-      }
-    }
-    sum[2 * k] = sx;
-    sum[2 * k + 1] = sy;
-    G[0] += sx;
-    G[1] += sy;
-  }
-  if (J) {
-    if (run >= 0)
-      for (int q = 0; q < 4; q++) {
-        Jp[0][run + q] += ax[q];
-        Jp[1][run + q] += ay[q];
-      }
-    for (int r = 0; r < 2; r++) memcpy(J[r], Jp[r] + 3, sizeof J[r]);
-  }
-}
-
-/* The pieces' sums moved to first order by a step of psi (padded
- * coefficients dcp) from where e was stored: sum_k += integral over piece
- * k of i e^(i theta) dpsi. */
-static void linear_finish(const km__frame_plan *p, const double *dcp,
-                          const double *e, double *sum) {
-  for (size_t k = 0; k < p->np; k++) {
-    double dx = 0.0, dy = 0.0;
-    for (size_t j = p->first[k]; j < p->first[k + 1]; j++) {
-      const gnode *nd = &p->node[j];
-      const double *bv = nd->bv;
-      int o = nd->bi + 3;
-      double d = nd->w * (dcp[o] * bv[0] + dcp[o + 1] * bv[1] +
-                          dcp[o + 2] * bv[2] + dcp[o + 3] * bv[3]);
-      dx -= e[2 * j + 1] * d;
-      dy += e[2 * j] * d;
-    }
-    sum[2 * k] += dx;
-    sum[2 * k + 1] += dy;
-  }
-}
-
-/* Y = M^-1 J^T (rows) and S = J M^-1 J^T for the closure metric M: what
- * minimum-norm steps with this J need, kept for a chord step. */
-static void metric_rows(const km__frame_plan *p, double J[2][NF],
-                        double Y[2][NF], double S[4]) {
-  for (int r = 0; r < 2; r++) {
-    memcpy(Y[r], J[r], sizeof Y[r]);
-    chol_solve(p->chol, Y[r]);
-  }
-  for (int r = 0; r < 2; r++)
-    for (int k = 0; k < 2; k++) {
-      double v = 0.0;
-      for (int i = 0; i < NF; i++) v += J[r][i] * Y[k][i];
-      S[r * 2 + k] = v;
-    }
-}
-
-/* The minimum-norm step dc = M^-1 J^T lambda with J dc = rhs; false if J
- * is singular. */
-static bool metric_step(double Y[2][NF], const double S[4], const double rhs[2],
-                        double dc[NF]) {
-  double A[4] = {S[0], S[1], S[2], S[3]}, l[2] = {rhs[0], rhs[1]};
-  if (!km__solve_dense(A, l, 2)) return false;
-  for (int i = 0; i < NF; i++) dc[i] = Y[0][i] * l[0] + Y[1][i] * l[1];
-  return true;
-}
-
-/* theta_t plus the closure correction psi (coefficients c, started from
- * c), integrated over every piece: sum[2k], sum[2k+1] = integral of
- * e^(i theta) dr over piece k. scratch: e^(i theta) at the nodes (2 per
- * node).
- *
- * The lsq closure solves G(c) = 0 for the least change of curvature: with
- * project, a projection onto the linearised constraints (the minimum-norm
- * point of J c = J c_old - G in the metric integral psi'^2, whose Gram
- * matrix is Toeplitz with entries 2/3, -1/8, -1/5, -1/120) - how the
- * corrections frames start from are found - else a first step from c;
- * then steps dc = M^-1 J^T lambda with J dc = -G: with the first J (a
- * chord step) when the first change was at most 1e-3, else Newton steps
- * with fresh Jacobians, which converge quadratically. No pass follows the last
- * step when a bound on what it leaves says so:
- *   G(c + dc) = (J(c) - J(c0)) dc + R,
- * |J(c) - J(c0)| dc <= max|dc0| sum_i |dc_i| wb_i for the chord (|e^(i a)
- * - e^(i b)| <= |a - b|, and |psi change| <= max|dc| since the basis sums
- * to at most one; nothing for Newton), |R| <= max|dc|^2 / 2 (the Taylor
- * remainder of e^(i d), the weights summing to one). Below CLOSED_GAP the
- * pieces' sums take the linear change (linear_finish, each within its
- * share of the same bound) and the frame is closed to CLOSED_GAP of its
- * length, as by a further pass. */
-static km_status close_frame(const km__frame_plan *p, double t, double theta0,
-                             bool close_lsq, bool project, double *c,
-                             double *sum, double *scratch, km__poll *poll) {
-  double Lt = (1 - t) * p->La + t * p->Lb;
-  bool lsq = close_lsq && p->closed;
-  double *e = scratch;
-  double cp[NF + 6] = {0}, dcp[NF + 6] = {0}, dc[NF], G[2], J[2][NF];
-  double Y[2][NF], S[4];
-  memcpy(cp + 3, c, sizeof dc);
-  frame_pass(p, t, theta0, cp, NULL, false, sum, e, G, lsq ? J : NULL, poll);
-  if (poll && poll->stopped) return KM_ECANCELLED;
-  /* With the projection a start that is closed already is the answer
-   * only if it is zero: the projection from it leads elsewhere, and the
-   * frames beside it take that (a closed start kept at t = 1/2 stood 1.4%
-   * of U_to_S's length off its neighbours at 1/2 +- 1e-6). */
-  bool closed = Lt * hypot(G[0], G[1]) <= CLOSED_GAP * Lt;
-  if (!lsq || (closed && (!project || max_abs(c, NF) == 0))) return KM_OK;
-  metric_rows(p, J, Y, S);
-  double rhs[2] = {-G[0], -G[1]};
-  if (project) {
-    for (int r = 0; r < 2; r++)
-      for (int i = 0; i < NF; i++) rhs[r] += J[r][i] * c[i];
-    if (!metric_step(Y, S, rhs, dc)) return KM_ENOCONVERGE;
-    for (int i = 0; i < NF; i++) {
-      double ci = dc[i];
-      dc[i] = ci - c[i];
-      c[i] = ci;
-    }
-  } else {
-    if (!metric_step(Y, S, rhs, dc)) return KM_ENOCONVERGE;
-    for (int i = 0; i < NF; i++) c[i] += dc[i];
-  }
-  /* A small first change leaves so little that a chord step with this
-   * Jacobian finishes (the bound below); a large one needs Newton steps
-   * with fresh Jacobians, which converge quadratically. */
-  double dc0 = max_abs(dc, NF);
-  bool chord = dc0 <= 1e-3;
-  for (int it = 0;; it++) {
-    memcpy(dcp + 3, dc, sizeof dc);
-    frame_pass(p, t, theta0, cp, dcp, true, sum, e, G, chord ? NULL : J, poll);
-    if (poll && poll->stopped) return KM_ECANCELLED;
-    if (Lt * hypot(G[0], G[1]) <= CLOSED_GAP * Lt) return KM_OK;
-    if (it == 40) return KM_ENOCONVERGE;
-    if (!chord) metric_rows(p, J, Y, S);
-    double r[2] = {-G[0], -G[1]}, cross = 0.0;
-    if (!metric_step(Y, S, r, dc)) return KM_ENOCONVERGE;
-    if (chord)
-      for (int i = 0; i < NF; i++) cross += fabs(dc[i]) * p->wb[i];
-    for (int i = 0; i < NF; i++) c[i] += dc[i];
-    double d = max_abs(dc, NF);
-    if (dc0 * cross + 0.5 * d * d <= CLOSED_GAP && isfinite(d)) {
-      memcpy(dcp + 3, dc, sizeof dc);
-      linear_finish(p, dcp, e, sum);
-      return KM_OK;
-    }
-    chord = false; /* from here on, Newton */
-  }
-}
-
-/* Closes a frame by its corners (km__close_by_corners) given the pieces'
- * integrals sum (rotated in place on success); dp[k] receives the turn
- * added before piece k. Scratch: tau, delta (nc each), S (2 (nc + 1)). */
-static bool corner_closure(const km__frame_plan *p, double t, double *sum,
-                           double *tau, double *delta, double *S,
-                           double *dp) {
-  size_t np = p->np, nc = p->ncorners, m = 0;
-  S[0] = S[1] = 0.0;
-  for (size_t k = 0; k < np; k++) {
-    if (m < nc && p->corner_at[m] == k) {
-      size_t b = p->corner_at[m];
-      tau[m] = (1 - t) * (p->ta_r[b] - p->ta_l[b]) + t * (p->tb_r[b] - p->tb_l[b]);
-      m++;
-      S[2 * m] = S[2 * m + 1] = 0.0;
-    }
-    S[2 * m] += sum[2 * k];
-    S[2 * m + 1] += sum[2 * k + 1];
-  }
-  if (!km__close_by_corners(S, tau, nc, delta)) return false;
-  double d = 0.0;
-  m = 0;
-  for (size_t k = 0; k < np; k++) {
-    if (m < nc && p->corner_at[m] == k) d += delta[m++];
-    dp[k] = d;
-    double cs = cos(d), sn = sin(d), x = sum[2 * k], y = sum[2 * k + 1];
-    sum[2 * k] = cs * x - sn * y;
-    sum[2 * k + 1] = sn * x + cs * y;
-  }
-  return true;
-}
-
-/* The closure correction a frame at t starts from: the polynomial through
- * the kept corrections (smooth in t, exact at each: frames move smoothly
- * through them, where a piecewise cubic left a kink). */
-static void warm_start(const km__frame_plan *p, double t, double *c) {
-  double x = t * WARM_POINTS;
-  for (int i = 0; i < NF; i++) c[i] = 0.0;
-  for (int j = 1; j < WARM_POINTS; j++) { /* the ends are zero */
-    double l = 1.0;
-    for (int q = 0; q <= WARM_POINTS; q++)
-      if (q != j) l *= (x - q) / (double)(j - q);
-    for (int i = 0; i < NF; i++) c[i] += l * p->c_at[j][i];
-  }
-}
-
-km_status km__frame_plan_curve(const km__frame_plan *p, double t,
-                               double theta0, bool close_lsq, km_curve *out,
-                               double *ends, km__poll *poll, km_error *err) {
-  double Lt = (1 - t) * p->La + t * p->Lb, al = 1 - t, be = t;
-  size_t np = p->np;
-  double c[NF] = {0};
-  bool lsq = close_lsq && p->closed;
-  /* sums of the pieces, scratch of the nodes, and per corner its turn,
-   * its change and the stretch sums; per piece the turn added before it */
-  size_t nc = p->ncorners;
-  double *sum = malloc((frame_scratch(p) + 4 * nc + 2 + np) * sizeof(double));
-  if (!sum) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
-  double *tau = sum + frame_scratch(p), *delta = tau + nc, *S = delta + nc;
-  double *dp = S + 2 * (nc + 1);
-  for (size_t k = 0; k < np; k++) dp[k] = 0.0;
-  km_status st = KM_OK;
-  bool by_corners = false;
-  if (lsq && p->by_corners) {
-    st = close_frame(p, t, theta0, false, false, c, sum, sum + 2 * np, poll);
-    by_corners = !st && corner_closure(p, t, sum, tau, delta, S, dp);
-  }
-  if (!st && !by_corners) {
-    /* the smooth curvature takes the correction, by steps from the
-     * cubic through the kept ones (warm_start): closed at those points
-     * already, near it between them, so frames near each other take
-     * nearly the same correction (continuous in t), and the ends none.
-     * Should the steps fail, the projection from there, as the kept
-     * corrections were found. */
-    if (lsq) warm_start(p, t, c);
-    st = close_frame(p, t, theta0, close_lsq, false, c, sum, sum + 2 * np,
-                     poll);
-    if (st == KM_ENOCONVERGE && lsq) {
-      warm_start(p, t, c);
-      st = close_frame(p, t, theta0, true, true, c, sum, sum + 2 * np, poll);
-    }
-  }
-  if (st == KM_ECANCELLED || (poll && poll->stopped)) {
-    free(sum);
-    return km__stopped(err);
-  }
-  if (st) {
-    free(sum);
-    return km__fail(err, st, KM_FIELD_NONE, -1, NAN,
-                    "closing the frame did not converge");
-  }
-  /* Hermite control points: P0, then Q1 Q2 of every piece, with the
-   * junction point itself at corners (triple knots; double elsewhere) */
-  size_t ncorner = 0;
-  for (size_t k = 1; k < np; k++) ncorner += p->corner[k];
-  size_t ncp = 2 * np + 2 + ncorner, nknots = ncp + 4;
-  km_curve f;
-  km_curve_init(&f);
-  st = km__curve_alloc(&f, 3, ncp, false);
-  if (st) {
-    free(sum);
-    return km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
-  }
-  size_t cc = 0, kk = 0;
-  double P[2] = {0.0, 0.0};
-  for (int r = 0; r < 4; r++) f.knots[kk++] = 0.0;
-  f.cp[cc++] = 0.0;
-  f.cp[cc++] = 0.0;
-  if (ends) ends[0] = ends[1] = 0.0;
-  /* the tangent a piece ends with is the next one's start but at corners
-   * (theta is continuous there to 1e-12, and so is the turn dp) */
-  double c1 = 0.0, s1 = 0.0;
-  for (size_t k = 0; k < np; k++) {
-    double h = Lt * (p->x[k + 1] - p->x[k]);
-    double th1 = theta0 + al * p->ta_l[k + 1] + be * p->tb_l[k + 1] +
-                 psi_at_break(p, c, k + 1) + dp[k];
-    double Pn[2] = {P[0] + Lt * sum[2 * k], P[1] + Lt * sum[2 * k + 1]};
-    if (k > 0 && p->corner[k]) {
-      f.cp[cc++] = P[0];
-      f.cp[cc++] = P[1];
-    }
-    double c0 = c1, s0 = s1;
-    if (k == 0 || p->corner[k]) {
-      double th0 = theta0 + al * p->ta_r[k] + be * p->tb_r[k] +
-                   psi_at_break(p, c, k) + dp[k];
-      km__sincos(th0, &s0, &c0);
-    }
-    km__sincos(th1, &s1, &c1);
-    f.cp[cc++] = P[0] + h / 3.0 * c0;
-    f.cp[cc++] = P[1] + h / 3.0 * s0;
-    f.cp[cc++] = Pn[0] - h / 3.0 * c1;
-    f.cp[cc++] = Pn[1] - h / 3.0 * s1;
-    if (k + 1 < np) {
-      int mult = p->corner[k + 1] ? 3 : 2;
-      for (int r = 0; r < mult; r++) f.knots[kk++] = Lt * p->x[k + 1];
-    }
-    P[0] = Pn[0];
-    P[1] = Pn[1];
-    if (ends) {
-      ends[2 * k + 2] = P[0];
-      ends[2 * k + 3] = P[1];
-    }
-  }
-  f.cp[cc++] = P[0];
-  f.cp[cc++] = P[1];
-  for (int r = 0; r < 4; r++) f.knots[kk++] = Lt;
-  free(sum);
-  if (cc != 2 * ncp || kk != nknots) {
-    km_curve_free(&f);
-    return km__fail(err, KM_EINVAL, KM_FIELD_NONE, -1, NAN,
-                    "internal inconsistency building a frame");
-  }
-  f.closed = false;
-  if (p->closed) {
-    double g = hypot(P[0], P[1]);
-    if (g <= p->tol) {
-      f.cp[2 * (ncp - 1)] = f.cp[0];
-      f.cp[2 * (ncp - 1) + 1] = f.cp[1];
-      f.closed = true;
-    }
-  }
-  *out = f;
-  return KM_OK;
-}

@@ -1,0 +1,107 @@
+/* morph_internal.h - the morph object and its prepared inputs, shared by
+ * the files of the morph engine (morph*.c); internal to the core.
+ *
+ * morph.c creates the object and dispatches frames; the inputs are made
+ * ready in morph_input.c (copy, signature, tables, orientation, start),
+ * matched in morph_match.c, blended in morph_blend.c, closed in
+ * morph_closure.c and placed in morph_place.c; planned frames come from
+ * morph_plan.c. Every function declared here reads a morph or an input
+ * that does not change any more, so frames may be built from many threads
+ * at once.
+ */
+#ifndef KM_MORPH_INTERNAL_H
+#define KM_MORPH_INTERNAL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "internal.h"
+#include "km/curve.h"
+#include "km/morph.h"
+#include "km/signature.h"
+#include "km/status.h"
+#include "morph_plan.h"
+
+/* Samples of an input's position table, at s = L j / KM__TABLE_N: the
+ * placement targets and the start alignment read it. */
+#define KM__TABLE_N 512
+/* Starts of a closed `to` tried, best aligned first (km__best_shifts). */
+#define KM__SHIFT_CANDIDATES 4
+
+/* One input of a morph, made ready (km__input_prepare). */
+typedef struct km__input {
+  km_curve curve;
+  bool has_curve;
+  km_signature sig;
+  km_pp kappa, theta; /* theta pieces in s */
+  double table[KM__TABLE_N + 1][2]; /* positions at s = L j / KM__TABLE_N */
+  double centroid[2];
+} km__input;
+
+struct km_morph {
+  km_morph_options opt;
+  double tol;
+  bool closed;
+  km__input in[2];
+  double *ra, *rb; /* correspondence knots, nm+2 of them incl. 0 and 1 */
+  size_t nk;
+  size_t nuser;    /* match pairs reported */
+  km_curve lin[2]; /* compatible curves (linear method) */
+  km__frame_plan *plan; /* frames planned once (morph_plan.c), or NULL */
+  bool close_by_corners; /* lsq closure by the frames' corners */
+  double kmax;           /* the inputs' largest |kappa|: the frames' bound */
+  /* placement targets of planned frames: the inputs' points at the plan's
+   * breaks (x, y of a, then of b) and the break's trapezoid weight; the
+   * weights' sum and the weighted means */
+  double (*place_ab)[5];
+  double place_w_sum, place_qa[2], place_qb[2];
+  /* the caller's stop condition while km_morph_create runs, NULL after:
+   * frames take their own (km_morph_frame_until) */
+  km__poll *poll;
+};
+
+/* ---- inputs (morph_input.c) ---------------------------------------------
+ * Statuses: KM_ENOMEM (with err), KM_ECANCELLED when poll says stop (err
+ * untouched: the caller reports the stop), and those of the signature and
+ * curve functions named. */
+
+/* Makes *in ready from src (a curve, a signature or both): its copy, its
+ * signature (computed from the curve to tol, or without one to 1e-6 of its
+ * own length), its theta pieces and its position table. *in is
+ * initialised first, so km__input_free may follow any outcome. KM_EINVAL
+ * (err) when src has neither. */
+km_status km__input_prepare(km__input *in, const km_morph_input *src,
+                            double tol, km__poll *poll, km_error *err);
+/* Frees what *in holds (an initialised or prepared input). */
+void km__input_free(km__input *in);
+/* Deep copy of a prepared input into *out (initialised, empty); on failure
+ * *out holds what was copied and is freed by km__input_free. */
+km_status km__input_copy(km__input *out, const km__input *in, km_error *err);
+/* The input's curve, reconstructed from its signature to tol (at most
+ * max_points control points, 0: no bound) unless it has one. */
+km_status km__input_ensure_curve(km__input *in, double tol, size_t max_points,
+                                 km__poll *poll, km_error *err);
+/* The closed input started at arc length s0 instead of 0 (exactly: its
+ * signature shifted cyclically, its curve split and joined); nothing
+ * changes for s0 within 1e-12 L of either end. */
+km_status km__input_rotate_start(km__input *in, double s0, km__poll *poll,
+                                 km_error *err);
+/* The closed input traced backwards, exactly. */
+km_status km__input_reverse(km__input *in, km__poll *poll, km_error *err);
+/* Position at normalised arc length r in [0, 1] (clamped), linear between
+ * the table's points. */
+void km__input_point_at(const km__input *in, double r, double out[2]);
+/* Tangent angle at arc length s (clamped to the piece at either end). */
+double km__input_theta_at(const km__input *in, double s);
+/* Fills cand[] with up to KM__SHIFT_CANDIDATES starts of b (fractions of
+ * its length), best aligned with a first, and returns how many (at least
+ * one: without memory the given start, 0). */
+size_t km__best_shifts(const km__input *a, const km__input *b, double *cand);
+
+/* Pieces of p restricted to [x0, x1] (x0 < x1, inside p's breaks) into
+ * *out (initialised, empty; the caller frees it). KM_ENOMEM, no message. */
+km_status km__pp_slice(km_pp *out, const km_pp *p, double x0, double x1);
+/* qsort comparison of km_corner by arc length. */
+int km__cmp_corner(const void *x, const void *y);
+
+#endif
