@@ -12,6 +12,7 @@
 #include <cmocka.h>
 
 #include "api_testutil.h"
+#include "testmain.h"
 
 /* ---- stop conditions ---- */
 
@@ -273,13 +274,12 @@ static void reconstruct_answer_is_held_to_the_limit(void **state) {
   cJSON_Delete(j);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(stop_gives_503_stopped_on_every_route),
-      cmocka_unit_test(stopped_frame_makes_the_result_stopped),
-      cmocka_unit_test(huge_answer_is_refused_before_work),
-      cmocka_unit_test(prediction_bounds_the_real_answer),
-      cmocka_unit_test(reconstruct_answer_is_held_to_the_limit),
-  };
-  return cmocka_run_group_tests(tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(stop_gives_503_stopped_on_every_route),
+    cmocka_unit_test(stopped_frame_makes_the_result_stopped),
+    cmocka_unit_test(huge_answer_is_refused_before_work),
+    cmocka_unit_test(prediction_bounds_the_real_answer),
+    cmocka_unit_test(reconstruct_answer_is_held_to_the_limit),
+};
+
+TM_SUITE("api_bounds", tests, NULL, NULL);

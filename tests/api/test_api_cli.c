@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include "api_testutil.h"
+#include "testmain.h"
 
 typedef struct cli_env {
   const char *cli;
@@ -141,12 +142,11 @@ static void cli_morph_validation_goes_through_the_api(void **state) {
   free(out);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(cli_signature_of_a_circle_succeeds),
-      cmocka_unit_test(cli_problem_exits_1_with_problem_json),
-      cmocka_unit_test(cli_usage_errors_exit_2),
-      cmocka_unit_test(cli_morph_validation_goes_through_the_api),
-  };
-  return cmocka_run_group_tests(tests, setup, teardown);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(cli_signature_of_a_circle_succeeds),
+    cmocka_unit_test(cli_problem_exits_1_with_problem_json),
+    cmocka_unit_test(cli_usage_errors_exit_2),
+    cmocka_unit_test(cli_morph_validation_goes_through_the_api),
+};
+
+TM_SUITE("api_cli", tests, setup, teardown);

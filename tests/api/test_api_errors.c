@@ -3,6 +3,7 @@
  * api_handle exactly as the daemon and the CLI call it.
  */
 #include "api_testutil.h"
+#include "testmain.h"
 
 #define SIG API_ROUTE_SIGNATURE
 #define REC API_ROUTE_RECONSTRUCT
@@ -464,33 +465,32 @@ static void request_id_is_echoed_in_problems(void **state) {
   cJSON_Delete(j);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(malformed_json_is_400),
-      cmocka_unit_test(invalid_utf8_is_400),
-      cmocka_unit_test(string_escapes_are_decoded),
-      cmocka_unit_test(body_without_nul_is_read_to_its_length),
-      cmocka_unit_test(nesting_deeper_than_the_limit_is_400),
-      cmocka_unit_test(overlong_array_is_refused_before_parsing),
-      cmocka_unit_test(non_object_body_is_422_at_root),
-      cmocka_unit_test(body_over_the_limit_is_413),
-      cmocka_unit_test(unknown_route_is_404),
-      cmocka_unit_test(missing_and_mistyped_fields_name_the_field),
-      cmocka_unit_test(non_finite_numbers_are_422),
-      cmocka_unit_test(bad_svg_path_names_d_and_the_offset),
-      cmocka_unit_test(decreasing_knot_is_named),
-      cmocka_unit_test(wrong_knot_count_is_named),
-      cmocka_unit_test(degree_out_of_range_is_named),
-      cmocka_unit_test(non_positive_weight_is_named),
-      cmocka_unit_test(closed_curve_that_does_not_close_is_named),
-      cmocka_unit_test(cusp_is_422_invalid_curve),
-      cmocka_unit_test(control_points_above_the_limit_are_422),
-      cmocka_unit_test(answers_and_turns_above_the_limits_are_422),
-      cmocka_unit_test(bad_tolerance_and_samples_are_named),
-      cmocka_unit_test(signature_errors_are_named),
-      cmocka_unit_test(reconstruct_degree_must_be_3_or_5),
-      cmocka_unit_test(problem_bodies_follow_rfc9457),
-      cmocka_unit_test(request_id_is_echoed_in_problems),
-  };
-  return cmocka_run_group_tests(tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(malformed_json_is_400),
+    cmocka_unit_test(invalid_utf8_is_400),
+    cmocka_unit_test(string_escapes_are_decoded),
+    cmocka_unit_test(body_without_nul_is_read_to_its_length),
+    cmocka_unit_test(nesting_deeper_than_the_limit_is_400),
+    cmocka_unit_test(overlong_array_is_refused_before_parsing),
+    cmocka_unit_test(non_object_body_is_422_at_root),
+    cmocka_unit_test(body_over_the_limit_is_413),
+    cmocka_unit_test(unknown_route_is_404),
+    cmocka_unit_test(missing_and_mistyped_fields_name_the_field),
+    cmocka_unit_test(non_finite_numbers_are_422),
+    cmocka_unit_test(bad_svg_path_names_d_and_the_offset),
+    cmocka_unit_test(decreasing_knot_is_named),
+    cmocka_unit_test(wrong_knot_count_is_named),
+    cmocka_unit_test(degree_out_of_range_is_named),
+    cmocka_unit_test(non_positive_weight_is_named),
+    cmocka_unit_test(closed_curve_that_does_not_close_is_named),
+    cmocka_unit_test(cusp_is_422_invalid_curve),
+    cmocka_unit_test(control_points_above_the_limit_are_422),
+    cmocka_unit_test(answers_and_turns_above_the_limits_are_422),
+    cmocka_unit_test(bad_tolerance_and_samples_are_named),
+    cmocka_unit_test(signature_errors_are_named),
+    cmocka_unit_test(reconstruct_degree_must_be_3_or_5),
+    cmocka_unit_test(problem_bodies_follow_rfc9457),
+    cmocka_unit_test(request_id_is_echoed_in_problems),
+};
+
+TM_SUITE("api_errors", tests, NULL, NULL);

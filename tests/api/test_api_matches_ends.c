@@ -11,6 +11,7 @@
  * blend of corresponding points, which lie on that circle).
  */
 #include "api_testutil.h"
+#include "testmain.h"
 
 #define MORPH API_ROUTE_MORPH
 
@@ -136,11 +137,10 @@ static void paper_blend_beside_an_end_answers_200(void **state) {
   cJSON_Delete(j);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(a_match_from_the_start_to_the_end_answers_200),
-      cmocka_unit_test(matches_next_to_the_ends_keep_the_circle),
-      cmocka_unit_test(paper_blend_beside_an_end_answers_200),
-  };
-  return cmocka_run_group_tests(tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(a_match_from_the_start_to_the_end_answers_200),
+    cmocka_unit_test(matches_next_to_the_ends_keep_the_circle),
+    cmocka_unit_test(paper_blend_beside_an_end_answers_200),
+};
+
+TM_SUITE("api_matches_ends", tests, NULL, NULL);

@@ -4,6 +4,7 @@
  * into a circle stays a circle under the turning blend).
  */
 #include "api_testutil.h"
+#include "testmain.h"
 
 #define MORPH API_ROUTE_MORPH
 
@@ -445,24 +446,23 @@ static void opposite_turning_kept_is_not_morphable(void **state) {
   free(b.s);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(frame_counts_are_validated),
-      cmocka_unit_test(job_frame_limit_is_the_callers),
-      cmocka_unit_test(unknown_enum_values_are_named),
-      cmocka_unit_test(matches_are_validated),
-      cmocka_unit_test(svg_options_are_validated),
-      cmocka_unit_test(curves_are_validated_under_their_side),
-      cmocka_unit_test(circle_to_circle_stays_a_circle),
-      cmocka_unit_test(times_choose_the_frames),
-      cmocka_unit_test(metrics_false_omits_metrics),
-      cmocka_unit_test(linear_method_starts_and_ends_at_the_inputs),
-      cmocka_unit_test(animate_d_paths_share_one_structure),
-      cmocka_unit_test(svg_is_returned_when_asked),
-      cmocka_unit_test(prepared_plan_renders_the_same_result),
-      cmocka_unit_test(plan_names_the_member_that_chose_the_frames),
-      cmocka_unit_test(open_into_closed_is_not_morphable),
-      cmocka_unit_test(opposite_turning_kept_is_not_morphable),
-  };
-  return cmocka_run_group_tests(tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(frame_counts_are_validated),
+    cmocka_unit_test(job_frame_limit_is_the_callers),
+    cmocka_unit_test(unknown_enum_values_are_named),
+    cmocka_unit_test(matches_are_validated),
+    cmocka_unit_test(svg_options_are_validated),
+    cmocka_unit_test(curves_are_validated_under_their_side),
+    cmocka_unit_test(circle_to_circle_stays_a_circle),
+    cmocka_unit_test(times_choose_the_frames),
+    cmocka_unit_test(metrics_false_omits_metrics),
+    cmocka_unit_test(linear_method_starts_and_ends_at_the_inputs),
+    cmocka_unit_test(animate_d_paths_share_one_structure),
+    cmocka_unit_test(svg_is_returned_when_asked),
+    cmocka_unit_test(prepared_plan_renders_the_same_result),
+    cmocka_unit_test(plan_names_the_member_that_chose_the_frames),
+    cmocka_unit_test(open_into_closed_is_not_morphable),
+    cmocka_unit_test(opposite_turning_kept_is_not_morphable),
+};
+
+TM_SUITE("api_morph", tests, NULL, NULL);

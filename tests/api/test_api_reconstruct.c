@@ -5,6 +5,7 @@
  */
 #include "api_testutil.h"
 #include "fixtures.h"
+#include "testmain.h"
 
 /* The fixture's signature as a request body. */
 static char *request_for(const char *name, double tol, int degree) {
@@ -171,13 +172,12 @@ static void signature_then_reconstruct_round_trips(void **state) {
   free(b.s);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(unit_circle_cubic_lands_on_the_circle),
-      cmocka_unit_test(unit_circle_quintic_lands_on_the_circle),
-      cmocka_unit_test(cornu_spiral_matches_fresnel_integrals),
-      cmocka_unit_test(svg_d_is_included_when_asked),
-      cmocka_unit_test(signature_then_reconstruct_round_trips),
-  };
-  return cmocka_run_group_tests(tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(unit_circle_cubic_lands_on_the_circle),
+    cmocka_unit_test(unit_circle_quintic_lands_on_the_circle),
+    cmocka_unit_test(cornu_spiral_matches_fresnel_integrals),
+    cmocka_unit_test(svg_d_is_included_when_asked),
+    cmocka_unit_test(signature_then_reconstruct_round_trips),
+};
+
+TM_SUITE("api_reconstruct", tests, NULL, NULL);

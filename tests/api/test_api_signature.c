@@ -3,6 +3,7 @@
  * segments, polygons), sent and received as JSON.
  */
 #include "api_testutil.h"
+#include "testmain.h"
 
 static cJSON *signature_of(const char *body) {
   api_response res;
@@ -208,16 +209,15 @@ static void numbers_round_trip_through_json(void **state) {
   free(b.s);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(circle_signature_has_kappa_one_over_r),
-      cmocka_unit_test(clockwise_circle_has_negative_kappa),
-      cmocka_unit_test(segment_signature_is_straight),
-      cmocka_unit_test(square_signature_has_four_right_angle_corners),
-      cmocka_unit_test(signature_input_is_returned_as_given),
-      cmocka_unit_test(svg_path_signature_has_its_corner),
-      cmocka_unit_test(unknown_top_level_fields_are_ignored),
-      cmocka_unit_test(numbers_round_trip_through_json),
-  };
-  return cmocka_run_group_tests(tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(circle_signature_has_kappa_one_over_r),
+    cmocka_unit_test(clockwise_circle_has_negative_kappa),
+    cmocka_unit_test(segment_signature_is_straight),
+    cmocka_unit_test(square_signature_has_four_right_angle_corners),
+    cmocka_unit_test(signature_input_is_returned_as_given),
+    cmocka_unit_test(svg_path_signature_has_its_corner),
+    cmocka_unit_test(unknown_top_level_fields_are_ignored),
+    cmocka_unit_test(numbers_round_trip_through_json),
+};
+
+TM_SUITE("api_signature", tests, NULL, NULL);

@@ -6,6 +6,7 @@
 #include <pthread.h>
 
 #include "api_testutil.h"
+#include "testmain.h"
 
 #define NTHREADS 4
 #define ROUNDS 8
@@ -122,10 +123,9 @@ static void plan_frames_render_on_many_threads(void **state) {
   free(b.s);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(concurrent_requests_answer_as_sequential_ones),
-      cmocka_unit_test(plan_frames_render_on_many_threads),
-  };
-  return cmocka_run_group_tests(tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(concurrent_requests_answer_as_sequential_ones),
+    cmocka_unit_test(plan_frames_render_on_many_threads),
+};
+
+TM_SUITE("api_threads", tests, NULL, NULL);

@@ -10,6 +10,7 @@
 #include "api_testutil.h"
 
 #include "../../api/src/internal.h"
+#include "testmain.h"
 
 #define SIG API_ROUTE_SIGNATURE
 #define MORPH API_ROUTE_MORPH
@@ -406,23 +407,22 @@ static void refusal_says_why(void **state) {
   free(body);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(duplicate_top_level_member_is_400_naming_it),
-      cmocka_unit_test(duplicate_nested_member_is_400_naming_its_object),
-      cmocka_unit_test(duplicate_in_an_array_element_names_the_element),
-      cmocka_unit_test(escaped_spelling_of_a_name_is_the_same_member),
-      cmocka_unit_test(first_repeat_in_the_text_is_named),
-      cmocka_unit_test(repeat_among_many_members_is_found),
-      cmocka_unit_test(distinct_names_differing_late_are_accepted),
-      cmocka_unit_test(packed_arrays_read_exact_values),
-      cmocka_unit_test(bad_control_points_are_named_as_before),
-      cmocka_unit_test(packed_elements_where_items_belong_are_named),
-      cmocka_unit_test(matches_are_read_from_packed_pairs),
-      cmocka_unit_test(number_dense_bodies_take_at_most_4x),
-      cmocka_unit_test(string_dense_body_takes_about_its_size),
-      cmocka_unit_test(costly_bodies_are_413_before_any_tree),
-      cmocka_unit_test(refusal_says_why),
-  };
-  return cmocka_run_group_tests(tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(duplicate_top_level_member_is_400_naming_it),
+    cmocka_unit_test(duplicate_nested_member_is_400_naming_its_object),
+    cmocka_unit_test(duplicate_in_an_array_element_names_the_element),
+    cmocka_unit_test(escaped_spelling_of_a_name_is_the_same_member),
+    cmocka_unit_test(first_repeat_in_the_text_is_named),
+    cmocka_unit_test(repeat_among_many_members_is_found),
+    cmocka_unit_test(distinct_names_differing_late_are_accepted),
+    cmocka_unit_test(packed_arrays_read_exact_values),
+    cmocka_unit_test(bad_control_points_are_named_as_before),
+    cmocka_unit_test(packed_elements_where_items_belong_are_named),
+    cmocka_unit_test(matches_are_read_from_packed_pairs),
+    cmocka_unit_test(number_dense_bodies_take_at_most_4x),
+    cmocka_unit_test(string_dense_body_takes_about_its_size),
+    cmocka_unit_test(costly_bodies_are_413_before_any_tree),
+    cmocka_unit_test(refusal_says_why),
+};
+
+TM_SUITE("json_parse", tests, NULL, NULL);

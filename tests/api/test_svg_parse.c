@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "svg_testutil.h"
+#include "testmain.h"
 
 typedef struct pair {
   const char *what, *d, *abs;
@@ -376,17 +377,16 @@ static void closing_after_relative_round_trip_adds_no_sliver(void **state) {
   km_curve_free(&c);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(real_icon_and_glyph_paths_equal_their_absolute_forms),
-      cmocka_unit_test(every_grammar_corner_equals_its_explicit_form),
-      cmocka_unit_test(real_paths_have_the_expected_pieces),
-      cmocka_unit_test(shapes_fixture_paths_match_their_bsplines),
-      cmocka_unit_test(circle_from_two_arc_commands_has_curvature_one_over_r),
-      cmocka_unit_test(arc_with_too_small_radii_is_scaled_up),
-      cmocka_unit_test(bad_path_data_is_refused_with_the_offset),
-      cmocka_unit_test(error_messages_are_bounded),
-      cmocka_unit_test(closing_after_relative_round_trip_adds_no_sliver),
-  };
-  return cmocka_run_group_tests(tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(real_icon_and_glyph_paths_equal_their_absolute_forms),
+    cmocka_unit_test(every_grammar_corner_equals_its_explicit_form),
+    cmocka_unit_test(real_paths_have_the_expected_pieces),
+    cmocka_unit_test(shapes_fixture_paths_match_their_bsplines),
+    cmocka_unit_test(circle_from_two_arc_commands_has_curvature_one_over_r),
+    cmocka_unit_test(arc_with_too_small_radii_is_scaled_up),
+    cmocka_unit_test(bad_path_data_is_refused_with_the_offset),
+    cmocka_unit_test(error_messages_are_bounded),
+    cmocka_unit_test(closing_after_relative_round_trip_adds_no_sliver),
+};
+
+TM_SUITE("svg_parse", tests, NULL, NULL);

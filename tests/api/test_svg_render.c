@@ -15,6 +15,7 @@
 
 #include "km/signature.h"
 #include "svg_testutil.h"
+#include "testmain.h"
 
 /* PNG decoder (zlib + the five row filters) printing "width height dark
  * red" with dark = pixels whose darkest channel is below 200 and red =
@@ -511,17 +512,16 @@ static void no_frames_still_give_a_document(void **state) {
   free(doc);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(every_layout_is_well_formed_and_renders),
-      cmocka_unit_test(
-          curvature_plot_without_signatures_and_single_frames_render),
-      cmocka_unit_test(size_stroke_and_colour_options_are_honoured),
-      cmocka_unit_test(hostile_option_strings_keep_the_document_well_formed),
-      cmocka_unit_test(animation_frames_share_one_command_structure),
-      cmocka_unit_test(filmstrip_labels_every_frame_with_its_t),
-      cmocka_unit_test(curvature_plot_shows_kappa_and_corners),
-      cmocka_unit_test(no_frames_still_give_a_document),
-  };
-  return cmocka_run_group_tests(tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(every_layout_is_well_formed_and_renders),
+    cmocka_unit_test(
+        curvature_plot_without_signatures_and_single_frames_render),
+    cmocka_unit_test(size_stroke_and_colour_options_are_honoured),
+    cmocka_unit_test(hostile_option_strings_keep_the_document_well_formed),
+    cmocka_unit_test(animation_frames_share_one_command_structure),
+    cmocka_unit_test(filmstrip_labels_every_frame_with_its_t),
+    cmocka_unit_test(curvature_plot_shows_kappa_and_corners),
+    cmocka_unit_test(no_frames_still_give_a_document),
+};
+
+TM_SUITE("svg_render", tests, NULL, NULL);

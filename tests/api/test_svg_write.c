@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "svg_testutil.h"
+#include "testmain.h"
 
 /* Command letters of d in order, and the count of numbers. */
 static void structure(const char *d, char *cmds, size_t cap, size_t *nums) {
@@ -288,16 +289,15 @@ static void numbers_are_compact_and_within_budget(void **state) {
   free(s);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(polynomial_cubic_exports_exactly),
-      cmocka_unit_test(output_is_one_moveto_and_cubics),
-      cmocka_unit_test(rational_circle_exports_within_the_stated_bound),
-      cmocka_unit_test(quintic_exports_within_the_stated_bound),
-      cmocka_unit_test(parse_export_parse_keeps_the_trace),
-      cmocka_unit_test(fixed_pieces_are_uniform_in_arc_length),
-      cmocka_unit_test(fixed_pieces_give_one_structure_for_different_shapes),
-      cmocka_unit_test(numbers_are_compact_and_within_budget),
-  };
-  return cmocka_run_group_tests(tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(polynomial_cubic_exports_exactly),
+    cmocka_unit_test(output_is_one_moveto_and_cubics),
+    cmocka_unit_test(rational_circle_exports_within_the_stated_bound),
+    cmocka_unit_test(quintic_exports_within_the_stated_bound),
+    cmocka_unit_test(parse_export_parse_keeps_the_trace),
+    cmocka_unit_test(fixed_pieces_are_uniform_in_arc_length),
+    cmocka_unit_test(fixed_pieces_give_one_structure_for_different_shapes),
+    cmocka_unit_test(numbers_are_compact_and_within_budget),
+};
+
+TM_SUITE("svg_write", tests, NULL, NULL);

@@ -12,6 +12,7 @@
 #include "km/curve.h"
 #include "curvecases.h"
 #include "testutil.h"
+#include "testmain.h"
 
 /* Build a curve that must be valid. */
 static void make_curve(km_curve *c, int p, size_t n, const double *knots,
@@ -487,24 +488,23 @@ static void hairpin_length_counts_its_tip(void **state) {
   }
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(eval_bezier_t_t2_t3_is_exact),
-      cmocka_unit_test(eval_polynomial_on_nonuniform_knots_matches_closed_form),
-      cmocka_unit_test(eval_cubic_written_in_degree_five_and_nine_is_exact),
-      cmocka_unit_test(eval_rational_with_equal_weights_equals_polynomial),
-      cmocka_unit_test(eval_rational_quadratic_matches_quotient_rule),
-      cmocka_unit_test(
-          eval_nurbs_circle_has_radius_orthogonal_tangent_and_curvature),
-      cmocka_unit_test(eval_side_gives_one_sided_limits_at_c0_knot),
-      cmocka_unit_test(length_of_line_with_uneven_speed_is_the_distance),
-      cmocka_unit_test(length_of_nurbs_circle_is_two_pi_r),
-      cmocka_unit_test(length_of_parabola_matches_asinh_closed_form),
-      cmocka_unit_test(param_at_length_clamps_to_the_ends),
-      cmocka_unit_test(length_of_a_point_curve_is_zero),
-      cmocka_unit_test(
-          rational_segment_leaving_a_degenerate_leg_has_its_length),
-      cmocka_unit_test(hairpin_length_counts_its_tip),
-  };
-  return cmocka_run_group_tests_name("curve_eval", tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(eval_bezier_t_t2_t3_is_exact),
+    cmocka_unit_test(eval_polynomial_on_nonuniform_knots_matches_closed_form),
+    cmocka_unit_test(eval_cubic_written_in_degree_five_and_nine_is_exact),
+    cmocka_unit_test(eval_rational_with_equal_weights_equals_polynomial),
+    cmocka_unit_test(eval_rational_quadratic_matches_quotient_rule),
+    cmocka_unit_test(
+        eval_nurbs_circle_has_radius_orthogonal_tangent_and_curvature),
+    cmocka_unit_test(eval_side_gives_one_sided_limits_at_c0_knot),
+    cmocka_unit_test(length_of_line_with_uneven_speed_is_the_distance),
+    cmocka_unit_test(length_of_nurbs_circle_is_two_pi_r),
+    cmocka_unit_test(length_of_parabola_matches_asinh_closed_form),
+    cmocka_unit_test(param_at_length_clamps_to_the_ends),
+    cmocka_unit_test(length_of_a_point_curve_is_zero),
+    cmocka_unit_test(
+        rational_segment_leaving_a_degenerate_leg_has_its_length),
+    cmocka_unit_test(hairpin_length_counts_its_tip),
+};
+
+TM_SUITE("curve_eval", tests, NULL, NULL);

@@ -13,6 +13,7 @@
 
 #include "km/curve.h"
 #include "km/limits.h"
+#include "testmain.h"
 
 #define CX 1.0
 #define CY -1.0
@@ -460,25 +461,24 @@ static void transform_moves_circle_rigidly(void **state) {
   km_curve_free(&c);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(insert_knot_keeps_circle_on_circle),
-      cmocka_unit_test(insert_knot_keeps_polynomial),
-      cmocka_unit_test(insert_knot_keeps_random_nurbs),
-      cmocka_unit_test(insert_knot_rejects_bad_input_and_leaves_out_alone),
-      cmocka_unit_test(split_pieces_concatenate_to_the_whole),
-      cmocka_unit_test(split_polynomial_pieces_stay_the_polynomial),
-      cmocka_unit_test(reverse_traces_the_same_points_backwards),
-      cmocka_unit_test(to_bezier_has_full_interior_multiplicity),
-      cmocka_unit_test(elevate_polynomial_stays_the_polynomial),
-      cmocka_unit_test(elevate_circle_stays_on_circle),
-      cmocka_unit_test(elevate_random_nurbs_keeps_trace),
-      cmocka_unit_test(elevate_refuses_degree_beyond_limit),
-      cmocka_unit_test(make_compatible_gives_same_degree_and_knots),
-      cmocka_unit_test(make_compatible_of_two_random_nurbs),
-      cmocka_unit_test(make_compatible_merges_knots_equal_up_to_rounding),
-      cmocka_unit_test(reparam_maps_domain_linearly),
-      cmocka_unit_test(transform_moves_circle_rigidly),
-  };
-  return cmocka_run_group_tests(tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(insert_knot_keeps_circle_on_circle),
+    cmocka_unit_test(insert_knot_keeps_polynomial),
+    cmocka_unit_test(insert_knot_keeps_random_nurbs),
+    cmocka_unit_test(insert_knot_rejects_bad_input_and_leaves_out_alone),
+    cmocka_unit_test(split_pieces_concatenate_to_the_whole),
+    cmocka_unit_test(split_polynomial_pieces_stay_the_polynomial),
+    cmocka_unit_test(reverse_traces_the_same_points_backwards),
+    cmocka_unit_test(to_bezier_has_full_interior_multiplicity),
+    cmocka_unit_test(elevate_polynomial_stays_the_polynomial),
+    cmocka_unit_test(elevate_circle_stays_on_circle),
+    cmocka_unit_test(elevate_random_nurbs_keeps_trace),
+    cmocka_unit_test(elevate_refuses_degree_beyond_limit),
+    cmocka_unit_test(make_compatible_gives_same_degree_and_knots),
+    cmocka_unit_test(make_compatible_of_two_random_nurbs),
+    cmocka_unit_test(make_compatible_merges_knots_equal_up_to_rounding),
+    cmocka_unit_test(reparam_maps_domain_linearly),
+    cmocka_unit_test(transform_moves_circle_rigidly),
+};
+
+TM_SUITE("curve_ops", tests, NULL, NULL);

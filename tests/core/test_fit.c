@@ -10,6 +10,7 @@
 #include <cmocka.h>
 
 #include "km/curve.h"
+#include "testmain.h"
 
 /* distance from p to the curve: best of a dense sampling, then refined by
  * golden-section search around it */
@@ -146,12 +147,11 @@ static void closed_points_are_fitted_with_a_smooth_seam(void **state) {
   free(p);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(dense_smooth_samples_need_few_control_points),
-      cmocka_unit_test(points_on_a_cubic_need_a_small_fraction_of_the_points),
-      cmocka_unit_test(noisy_points_are_interpolated),
-      cmocka_unit_test(closed_points_are_fitted_with_a_smooth_seam),
-  };
-  return cmocka_run_group_tests_name("fit", tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(dense_smooth_samples_need_few_control_points),
+    cmocka_unit_test(points_on_a_cubic_need_a_small_fraction_of_the_points),
+    cmocka_unit_test(noisy_points_are_interpolated),
+    cmocka_unit_test(closed_points_are_fitted_with_a_smooth_seam),
+};
+
+TM_SUITE("fit", tests, NULL, NULL);

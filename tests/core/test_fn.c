@@ -10,6 +10,7 @@
 #include "km/fn.h"
 #include "km/limits.h"
 #include "testutil.h"
+#include "testmain.h"
 
 static void make_fn(km_fn *f, int p, size_t n, const double *knots,
                     const double *coef) {
@@ -348,17 +349,16 @@ static void fn_create_rejects_bad_input(void **state) {
   assert_null(f.knots);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(fn_eval_matches_polynomial_and_its_derivatives),
-      cmocka_unit_test(fn_constant_is_constant_on_its_domain),
-      cmocka_unit_test(antiderivative_is_exact_for_a_polynomial_spline),
-      cmocka_unit_test(antiderivative_stays_continuous_across_a_jump),
-      cmocka_unit_test(blend_equals_pointwise_formula_on_different_knots),
-      cmocka_unit_test(max_abs_and_bound_agree_with_known_maximum),
-      cmocka_unit_test(abs_bound_covers_dense_samples_of_random_splines),
-      cmocka_unit_test(integral_sq_is_exact_for_polynomials),
-      cmocka_unit_test(fn_create_rejects_bad_input),
-  };
-  return cmocka_run_group_tests_name("fn", tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(fn_eval_matches_polynomial_and_its_derivatives),
+    cmocka_unit_test(fn_constant_is_constant_on_its_domain),
+    cmocka_unit_test(antiderivative_is_exact_for_a_polynomial_spline),
+    cmocka_unit_test(antiderivative_stays_continuous_across_a_jump),
+    cmocka_unit_test(blend_equals_pointwise_formula_on_different_knots),
+    cmocka_unit_test(max_abs_and_bound_agree_with_known_maximum),
+    cmocka_unit_test(abs_bound_covers_dense_samples_of_random_splines),
+    cmocka_unit_test(integral_sq_is_exact_for_polynomials),
+    cmocka_unit_test(fn_create_rejects_bad_input),
+};
+
+TM_SUITE("fn", tests, NULL, NULL);

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "km/curve.h"
+#include "testmain.h"
 
 /* Chord-length parameters of pts (closed adds the closing chord), written
  * here from the definition so the test does not trust the code. */
@@ -314,19 +315,18 @@ static void open_arc_samples_converge_like_h4(void **state) {
   }
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(open_interpolant_passes_through_every_point),
-      cmocka_unit_test(open_interpolant_is_not_a_knot),
-      cmocka_unit_test(collinear_points_give_a_uniform_speed_line),
-      cmocka_unit_test(two_points_give_a_straight_segment),
-      cmocka_unit_test(three_points_give_a_parabola_through_them),
-      cmocka_unit_test(duplicates_are_dropped),
-      cmocka_unit_test(too_few_distinct_points_are_degenerate),
-      cmocka_unit_test(
-          closed_interpolant_passes_through_points_and_is_c2_at_seam),
-      cmocka_unit_test(closed_circle_samples_converge_like_h4),
-      cmocka_unit_test(open_arc_samples_converge_like_h4),
-  };
-  return cmocka_run_group_tests(tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(open_interpolant_passes_through_every_point),
+    cmocka_unit_test(open_interpolant_is_not_a_knot),
+    cmocka_unit_test(collinear_points_give_a_uniform_speed_line),
+    cmocka_unit_test(two_points_give_a_straight_segment),
+    cmocka_unit_test(three_points_give_a_parabola_through_them),
+    cmocka_unit_test(duplicates_are_dropped),
+    cmocka_unit_test(too_few_distinct_points_are_degenerate),
+    cmocka_unit_test(
+        closed_interpolant_passes_through_points_and_is_c2_at_seam),
+    cmocka_unit_test(closed_circle_samples_converge_like_h4),
+    cmocka_unit_test(open_arc_samples_converge_like_h4),
+};
+
+TM_SUITE("interp", tests, NULL, NULL);

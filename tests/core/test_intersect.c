@@ -14,6 +14,7 @@
 
 #include "km/curve.h"
 #include "km/morph.h"
+#include "testmain.h"
 
 static km_curve make(int degree, size_t n, const double *knots,
                      const double *cp, const double *w, bool closed) {
@@ -251,20 +252,19 @@ static void invalid_curve_gives_minus_one(void **state) {
   assert_int_equal(km_curve_self_intersections(&empty, 1e-9), -1);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(loop_cubic_bezier_crosses_once),
-      cmocka_unit_test(loop_is_found_after_exact_operations),
-      cmocka_unit_test(figure_eight_crosses_once),
-      cmocka_unit_test(circles_do_not_cross_themselves),
-      cmocka_unit_test(tangential_touch_is_not_a_crossing),
-      cmocka_unit_test(curve_crossing_itself_twice),
-      cmocka_unit_test(polygons_count_like_by_hand),
-      cmocka_unit_test(star_polygons_cross_p_times_q_minus_one),
-      cmocka_unit_test(crossing_at_a_piece_boundary_counts_once),
-      cmocka_unit_test(crossing_at_the_seam_counts_once),
-      cmocka_unit_test(count_is_invariant_under_rigid_motion),
-      cmocka_unit_test(invalid_curve_gives_minus_one),
-  };
-  return cmocka_run_group_tests(tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(loop_cubic_bezier_crosses_once),
+    cmocka_unit_test(loop_is_found_after_exact_operations),
+    cmocka_unit_test(figure_eight_crosses_once),
+    cmocka_unit_test(circles_do_not_cross_themselves),
+    cmocka_unit_test(tangential_touch_is_not_a_crossing),
+    cmocka_unit_test(curve_crossing_itself_twice),
+    cmocka_unit_test(polygons_count_like_by_hand),
+    cmocka_unit_test(star_polygons_cross_p_times_q_minus_one),
+    cmocka_unit_test(crossing_at_a_piece_boundary_counts_once),
+    cmocka_unit_test(crossing_at_the_seam_counts_once),
+    cmocka_unit_test(count_is_invariant_under_rigid_motion),
+    cmocka_unit_test(invalid_curve_gives_minus_one),
+};
+
+TM_SUITE("intersect", tests, NULL, NULL);

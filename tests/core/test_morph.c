@@ -23,6 +23,7 @@
 #include "curvedist.h"
 #include "testutil.h"
 #include "morphutil.h"
+#include "testmain.h"
 
 /* ---- building inputs ---------------------------------------------------- */
 
@@ -1236,33 +1237,32 @@ static void times_outside_the_unit_interval_are_rejected(void **state) {
   km_signature_free(&sb);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(spiral_curvature_frames_never_exceed_the_inputs_curvature),
-      cmocka_unit_test(frames_hold_to_a_number_of_points),
-      cmocka_unit_test(spiral_linear_baseline_exceeds_the_inputs_curvature),
-      cmocka_unit_test(spiral_end_frames_are_the_exact_spirals),
-      cmocka_unit_test(planned_spiral_frames_are_the_exact_blended_spirals),
-      cmocka_unit_test(curvature_bound_holds_for_random_pairs_and_matches),
-      cmocka_unit_test(curvature_bound_holds_for_curve_inputs),
-      cmocka_unit_test(every_frame_has_the_interpolated_length),
-      cmocka_unit_test(end_frames_of_random_pairs_are_the_inputs_where_they_stand),
-      cmocka_unit_test(end_frames_of_curve_inputs_trace_the_inputs),
-      cmocka_unit_test(matched_segments_join_with_g2_under_the_paper_blend),
-      cmocka_unit_test(matched_segments_join_with_g2_under_the_turning_blend),
-      cmocka_unit_test(matched_arcs_have_continuous_curvature),
-      cmocka_unit_test(proportional_matches_give_the_global_morph),
-      cmocka_unit_test(matches_used_reports_the_given_pairs),
-      cmocka_unit_test(auto_matches_are_a_valid_correspondence),
-      cmocka_unit_test(anchor_start_moves_the_start_point_on_a_straight_line),
-      cmocka_unit_test(anchor_centroid_moves_the_centroid_on_a_straight_line),
-      cmocka_unit_test(anchor_fit_keeps_the_end_frames_where_the_inputs_stand),
-      cmocka_unit_test(different_turning_numbers_are_rejected_naming_both),
-      cmocka_unit_test(opposite_orientations_are_matched_unless_kept),
-      cmocka_unit_test(open_and_closed_inputs_are_rejected),
-      cmocka_unit_test(invalid_matches_are_rejected_with_their_index),
-      cmocka_unit_test(a_cusp_in_an_input_is_rejected),
-      cmocka_unit_test(times_outside_the_unit_interval_are_rejected),
-  };
-  return cmocka_run_group_tests(tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(spiral_curvature_frames_never_exceed_the_inputs_curvature),
+    cmocka_unit_test(frames_hold_to_a_number_of_points),
+    cmocka_unit_test(spiral_linear_baseline_exceeds_the_inputs_curvature),
+    cmocka_unit_test(spiral_end_frames_are_the_exact_spirals),
+    cmocka_unit_test(planned_spiral_frames_are_the_exact_blended_spirals),
+    cmocka_unit_test(curvature_bound_holds_for_random_pairs_and_matches),
+    cmocka_unit_test(curvature_bound_holds_for_curve_inputs),
+    cmocka_unit_test(every_frame_has_the_interpolated_length),
+    cmocka_unit_test(end_frames_of_random_pairs_are_the_inputs_where_they_stand),
+    cmocka_unit_test(end_frames_of_curve_inputs_trace_the_inputs),
+    cmocka_unit_test(matched_segments_join_with_g2_under_the_paper_blend),
+    cmocka_unit_test(matched_segments_join_with_g2_under_the_turning_blend),
+    cmocka_unit_test(matched_arcs_have_continuous_curvature),
+    cmocka_unit_test(proportional_matches_give_the_global_morph),
+    cmocka_unit_test(matches_used_reports_the_given_pairs),
+    cmocka_unit_test(auto_matches_are_a_valid_correspondence),
+    cmocka_unit_test(anchor_start_moves_the_start_point_on_a_straight_line),
+    cmocka_unit_test(anchor_centroid_moves_the_centroid_on_a_straight_line),
+    cmocka_unit_test(anchor_fit_keeps_the_end_frames_where_the_inputs_stand),
+    cmocka_unit_test(different_turning_numbers_are_rejected_naming_both),
+    cmocka_unit_test(opposite_orientations_are_matched_unless_kept),
+    cmocka_unit_test(open_and_closed_inputs_are_rejected),
+    cmocka_unit_test(invalid_matches_are_rejected_with_their_index),
+    cmocka_unit_test(a_cusp_in_an_input_is_rejected),
+    cmocka_unit_test(times_outside_the_unit_interval_are_rejected),
+};
+
+TM_SUITE("morph", tests, NULL, NULL);

@@ -24,6 +24,7 @@
 #include "curvedist.h"
 #include "testutil.h"
 #include "morphutil.h"
+#include "testmain.h"
 
 /* ---- inputs ------------------------------------------------------------- */
 
@@ -1274,30 +1275,29 @@ static void a_curve_looping_twice_is_rejected_against_a_circle(void **state) {
   km_curve_free(&e);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(circle_to_ellipse_frames_close),
-      cmocka_unit_test(rounded_square_to_star_frames_close),
-      cmocka_unit_test(paper_closures_keep_their_seam_promise),
-      cmocka_unit_test(circles_of_radius_one_and_two_morph_through_circles),
-      cmocka_unit_test(paper_blend_on_circles_shows_the_turning_defect),
-      cmocka_unit_test(matched_corners_blend_as_turning_jumps),
-      cmocka_unit_test(square_corners_fade_into_a_smooth_star),
-      cmocka_unit_test(polygons_morph_through_polygons),
-      cmocka_unit_test(closed_frames_respect_the_curvature_bound),
-      cmocka_unit_test(distorting_match_closes_within_the_curvature_bound),
-      cmocka_unit_test(proportional_matches_on_a_closed_pair_give_the_global_morph),
-      cmocka_unit_test(fixture_pairs_end_frames_length_and_closure),
-      cmocka_unit_test(fixture_pairs_with_auto_matches_degree_5_and_linear),
-      cmocka_unit_test(fixture_pairs_default_frames_do_not_self_intersect),
-      cmocka_unit_test(planned_frames_of_circles_are_circles),
-      cmocka_unit_test(planned_default_frames_of_the_fixture_pairs),
-      cmocka_unit_test(planned_and_reconstructed_frames_agree),
-      cmocka_unit_test(congruent_shapes_morph_through_congruent_frames),
-      cmocka_unit_test(frames_move_smoothly_through_the_middle),
-      cmocka_unit_test(reversed_copy_morphs_through_the_shape_itself),
-      cmocka_unit_test(sharp_tips_are_not_counted_as_crossings),
-      cmocka_unit_test(a_curve_looping_twice_is_rejected_against_a_circle),
-  };
-  return cmocka_run_group_tests(tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(circle_to_ellipse_frames_close),
+    cmocka_unit_test(rounded_square_to_star_frames_close),
+    cmocka_unit_test(paper_closures_keep_their_seam_promise),
+    cmocka_unit_test(circles_of_radius_one_and_two_morph_through_circles),
+    cmocka_unit_test(paper_blend_on_circles_shows_the_turning_defect),
+    cmocka_unit_test(matched_corners_blend_as_turning_jumps),
+    cmocka_unit_test(square_corners_fade_into_a_smooth_star),
+    cmocka_unit_test(polygons_morph_through_polygons),
+    cmocka_unit_test(closed_frames_respect_the_curvature_bound),
+    cmocka_unit_test(distorting_match_closes_within_the_curvature_bound),
+    cmocka_unit_test(proportional_matches_on_a_closed_pair_give_the_global_morph),
+    cmocka_unit_test(fixture_pairs_end_frames_length_and_closure),
+    cmocka_unit_test(fixture_pairs_with_auto_matches_degree_5_and_linear),
+    cmocka_unit_test(fixture_pairs_default_frames_do_not_self_intersect),
+    cmocka_unit_test(planned_frames_of_circles_are_circles),
+    cmocka_unit_test(planned_default_frames_of_the_fixture_pairs),
+    cmocka_unit_test(planned_and_reconstructed_frames_agree),
+    cmocka_unit_test(congruent_shapes_morph_through_congruent_frames),
+    cmocka_unit_test(frames_move_smoothly_through_the_middle),
+    cmocka_unit_test(reversed_copy_morphs_through_the_shape_itself),
+    cmocka_unit_test(sharp_tips_are_not_counted_as_crossings),
+    cmocka_unit_test(a_curve_looping_twice_is_rejected_against_a_circle),
+};
+
+TM_SUITE("morph_closed", tests, NULL, NULL);

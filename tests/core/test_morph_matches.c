@@ -25,6 +25,7 @@
 #include "km/signature.h"
 #include "testutil.h"
 #include "morphutil.h"
+#include "testmain.h"
 
 #define ONE_MINUS 0.99999999999999989 /* 1 - 2^-53, the largest double below 1 */
 
@@ -291,11 +292,10 @@ static void the_match_from_the_start_to_the_end_is_continuous(void **state) {
   }
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(proportional_matches_next_to_the_ends_keep_the_circle),
-      cmocka_unit_test(uneven_matches_next_to_the_ends_tend_to_the_circle),
-      cmocka_unit_test(the_match_from_the_start_to_the_end_is_continuous),
-  };
-  return cmocka_run_group_tests(tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(proportional_matches_next_to_the_ends_keep_the_circle),
+    cmocka_unit_test(uneven_matches_next_to_the_ends_tend_to_the_circle),
+    cmocka_unit_test(the_match_from_the_start_to_the_end_is_continuous),
+};
+
+TM_SUITE("morph_matches", tests, NULL, NULL);

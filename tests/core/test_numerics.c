@@ -16,6 +16,7 @@
 #include "../../core/src/morph_plan.h"
 #include "km/curve.h"
 #include "testutil.h"
+#include "testmain.h"
 
 #define PI 3.14159265358979323846
 
@@ -340,18 +341,17 @@ static void derivative_of_pieces_is_exact(void **state) {
   km__pp_free(&d);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(cheb_cumulative_integrates_monomials_exactly),
-      cmocka_unit_test(cheb_cumulative_of_exp_is_spectrally_accurate),
-      cmocka_unit_test(bern_eval_is_within_its_rounding_bound),
-      cmocka_unit_test(bezier_span_evaluation_agrees_with_de_boor),
-      cmocka_unit_test(sincos_agrees_with_libm),
-      cmocka_unit_test(weighted_closure_metric_is_the_gram_matrix),
-      cmocka_unit_test(merge_of_one_polynomial_is_one_piece),
-      cmocka_unit_test(merge_stays_within_delta_across_a_kink),
-      cmocka_unit_test(merge_never_crosses_a_jump),
-      cmocka_unit_test(derivative_of_pieces_is_exact),
-  };
-  return cmocka_run_group_tests_name("numerics", tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(cheb_cumulative_integrates_monomials_exactly),
+    cmocka_unit_test(cheb_cumulative_of_exp_is_spectrally_accurate),
+    cmocka_unit_test(bern_eval_is_within_its_rounding_bound),
+    cmocka_unit_test(bezier_span_evaluation_agrees_with_de_boor),
+    cmocka_unit_test(sincos_agrees_with_libm),
+    cmocka_unit_test(weighted_closure_metric_is_the_gram_matrix),
+    cmocka_unit_test(merge_of_one_polynomial_is_one_piece),
+    cmocka_unit_test(merge_stays_within_delta_across_a_kink),
+    cmocka_unit_test(merge_never_crosses_a_jump),
+    cmocka_unit_test(derivative_of_pieces_is_exact),
+};
+
+TM_SUITE("numerics", tests, NULL, NULL);

@@ -13,6 +13,7 @@
 #include "km/curve.h"
 #include "km/path.h"
 #include "testutil.h"
+#include "testmain.h"
 
 /* Point of the Bezier with control points p (degree d) at u. */
 static void bezier(const double p[][2], int d, double u, double out[2]) {
@@ -417,20 +418,19 @@ static void bad_coordinates_and_misuse_are_refused(void **state) {
   km_path_free(NULL);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(line_path_is_a_degree_one_polyline),
-      cmocka_unit_test(mixed_pieces_are_raised_to_cubic_exactly),
-      cmocka_unit_test(quarter_arc_is_one_exact_rational_piece),
-      cmocka_unit_test(two_half_arcs_make_a_circle_of_curvature_one_over_r),
-      cmocka_unit_test(too_small_radii_are_scaled_up),
-      cmocka_unit_test(rotated_elliptical_arc_lies_on_its_ellipse),
-      cmocka_unit_test(arc_flags_choose_length_and_turning_direction),
-      cmocka_unit_test(zero_radius_arc_is_a_straight_line),
-      cmocka_unit_test(point_pieces_are_dropped_but_degenerate_legs_kept),
-      cmocka_unit_test(pieces_within_eps_are_dropped_and_the_path_stays_joined),
-      cmocka_unit_test(close_joins_the_end_to_the_start),
-      cmocka_unit_test(bad_coordinates_and_misuse_are_refused),
-  };
-  return cmocka_run_group_tests(tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(line_path_is_a_degree_one_polyline),
+    cmocka_unit_test(mixed_pieces_are_raised_to_cubic_exactly),
+    cmocka_unit_test(quarter_arc_is_one_exact_rational_piece),
+    cmocka_unit_test(two_half_arcs_make_a_circle_of_curvature_one_over_r),
+    cmocka_unit_test(too_small_radii_are_scaled_up),
+    cmocka_unit_test(rotated_elliptical_arc_lies_on_its_ellipse),
+    cmocka_unit_test(arc_flags_choose_length_and_turning_direction),
+    cmocka_unit_test(zero_radius_arc_is_a_straight_line),
+    cmocka_unit_test(point_pieces_are_dropped_but_degenerate_legs_kept),
+    cmocka_unit_test(pieces_within_eps_are_dropped_and_the_path_stays_joined),
+    cmocka_unit_test(close_joins_the_end_to_the_start),
+    cmocka_unit_test(bad_coordinates_and_misuse_are_refused),
+};
+
+TM_SUITE("path", tests, NULL, NULL);

@@ -18,6 +18,7 @@
 #include "km/reconstruct.h"
 #include "km/signature.h"
 #include "testutil.h"
+#include "testmain.h"
 
 static void make_curve(km_curve *c, int p, size_t n, const double *knots,
                        const double *cp, const double *w, bool closed) {
@@ -611,21 +612,20 @@ static void reconstruction_holds_to_a_number_of_points(void **state) {
   km_signature_free(&sig);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(unit_circle_is_reconstructed_within_each_tolerance),
-      cmocka_unit_test(cornu_spirals_are_reconstructed_within_tolerance),
-      cmocka_unit_test(
-          error_bound_covers_the_true_error_with_a_corner_and_a_jump),
-      cmocka_unit_test(random_regular_curves_survive_a_round_trip),
-      cmocka_unit_test(rounded_rectangle_survives_a_round_trip),
-      cmocka_unit_test(letter_outline_with_corners_survives_a_round_trip),
-      cmocka_unit_test(fixture_outlines_survive_a_round_trip),
-      cmocka_unit_test(repeated_control_point_survives_a_round_trip),
-      cmocka_unit_test(reconstruct_rejects_other_degrees),
-      cmocka_unit_test(reconstruction_that_turns_without_end_is_refused),
-      cmocka_unit_test(reconstruction_holds_to_a_number_of_points),
-      cmocka_unit_test(corner_one_ulp_before_a_curvature_break_keeps_its_turn),
-  };
-  return cmocka_run_group_tests_name("reconstruct", tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(unit_circle_is_reconstructed_within_each_tolerance),
+    cmocka_unit_test(cornu_spirals_are_reconstructed_within_tolerance),
+    cmocka_unit_test(
+        error_bound_covers_the_true_error_with_a_corner_and_a_jump),
+    cmocka_unit_test(random_regular_curves_survive_a_round_trip),
+    cmocka_unit_test(rounded_rectangle_survives_a_round_trip),
+    cmocka_unit_test(letter_outline_with_corners_survives_a_round_trip),
+    cmocka_unit_test(fixture_outlines_survive_a_round_trip),
+    cmocka_unit_test(repeated_control_point_survives_a_round_trip),
+    cmocka_unit_test(reconstruct_rejects_other_degrees),
+    cmocka_unit_test(reconstruction_that_turns_without_end_is_refused),
+    cmocka_unit_test(reconstruction_holds_to_a_number_of_points),
+    cmocka_unit_test(corner_one_ulp_before_a_curvature_break_keeps_its_turn),
+};
+
+TM_SUITE("reconstruct", tests, NULL, NULL);

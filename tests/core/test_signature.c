@@ -16,6 +16,7 @@
 #include "km/signature.h"
 #include "curvecases.h"
 #include "testutil.h"
+#include "testmain.h"
 
 static void make_curve(km_curve *c, int p, size_t n, const double *knots,
                        const double *cp, const double *w, bool closed) {
@@ -1117,38 +1118,37 @@ static void rational_end_in_a_boundary_layer_keeps_its_turn(void **state) {
   km_curve_free(&c);
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(circle_has_constant_curvature_one_over_r),
-      cmocka_unit_test(clockwise_circle_has_curvature_minus_one_over_r),
-      cmocka_unit_test(square_has_zero_curvature_and_four_right_corners),
-      cmocka_unit_test(polygon_edges_have_exactly_zero_curvature),
-      cmocka_unit_test(turn_below_rounding_at_a_knot_counts_at_tight_tolerance),
-      cmocka_unit_test(clockwise_square_has_four_negative_corners),
-      cmocka_unit_test(
-          cubic_square_and_star_from_fixtures_have_polygon_corners),
-      cmocka_unit_test(straight_line_has_zero_curvature_and_turning),
-      cmocka_unit_test(kappa_breakpoints_include_arc_length_images_of_knots),
-      cmocka_unit_test(knot_insertion_and_elevation_keep_the_signature),
-      cmocka_unit_test(
-          repeated_first_control_point_gives_the_traced_signature),
-      cmocka_unit_test(degenerate_leg_at_a_join_is_smooth_or_a_corner),
-      cmocka_unit_test(rigid_motion_keeps_curvature_and_corners),
-      cmocka_unit_test(cusp_is_refused_with_its_parameter),
-      cmocka_unit_test(zero_length_curve_is_degenerate),
-      cmocka_unit_test(curve_create_rejects_bad_input_naming_the_field),
-      cmocka_unit_test(sharp_turn_close_to_the_end_has_its_exact_length),
-      cmocka_unit_test(
-          high_order_degenerate_ends_take_the_first_distinct_point),
-      cmocka_unit_test(closed_rational_curve_with_a_tiny_span_closes),
-      cmocka_unit_test(curve_far_from_the_origin_keeps_to_its_rounding),
-      cmocka_unit_test(spans_below_their_rounding_are_traced_or_refused),
-      cmocka_unit_test(closed_curve_ending_below_resolution_turns_whole_turns),
-      cmocka_unit_test(
-          rational_span_leaving_a_degenerate_leg_has_its_exact_length),
-      cmocka_unit_test(rational_end_in_a_boundary_layer_keeps_its_turn),
-      cmocka_unit_test(hairpin_whose_tip_is_rounding_turns_only_once),
-      cmocka_unit_test(hairpin_signature_counts_its_tip),
-  };
-  return cmocka_run_group_tests_name("signature", tests, NULL, NULL);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(circle_has_constant_curvature_one_over_r),
+    cmocka_unit_test(clockwise_circle_has_curvature_minus_one_over_r),
+    cmocka_unit_test(square_has_zero_curvature_and_four_right_corners),
+    cmocka_unit_test(polygon_edges_have_exactly_zero_curvature),
+    cmocka_unit_test(turn_below_rounding_at_a_knot_counts_at_tight_tolerance),
+    cmocka_unit_test(clockwise_square_has_four_negative_corners),
+    cmocka_unit_test(
+        cubic_square_and_star_from_fixtures_have_polygon_corners),
+    cmocka_unit_test(straight_line_has_zero_curvature_and_turning),
+    cmocka_unit_test(kappa_breakpoints_include_arc_length_images_of_knots),
+    cmocka_unit_test(knot_insertion_and_elevation_keep_the_signature),
+    cmocka_unit_test(
+        repeated_first_control_point_gives_the_traced_signature),
+    cmocka_unit_test(degenerate_leg_at_a_join_is_smooth_or_a_corner),
+    cmocka_unit_test(rigid_motion_keeps_curvature_and_corners),
+    cmocka_unit_test(cusp_is_refused_with_its_parameter),
+    cmocka_unit_test(zero_length_curve_is_degenerate),
+    cmocka_unit_test(curve_create_rejects_bad_input_naming_the_field),
+    cmocka_unit_test(sharp_turn_close_to_the_end_has_its_exact_length),
+    cmocka_unit_test(
+        high_order_degenerate_ends_take_the_first_distinct_point),
+    cmocka_unit_test(closed_rational_curve_with_a_tiny_span_closes),
+    cmocka_unit_test(curve_far_from_the_origin_keeps_to_its_rounding),
+    cmocka_unit_test(spans_below_their_rounding_are_traced_or_refused),
+    cmocka_unit_test(closed_curve_ending_below_resolution_turns_whole_turns),
+    cmocka_unit_test(
+        rational_span_leaving_a_degenerate_leg_has_its_exact_length),
+    cmocka_unit_test(rational_end_in_a_boundary_layer_keeps_its_turn),
+    cmocka_unit_test(hairpin_whose_tip_is_rounding_turns_only_once),
+    cmocka_unit_test(hairpin_signature_counts_its_tip),
+};
+
+TM_SUITE("signature", tests, NULL, NULL);

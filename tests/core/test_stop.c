@@ -18,6 +18,7 @@
 
 #include "km/kmorph.h"
 #include "km/stop.h"
+#include "testmain.h"
 
 typedef struct countdown {
   long left, asked;
@@ -259,11 +260,10 @@ static void a_flag_set_by_another_thread_stops_promptly(void **state) {
   }
 }
 
-int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(each_entry_point_stops_at_the_first_stop),
-      cmocka_unit_test(long_entry_points_ask),
-      cmocka_unit_test(a_flag_set_by_another_thread_stops_promptly),
-  };
-  return cmocka_run_group_tests(tests, setup, teardown);
-}
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(each_entry_point_stops_at_the_first_stop),
+    cmocka_unit_test(long_entry_points_ask),
+    cmocka_unit_test(a_flag_set_by_another_thread_stops_promptly),
+};
+
+TM_SUITE("stop", tests, setup, teardown);
