@@ -103,6 +103,15 @@ static inline const km_stop *api__km_stop(const api_request *req,
   return buf;
 }
 
+/* A number as api__number prints it, with its comma: %.17g is at most 24
+ * characters (sign, 17 digits, point, "e-308"). */
+#define API_JSON_NUM_BYTES 25
+/* A number of an SVG path as api_svg_path_d prints it (the shorter of its
+ * %e and %f forms, at most 26 characters) with its separator. */
+#define API_SVG_NUM_BYTES 27
+/* Numbers in the SVG path of a curve of n control points of the given
+ * degree, at most; hermite for curvature frames (json_out.c says why). */
+size_t api__path_numbers(size_t n, int degree, bool hermite);
 /* Bytes a curve takes in the JSON answer, at most: n control points of
  * the given degree (weights if rational), plus its "svg_d" when asked. */
 size_t api__curve_json_bytes(size_t n, int degree, bool rational,

@@ -214,3 +214,34 @@ fail:
   cJSON_Delete(o);
   return NULL;
 }
+
+/* ------------------------------------------------- bounds on the bytes */
+
+/* Numbers of cubic pieces' points a curve of n control points puts in a
+ * path. Curvature frames are Hermite splines: a cubic's knots are double
+ * (a span per two control points, three Bezier points a span), a
+ * quintic's at least triple, each span drawn as up to four cubics (halved
+ * until within the tolerance). Other curves (linear frames) have a span
+ * per control point. */
+size_t api__path_numbers(size_t n, int degree, bool hermite) {
+  if (hermite)
+    return (degree <= 3 ? 3 : 8) * n + 2;
+  return (degree <= 3 ? 6 : 24) * n + 2;
+}
+
+size_t api__curve_json_bytes(size_t n, int degree, bool rational,
+                             bool svg_d) {
+  size_t knots = n + (size_t)degree + 1;
+  size_t b = 128 +
+             API_JSON_NUM_BYTES * (knots + 2 * n + (rational ? n : 0)) +
+             3 * n;
+  if (svg_d)
+    b += 16 + API_SVG_NUM_BYTES * api__path_numbers(n, degree, false);
+  return b;
+}
+
+size_t api__signature_json_bytes(const km_signature *sig) {
+  size_t knots = sig->kappa.n + (size_t)sig->kappa.degree + 1;
+  return 256 + (API_JSON_NUM_BYTES + 1) * (knots + sig->kappa.n) +
+         (2 * API_JSON_NUM_BYTES + 16) * sig->ncorners;
+}

@@ -1,0 +1,84 @@
+/* morph_plan.h - the prepared morph behind POST /v1/morph and jobs, shared
+ * by the files that build and use it: morph_request.c reads the request
+ * into it, morph_plan.c plans it and renders its frames, morph_size.c
+ * bounds the size of its answer, morph_result.c assembles the answer.
+ * Internal to the api layer.
+ *
+ * DESIGN: api_handle(API_ROUTE_MORPH) is prepare + result on one thread, so
+ * the synchronous route and asynchronous jobs run exactly the same code.
+ * Each frame has its own slot in the plan; rendering frame i writes slot i
+ * only, which is what makes distinct frames safe to render concurrently.
+ * Errors found while rendering stay in their slot until api_morph_result
+ * reports the first one.
+ */
+#ifndef KMAPI_MORPH_PLAN_H
+#define KMAPI_MORPH_PLAN_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "internal.h"
+#include "svg.h"
+
+/* Bytes of a colour option, its NUL included, at most. */
+#define API_COLOUR_MAX 64
+
+typedef enum api_frame_state {
+  API_FRAME_PENDING, /* not rendered yet */
+  API_FRAME_DONE,    /* curve (and metrics, signature) valid */
+  API_FRAME_FAILED   /* st and err say why; stopped is KM_ECANCELLED */
+} api_frame_state;
+
+typedef struct api_frame_slot {
+  double t;
+  api_frame_state state;
+  km_curve curve;
+  km_frame_metrics metrics;
+  km_signature sig; /* only for curvature plots */
+  km_status st;
+  km_error err;
+} api_frame_slot;
+
+struct api_morph_plan {
+  api_config cfg;
+  char *request_id;
+  api_input from, to;
+  km_morph *morph;
+  km_morph_options opt;
+  double *matches;
+  bool times_given;
+  size_t nframes;
+  api_frame_slot *frames;
+  bool metrics;
+  bool svg;
+  bool want_sig;
+  api_include inc;
+  double tol;
+  api_svg_options svgopt;
+  char stroke[API_COLOUR_MAX], from_color[API_COLOUR_MAX],
+      to_color[API_COLOUR_MAX];
+  size_t predicted; /* upper bound on the result's bytes */
+};
+
+/* "method" names, indexed by km_morph_method. */
+extern const char *const api__morph_method_names[2];
+
+/* Read the morph request in root into pl (zeroed but for cfg): options,
+ * frames or times (at most max_frames), the answer's format (an explicit
+ * "format" wins over the accept header, which may be NULL) and both input
+ * curves, cheap checks first so that a bad option fails before any curve
+ * is fitted. Allocations stay in pl for api_morph_plan_free. False with
+ * the error in ctx. */
+bool api__morph_read_request(api_ctx *ctx, const cJSON *root,
+                             const char *accept, size_t max_frames,
+                             api_morph_plan *pl);
+
+/* Bound the answer of a planned morph (pl->morph built): set
+ * pl->predicted and refuse (422 limit-exceeded) an answer above
+ * pl->cfg.max_output_bytes, naming /tolerance when even the fewest frames
+ * would not fit, else the frames. Polls stop (may be NULL): 503 stopped.
+ * False with the error in ctx. */
+bool api__morph_check_size(api_ctx *ctx, api_morph_plan *pl,
+                           const km_stop *stop);
+
+#endif
