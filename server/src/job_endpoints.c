@@ -1,0 +1,117 @@
+/* job_endpoints.c - GET and DELETE /v1/jobs/{id}, GET /v1/jobs/{id}/result
+ * (see endpoints.h).
+ */
+#include "endpoints.h"
+
+#include <string.h>
+
+#include "reply.h"
+#include "util.h"
+
+/* 404 for a job never known (or deleted), 410 for one that was known and
+ * is no longer kept, with why: a client must not take an expired or
+ * evicted job for a mistyped id, nor resubmit blindly. */
+static enum MHD_Result job_missing(srv_req *r, int rc, const srv_job_view *v)
+{
+  if (rc == SRV_STORE_GONE) {
+    char detail[400];
+    snprintf(detail, sizeof detail, "job %s is no longer kept: %s", r->job_id,
+             v->error);
+    return srv__problem(r, 410, "/problems/job-gone", "Job gone", detail,
+                        NULL, NULL);
+  }
+  return srv__problem(r, 404, "/problems/job-not-found", "Job not found",
+                      "no such job", NULL, NULL);
+}
+
+static enum MHD_Result delete_job(srv_req *r)
+{
+  srv_server *s = r->srv;
+  if (srv_jobs_cancel(s->jobs, r->job_id) == 0)
+    return srv__answer(r, 204, NULL, (char *)"", 0, false);
+  /* Not live: a final job is forgotten; an unknown one is 404. */
+  if (s->store->ops->remove(s->store, r->job_id) == 0)
+    return srv__answer(r, 204, NULL, (char *)"", 0, false);
+  return srv__problem(r, 404, "/problems/job-not-found", "Job not found",
+                      "no such job (finished jobs are forgotten after a "
+                      "while)",
+                      NULL, NULL);
+}
+
+enum MHD_Result srv__serve_job(srv_req *r)
+{
+  srv_server *s = r->srv;
+  srv_job_view v;
+  double now = srv_now();
+  if (strcmp(r->method, "DELETE") == 0)
+    return delete_job(r);
+  int rc = s->store->ops->get(s->store, r->job_id, now, &v);
+  if (rc != SRV_STORE_OK)
+    return job_missing(r, rc, &v);
+  double progress =
+      v.frames_total ? (double)v.frames_done / (double)v.frames_total : 0.0;
+  if (v.state == SRV_JOB_DONE)
+    progress = 1.0;
+  char err[600] = "";
+  if (v.state == SRV_JOB_FAILED) {
+    char esc[520];
+    srv_json_escape(esc, sizeof esc, v.error);
+    snprintf(err, sizeof err, ",\"error\":{\"status\":%d,\"detail\":\"%s\"}",
+             v.error_status, esc);
+  }
+  return srv__answer_json(
+      r, 200,
+      "{\"id\":\"%s\",\"state\":\"%s\",\"progress\":%.6g,"
+      "\"frames_done\":%zu,\"frames_total\":%zu,\"age_seconds\":%.3f,"
+      "\"links\":{\"self\":\"/v1/jobs/%s\",\"result\":\"/v1/jobs/%s/result\"}"
+      "%s}",
+      v.id, srv_job_state_name(v.state), progress, v.frames_done,
+      v.frames_total, v.age, v.id, v.id, err);
+}
+
+static void drop_result_ref(void *cls) { srv_result_unref(cls); }
+
+/* A job's result, sent from the store's own copy: the answer holds a
+ * reference until libmicrohttpd has sent it, so a slow reader costs no
+ * memory of its own and an eviction meanwhile frees nothing under it. */
+static enum MHD_Result answer_result(srv_req *r, srv_result *res)
+{
+  size_t len = srv_result_length(res);
+  struct MHD_Response *resp =
+      MHD_create_response_from_buffer_with_free_callback_cls(
+          len, (void *)srv_result_body(res), drop_result_ref, res);
+  if (resp == NULL) {
+    srv_result_unref(res);
+    r->cut = "out of memory";
+    return MHD_NO;
+  }
+  MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE,
+                          srv_result_type(res));
+  int status = srv_result_status(res);
+  return srv__queue(r, status, resp, len);
+}
+
+enum MHD_Result srv__serve_result(srv_req *r)
+{
+  srv_server *s = r->srv;
+  srv_job_view v;
+  srv_result *res = NULL;
+  int rc = s->store->ops->result(s->store, r->job_id, srv_now(), &v, &res);
+  if (rc != SRV_STORE_OK)
+    return job_missing(r, rc, &v);
+  if (v.state == SRV_JOB_DONE && res != NULL)
+    return answer_result(r, res);
+  srv_result_unref(res);
+  char detail[400];
+  if (v.state == SRV_JOB_FAILED)
+    snprintf(detail, sizeof detail, "the job failed: %s", v.error);
+  else if (v.state == SRV_JOB_CANCELLED)
+    snprintf(detail, sizeof detail, "the job was cancelled");
+  else
+    snprintf(detail, sizeof detail,
+             "the job is %s (%zu of %zu frames done); poll /v1/jobs/%s",
+             srv_job_state_name(v.state), v.frames_done, v.frames_total,
+             v.id);
+  return srv__problem(r, 409, "/problems/job-not-done", "Result not ready",
+                      detail, NULL, NULL);
+}
