@@ -270,62 +270,66 @@ void km__frame_plan_free(km__frame_plan *p) {
   free(p);
 }
 
-
-km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const double length[2],
-                               const double angle[2], bool closed, double tol,
-                               size_t max_pieces, km__poll *poll,
-                               km_error *err) {
-  km_status st = KM_OK;
-  double *br = NULL, *Dall = NULL;
-  vec atoms = {NULL, 0, 0, sizeof(atom)}, nodes = {NULL, 0, 0, sizeof(gnode)};
-  km_pp mt[2], mk[2];
-  for (int w = 0; w < 2; w++) {
-    km__pp_init(&mt[w]);
-    km__pp_init(&mk[w]);
-  }
-  gl_rules *g = malloc(sizeof *g);
-  km__frame_plan *p = calloc(1, sizeof *p);
-  if (!p || !g) {
-    st = KM_ENOMEM;
-    goto fail;
-  }
-  gl_make(g);
-  double Lmax = fmax(length[0], length[1]);
-  /* The inputs' pieces merged where one polynomial carries them within
-   * MERGE_SHARE of the tolerance in position (|dC| <= L |d theta|): a
-   * signature breaks at every knot of its curve, and every merged break of
-   * the two inputs would otherwise cost output pieces and quadrature
-   * nodes in every frame. */
+/* ---- the phases of planning --------------------------------------------
+ * What planning needs beside the plan itself, freed once whatever the
+ * outcome. */
+typedef struct builder {
+  km_pp mt[2], mk[2]; /* the inputs' theta pieces merged, and their kappa */
   side sd[2];
+  gl_rules *g;
+  double Lmax;        /* the longer input: tolerances below are over it */
+  double *br;         /* m merged breaks of both inputs in r */
+  size_t m;
+  double *Dall;       /* bounds on theta's derivatives per merged interval */
+  vec atoms, nodes;
+  size_t *start;      /* first atom of each output piece, np + 1 */
+} builder;
+
+static void builder_free(builder *b) {
   for (int w = 0; w < 2; w++) {
-    st = km__pp_merge(&theta[w], MERGE_DEGREE, MERGE_SHARE * tol / Lmax, &mt[w]);
-    if (!st) st = km__pp_derivative(&mt[w], &mk[w]);
-    if (st) goto fail;
-    sd[w].kappa = &mk[w];
-    sd[w].theta = &mt[w];
-    sd[w].L = length[w];
-    sd[w].angle = angle[w];
+    km__pp_free(&b->mt[w]);
+    km__pp_free(&b->mk[w]);
   }
-  p->La = length[0];
-  p->Lb = length[1];
-  p->tol = tol;
-  p->closed = closed;
-  if (!km__closure_metric_factor(p->chol)) {
-    st = KM_ENOCONVERGE;
-    goto fail;
+  free(b->g);
+  free(b->br);
+  free(b->Dall);
+  free(b->atoms.p);
+  free(b->nodes.p);
+  free(b->start);
+}
+
+/* The inputs' pieces merged where one polynomial carries them within
+ * MERGE_SHARE of the tolerance in position (|dC| <= L |d theta|): a
+ * signature breaks at every knot of its curve, and every merged break of
+ * the two inputs would otherwise cost output pieces and quadrature nodes
+ * in every frame. */
+static km_status merge_inputs(builder *b, const km_pp theta[2],
+                              const double length[2], const double angle[2],
+                              double tol) {
+  for (int w = 0; w < 2; w++) {
+    km_status st = km__pp_merge(&theta[w], MERGE_DEGREE,
+                                MERGE_SHARE * tol / b->Lmax, &b->mt[w]);
+    if (!st) st = km__pp_derivative(&b->mt[w], &b->mk[w]);
+    if (st) return st;
+    b->sd[w].kappa = &b->mk[w];
+    b->sd[w].theta = &b->mt[w];
+    b->sd[w].L = length[w];
+    b->sd[w].angle = angle[w];
   }
-  /* merged breaks of both inputs in r */
-  size_t nbr = mt[0].m + mt[1].m + 2;
-  br = malloc(nbr * sizeof(double));
-  if (!br) {
-    st = KM_ENOMEM;
-    goto fail;
-  }
-  size_t q = 0;
+  return KM_OK;
+}
+
+/* The merged breaks of both inputs in r, from 0 to 1, and the bounds on
+ * theta's derivatives over every interval between them (once: the
+ * planning and the quadrature both use them). */
+static km_status merged_breaks(builder *b, const double length[2],
+                               km__poll *poll) {
+  size_t nbr = b->mt[0].m + b->mt[1].m + 2, q = 0, m = 0;
+  double *br = b->br = malloc(nbr * sizeof(double));
+  if (!br) return KM_ENOMEM;
   for (int w = 0; w < 2; w++)
-    for (size_t i = 0; i <= mt[w].m; i++) br[q++] = mt[w].x[i] / length[w];
+    for (size_t i = 0; i <= b->mt[w].m; i++) br[q++] = b->mt[w].x[i] / length[w];
   qsort(br, q, sizeof(double), km__cmp_double);
-  size_t m = 0;
   for (size_t i = 0; i < q; i++) {
     double v = fmin(fmax(br[i], 0.0), 1.0);
     if (m == 0 || v > br[m - 1] + 1e-14) br[m++] = v;
@@ -335,80 +339,83 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
     br[m++] = 1.0;
   else
     br[m - 1] = 1.0;
-  if (m < 2) {
-    st = KM_EDEGENERATE;
-    goto fail;
-  }
-  /* bounds on theta's derivatives over every merged interval (once: the
-   * planning and the quadrature both use them) */
-  Dall = malloc((m - 1) * (NDER + 1) * sizeof(double));
-  if (!Dall) {
-    st = KM_ENOMEM;
-    goto fail;
-  }
+  b->m = m;
+  if (m < 2) return KM_EDEGENERATE;
+  b->Dall = malloc((m - 1) * (NDER + 1) * sizeof(double));
+  if (!b->Dall) return KM_ENOMEM;
   for (size_t i = 0; i + 1 < m; i++) {
-    both_bounds(sd, br[i], br[i + 1], NDER, Dall + i * (NDER + 1));
-    if (km__poll_stop(poll, 2 * NDER)) {
-      st = KM_ECANCELLED;
-      goto fail;
-    }
+    both_bounds(b->sd, br[i], br[i + 1], NDER, b->Dall + i * (NDER + 1));
+    if (km__poll_stop(poll, 2 * NDER)) return KM_ECANCELLED;
   }
-  /* atoms; jumps and corners at the merged breaks */
-  double tolp = 0.5 * tol / Lmax;
-  for (size_t i = 0; i + 1 < m; i++) {
+  return KM_OK;
+}
+
+/* Bounds on the jumps of C'' and C''' (over L) at merged break i > 0 for
+ * every t, and whether theta jumps there. */
+static void break_jumps(const builder *b, size_t i, double *j2, double *j3,
+                        bool *corner) {
+  const double *Dl = b->Dall + (i - 1) * (NDER + 1), *Dr = b->Dall + i * (NDER + 1);
+  double D1 = fmax(Dl[1], Dr[1]);
+  for (int w = 0; w < 2; w++) {
+    double vl[3], vr[3];
+    side_eval(&b->sd[w], b->br[i], -1, vl);
+    side_eval(&b->sd[w], b->br[i], 1, vr);
+    if (fabs(vr[0] - vl[0]) > 1e-12) *corner = true;
+    double d1 = fabs(vr[1] - vl[1]), d2 = fabs(vr[2] - vl[2]);
+    *j2 = fmax(*j2, d1);
+    *j3 = fmax(*j3, d2 + d1 * 2 * D1);
+  }
+}
+
+/* Atoms of every merged interval, with the jumps and corners at their
+ * breaks; past 2 max_pieces of them (0: no bound) KM_ELIMIT. */
+static km_status make_atoms(builder *b, double tolp, size_t max_pieces,
+                            km__poll *poll) {
+  for (size_t i = 0; i + 1 < b->m; i++) {
     double j2 = 0.0, j3 = 0.0;
     bool corner = false;
-    if (i > 0) {
-      double D1 = fmax(Dall[(i - 1) * (NDER + 1) + 1], Dall[i * (NDER + 1) + 1]);
-      for (int w = 0; w < 2; w++) {
-        double vl[3], vr[3];
-        side_eval(&sd[w], br[i], -1, vl);
-        side_eval(&sd[w], br[i], 1, vr);
-        if (fabs(vr[0] - vl[0]) > 1e-12) corner = true;
-        double d1 = fabs(vr[1] - vl[1]), d2 = fabs(vr[2] - vl[2]);
-        j2 = fmax(j2, d1);
-        j3 = fmax(j3, d2 + d1 * 2 * D1);
-      }
+    if (i > 0) break_jumps(b, i, &j2, &j3, &corner);
+    km_status st = plan_interval(&b->atoms, b->sd, b->br[i], b->br[i + 1], i,
+                                 b->Dall + i * (NDER + 1), tolp, j2, j3,
+                                 corner, 2 * max_pieces, poll);
+    if (st) return st;
+  }
+  return KM_OK;
+}
+
+/* Atoms merged greedily into output pieces while the Hermite bound holds
+ * (b->start, *np of them); more than max_pieces (0: no bound) KM_ELIMIT. */
+static km_status group_atoms(builder *b, double tolp, size_t max_pieces,
+                             size_t *np_out) {
+  const atom *A = b->atoms.p;
+  size_t na = b->atoms.n, np = 0, k = 0;
+  size_t *start = b->start = malloc((na + 1) * sizeof(size_t));
+  if (!start) return KM_ENOMEM;
+  while (k < na) {
+    start[np++] = k;
+    double m4 = A[k].m4, s2 = 0.0, s3 = 0.0;
+    size_t e = k + 1;
+    while (e < na && !A[e].corner) {
+      double h = A[e].x1 - A[k].x0;
+      double m4n = fmax(m4, A[e].m4), s2n = s2 + A[e].j2, s3n = s3 + A[e].j3;
+      double e_h = pow(h, 4) / 384.0 * m4n + KM__HERMITE_JUMP2 * h * h * s2n +
+                   KM__HERMITE_JUMP3 * h * h * h * s3n;
+      if (e_h > tolp) break;
+      m4 = m4n;
+      s2 = s2n;
+      s3 = s3n;
+      e++;
     }
-    st = plan_interval(&atoms, sd, br[i], br[i + 1], i, Dall + i * (NDER + 1),
-                       tolp, j2, j3, corner, 2 * max_pieces, poll);
-    if (st) goto fail;
+    k = e;
   }
-  /* merge atoms greedily into output pieces while the bound holds */
-  atom *A = atoms.p;
-  size_t na = atoms.n;
-  size_t *start = malloc((na + 1) * sizeof(size_t));
-  if (!start) {
-    st = KM_ENOMEM;
-    goto fail;
-  }
-  size_t np = 0;
-  {
-    size_t k = 0;
-    while (k < na) {
-      start[np++] = k;
-      double m4 = A[k].m4, s2 = 0.0, s3 = 0.0;
-      size_t e = k + 1;
-      while (e < na && !A[e].corner) {
-        double h = A[e].x1 - A[k].x0;
-        double m4n = fmax(m4, A[e].m4), s2n = s2 + A[e].j2, s3n = s3 + A[e].j3;
-        double e_h = pow(h, 4) / 384.0 * m4n + KM__HERMITE_JUMP2 * h * h * s2n +
-                     KM__HERMITE_JUMP3 * h * h * h * s3n;
-        if (e_h > tolp) break;
-        m4 = m4n;
-        s2 = s2n;
-        s3 = s3n;
-        e++;
-      }
-      k = e;
-    }
-    start[np] = na;
-  }
-  if (max_pieces > 0 && np > max_pieces) {
-    free(start);
-    st = KM_ELIMIT;
-    goto fail;
-  }
+  start[np] = na;
+  if (max_pieces > 0 && np > max_pieces) return KM_ELIMIT;
+  *np_out = np;
+  return KM_OK;
+}
+
+/* The plan's per-break arrays for np pieces. */
+static km_status alloc_breaks(km__frame_plan *p, size_t np) {
   p->np = np;
   p->x = malloc((np + 1) * sizeof(double));
   p->corner = calloc(np + 1, 1);
@@ -417,175 +424,218 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
   p->tb_l = malloc((np + 1) * sizeof(double));
   p->tb_r = malloc((np + 1) * sizeof(double));
   p->first = malloc((np + 1) * sizeof(size_t));
-  if (!p->x || !p->corner || !p->ta_l || !p->ta_r || !p->tb_l || !p->tb_r ||
-      !p->first) {
-    free(start);
-    st = KM_ENOMEM;
-    goto fail;
+  p->at_break = malloc((np + 1) * sizeof(gnode));
+  p->corner_at = malloc((np + 1) * sizeof(size_t));
+  bool ok = p->x && p->corner && p->ta_l && p->ta_r && p->tb_l && p->tb_r &&
+            p->first && p->at_break && p->corner_at;
+  return ok ? KM_OK : KM_ENOMEM;
+}
+
+/* The lowest Gauss-Legendre order n, then halvings of [a, b] into
+ * *chunks, whose error bound meets tolq per unit r, for theta with
+ * derivative bounds D there. */
+static int atom_rule(const gl_rules *g, const double *D, double a, double b,
+                     double tolq, int *chunks_out) {
+  double B[NDER + 1], Dh[NDER + 1];
+  int chunks = 1, n = 2;
+  for (;;) {
+    double h = (b - a) / chunks, hj = h;
+    for (int j = 1; j <= NDER; j++) {
+      Dh[j] = D[j] * hj;
+      hj *= h;
+    }
+    bell(Dh, NDER, B);
+    bool ok = false;
+    for (n = 2; n <= MAX_RULE; n++)
+      if (g->K[n] * B[2 * n] <= tolq) {
+        ok = true;
+        break;
+      }
+    if (ok || chunks >= (1 << 20)) {
+      if (!ok) n = MAX_RULE;
+      break;
+    }
+    chunks *= 2;
   }
-  /* quadrature share of the tolerance, per unit of r */
-  double tolq = 0.1 * tol / Lmax;
-  for (size_t k = 0; k < np && !st; k++) {
-    p->x[k] = A[start[k]].x0;
-    p->corner[k] = A[start[k]].corner;
-    p->first[k] = nodes.n;
-    for (size_t ai = start[k]; ai < start[k + 1] && !st; ai++) {
-      double a = A[ai].x0, b = A[ai].x1;
-      double Dpart[NDER + 1], B[NDER + 1], Dh[NDER + 1];
-      const double *D = Dpart;
-      if (A[ai].whole)
-        D = Dall + A[ai].iv * (NDER + 1);
-      else
-        both_bounds(sd, a, b, NDER, Dpart);
-      /* lowest order, then halving, whose bound meets tolq per unit r */
-      int chunks = 1, n = 2;
-      for (;;) {
-        double h = (b - a) / chunks, hj = h;
-        for (int j = 1; j <= NDER; j++) {
-          Dh[j] = D[j] * hj;
-          hj *= h;
-        }
-        bell(Dh, NDER, B);
-        bool ok = false;
-        for (n = 2; n <= MAX_RULE; n++)
-          if (g->K[n] * B[2 * n] <= tolq) {
-            ok = true;
-            break;
-          }
-        if (ok || chunks >= (1 << 20)) {
-          if (!ok) n = MAX_RULE;
-          break;
-        }
-        chunks *= 2;
-      }
-      double hc = (b - a) / chunks;
-      /* a node costs two angles and its basis: some 4 units */
-      if (km__poll_stop(poll, 4L * chunks * n + 2 * NDER)) st = KM_ECANCELLED;
-      for (int c = 0; c < chunks && !st; c++) {
-        double mid = a + hc * (c + 0.5);
-        for (int j = 0; j < n && !st; j++) {
-          gnode nd;
-          double r = mid + 0.5 * hc * g->x[n][j];
-          nd.w = 0.5 * hc * g->w[n][j];
-          nd.ta = side_angle(&sd[0], r, 0);
-          nd.tb = side_angle(&sd[1], r, 0);
-          basis_at(r, &nd.bi, nd.bv);
-          st = vec_push(&nodes, &nd);
-        }
-      }
+  *chunks_out = chunks;
+  return n;
+}
+
+/* Quadrature nodes of atom ai (Ta, Tb and the closure basis at each). */
+static km_status atom_nodes(builder *b, size_t ai, double tolq,
+                            km__poll *poll) {
+  const atom *A = b->atoms.p;
+  double a = A[ai].x0, bb = A[ai].x1, Dpart[NDER + 1];
+  const double *D = Dpart;
+  if (A[ai].whole)
+    D = b->Dall + A[ai].iv * (NDER + 1);
+  else
+    both_bounds(b->sd, a, bb, NDER, Dpart);
+  int chunks, n = atom_rule(b->g, D, a, bb, tolq, &chunks);
+  double hc = (bb - a) / chunks;
+  /* a node costs two angles and its basis: some 4 units */
+  if (km__poll_stop(poll, 4L * chunks * n + 2 * NDER)) return KM_ECANCELLED;
+  for (int c = 0; c < chunks; c++) {
+    double mid = a + hc * (c + 0.5);
+    for (int j = 0; j < n; j++) {
+      gnode nd;
+      double r = mid + 0.5 * hc * b->g->x[n][j];
+      nd.w = 0.5 * hc * b->g->w[n][j];
+      nd.ta = side_angle(&b->sd[0], r, 0);
+      nd.tb = side_angle(&b->sd[1], r, 0);
+      basis_at(r, &nd.bi, nd.bv);
+      km_status st = vec_push(&b->nodes, &nd);
+      if (st) return st;
     }
   }
-  free(start);
-  if (st) goto fail;
-  p->x[np] = 1.0;
-  p->first[np] = nodes.n;
-  p->at_break = malloc((np + 1) * sizeof(gnode));
-  if (!p->at_break) {
-    st = KM_ENOMEM;
-    goto fail;
+  return KM_OK;
+}
+
+/* The output pieces' breaks and nodes, the quadrature taking a tenth of
+ * the tolerance; the nodes move from b into p. */
+static km_status plan_nodes(builder *b, km__frame_plan *p, double tol,
+                            km__poll *poll) {
+  const atom *A = b->atoms.p;
+  double tolq = 0.1 * tol / b->Lmax; /* per unit of r */
+  for (size_t k = 0; k < p->np; k++) {
+    p->x[k] = A[b->start[k]].x0;
+    p->corner[k] = A[b->start[k]].corner;
+    p->first[k] = b->nodes.n;
+    for (size_t ai = b->start[k]; ai < b->start[k + 1]; ai++) {
+      km_status st = atom_nodes(b, ai, tolq, poll);
+      if (st) return st;
+    }
   }
+  p->x[p->np] = 1.0;
+  p->first[p->np] = b->nodes.n;
+  p->node = b->nodes.p;
+  p->nn = b->nodes.n;
+  b->nodes.p = NULL;
+  return KM_OK;
+}
+
+/* At every break the closure basis and the inputs' angles either side;
+ * the basis functions' integrals; the corners. */
+static void break_tables(const builder *b, km__frame_plan *p) {
+  size_t np = p->np;
   for (size_t k = 0; k <= np; k++) basis_at(p->x[k], &p->at_break[k].bi, p->at_break[k].bv);
-  {
-    const gnode *N = nodes.p;
-    for (size_t j = 0; j < nodes.n; j++)
-      for (int b = 0; b < 4; b++)
-        if (N[j].bi + b >= 0 && N[j].bi + b < NF) p->wb[N[j].bi + b] += N[j].w * N[j].bv[b];
-  }
-  p->corner_at = malloc((np + 1) * sizeof(size_t));
-  if (!p->corner_at) {
-    st = KM_ENOMEM;
-    goto fail;
+  for (size_t j = 0; j < p->nn; j++) {
+    const gnode *N = &p->node[j];
+    for (int q = 0; q < 4; q++)
+      if (N->bi + q >= 0 && N->bi + q < NF) p->wb[N->bi + q] += N->w * N->bv[q];
   }
   for (size_t k = 1; k < np; k++)
     if (p->corner[k]) p->corner_at[p->ncorners++] = k;
   for (size_t k = 0; k <= np; k++) {
-    p->ta_l[k] = side_angle(&sd[0], p->x[k], k == 0 ? 1 : -1);
-    p->ta_r[k] = side_angle(&sd[0], p->x[k], k == np ? -1 : 1);
-    p->tb_l[k] = side_angle(&sd[1], p->x[k], k == 0 ? 1 : -1);
-    p->tb_r[k] = side_angle(&sd[1], p->x[k], k == np ? -1 : 1);
+    p->ta_l[k] = side_angle(&b->sd[0], p->x[k], k == 0 ? 1 : -1);
+    p->ta_r[k] = side_angle(&b->sd[0], p->x[k], k == np ? -1 : 1);
+    p->tb_l[k] = side_angle(&b->sd[1], p->x[k], k == 0 ? 1 : -1);
+    p->tb_r[k] = side_angle(&b->sd[1], p->x[k], k == np ? -1 : 1);
   }
-  p->node = nodes.p;
-  p->nn = nodes.n;
-  nodes.p = NULL;
-  if (closed) {
-    /* Corners close the frames of this morph if they can at t = 1/4, 1/2
-     * and 3/4; the choice holds for every frame, so that a sequence does
-     * not switch between two closures (a frame where it fails takes the
-     * smooth one). */
-    size_t nc = p->ncorners;
-    double *buf = nc >= 3 ? malloc((km__plan_frame_scratch(p) + 4 * nc + 2 + np) *
-                                   sizeof(double))
-                          : NULL;
-    if (buf) {
-      double *tau = buf + km__plan_frame_scratch(p), *delta = tau + nc, *S = delta + nc;
-      double *dp = S + 2 * (nc + 1), c0[NF] = {0};
-      p->by_corners = true;
-      for (int k = 1; k <= 3 && p->by_corners; k++)
-        p->by_corners = km__plan_close_frame(p, k / 4.0, 0.0, false, false, c0, buf,
-                                    buf + 2 * np, poll) == KM_OK &&
-                        km__plan_corner_closure(p, k / 4.0, buf, tau, delta, S, dp);
-      free(buf);
-    }
-    /* The corrections frames start from, at t = k / WARM_POINTS: the
-     * projection and steps from the closed correction found from zero at
-     * t = 1/2, scaled by 4 t (1 - t) - a smooth family in t (the frames of
-     * U_to_S took it, three or four passes each, before they started from
-     * the polynomial through it, two passes each). One that does not
-     * converge is zero, and so are all where corners close the frames
-     * (a frame they cannot close takes steps from zero). */
-    memset(p->c_at, 0, sizeof p->c_at);
-    if (!p->by_corners) {
-      double *sum = malloc(km__plan_frame_scratch(p) * sizeof(double));
-      if (!sum) {
-        st = KM_ENOMEM;
-        goto fail;
-      }
-      double c_half[NF] = {0};
-      st = km__plan_close_frame(p, 0.5, 0.0, true, true, c_half, sum, sum + 2 * np,
-                       poll);
-      if (st == KM_ENOCONVERGE) {
-        memset(c_half, 0, sizeof c_half);
-        st = KM_OK;
-      }
-      for (int k = 1; k < WARM_POINTS && !st; k++) {
-        double t = (double)k / WARM_POINTS;
-        for (int i = 0; i < NF; i++) p->c_at[k][i] = 4 * t * (1 - t) * c_half[i];
-        st = km__plan_close_frame(p, t, 0.0, true, true, p->c_at[k], sum, sum + 2 * np,
-                         poll);
-        if (st == KM_ENOCONVERGE) {
-          memset(p->c_at[k], 0, sizeof p->c_at[k]);
-          st = KM_OK;
-        }
-      }
-      free(sum);
-      if (st) goto fail;
+}
+
+/* Corners close the frames of this morph if they can at t = 1/4, 1/2 and
+ * 3/4; the choice holds for every frame, so that a sequence does not
+ * switch between two closures (a frame where it fails takes the smooth
+ * one). Without memory for the trial the smooth closure is chosen. */
+static void choose_corner_closure(km__frame_plan *p, km__poll *poll) {
+  size_t nc = p->ncorners, np = p->np;
+  double *buf = nc >= 3 ? malloc((km__plan_frame_scratch(p) + 4 * nc + 2 + np) *
+                                 sizeof(double))
+                        : NULL;
+  if (!buf) return;
+  double *tau = buf + km__plan_frame_scratch(p), *delta = tau + nc, *S = delta + nc;
+  double *dp = S + 2 * (nc + 1), c0[NF] = {0};
+  p->by_corners = true;
+  for (int k = 1; k <= 3 && p->by_corners; k++)
+    p->by_corners = km__plan_close_frame(p, k / 4.0, 0.0, false, false, c0, buf,
+                                         buf + 2 * np, poll) == KM_OK &&
+                    km__plan_corner_closure(p, k / 4.0, buf, tau, delta, S, dp);
+  free(buf);
+}
+
+/* The corrections frames start from, at t = k / WARM_POINTS: the
+ * projection and steps from the closed correction found from zero at
+ * t = 1/2, scaled by 4 t (1 - t) - a smooth family in t, from which frames
+ * start on the polynomial through them (fewer passes than from the scaled
+ * correction itself). One that does not converge is zero. */
+static km_status warm_corrections(km__frame_plan *p, km__poll *poll) {
+  size_t np = p->np;
+  double *sum = malloc(km__plan_frame_scratch(p) * sizeof(double));
+  if (!sum) return KM_ENOMEM;
+  double c_half[NF] = {0};
+  km_status st = km__plan_close_frame(p, 0.5, 0.0, true, true, c_half, sum,
+                                      sum + 2 * np, poll);
+  if (st == KM_ENOCONVERGE) {
+    memset(c_half, 0, sizeof c_half);
+    st = KM_OK;
+  }
+  for (int k = 1; k < WARM_POINTS && !st; k++) {
+    double t = (double)k / WARM_POINTS;
+    for (int i = 0; i < NF; i++) p->c_at[k][i] = 4 * t * (1 - t) * c_half[i];
+    st = km__plan_close_frame(p, t, 0.0, true, true, p->c_at[k], sum,
+                              sum + 2 * np, poll);
+    if (st == KM_ENOCONVERGE) {
+      memset(p->c_at[k], 0, sizeof p->c_at[k]);
+      st = KM_OK;
     }
   }
-  if (poll && poll->stopped) {
-    st = KM_ECANCELLED;
-    goto fail;
-  }
-  free(atoms.p);
-  free(br);
-  free(Dall);
-  free(g);
+  free(sum);
+  return st;
+}
+
+/* ---- planning ---------------------------------------------------------- */
+
+km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const double length[2],
+                               const double angle[2], bool closed, double tol,
+                               size_t max_pieces, km__poll *poll,
+                               km_error *err) {
+  builder b;
+  memset(&b, 0, sizeof b);
   for (int w = 0; w < 2; w++) {
-    km__pp_free(&mt[w]);
-    km__pp_free(&mk[w]);
+    km__pp_init(&b.mt[w]);
+    km__pp_init(&b.mk[w]);
   }
-  *out = p;
-  return KM_OK;
-fail:
-  free(atoms.p);
-  free(nodes.p);
-  free(br);
-  free(Dall);
-  free(g);
-  for (int w = 0; w < 2; w++) {
-    km__pp_free(&mt[w]);
-    km__pp_free(&mk[w]);
+  b.atoms.size = sizeof(atom);
+  b.nodes.size = sizeof(gnode);
+  b.Lmax = fmax(length[0], length[1]);
+  /* the Hermite pieces take half the tolerance (per unit of r) */
+  double tolp = 0.5 * tol / b.Lmax;
+  size_t np = 0;
+  km_status st = KM_OK;
+  b.g = malloc(sizeof *b.g);
+  km__frame_plan *p = calloc(1, sizeof *p);
+  if (!p || !b.g) {
+    st = KM_ENOMEM;
+    goto done;
   }
+  gl_make(b.g);
+  p->La = length[0];
+  p->Lb = length[1];
+  p->tol = tol;
+  p->closed = closed;
+  st = merge_inputs(&b, theta, length, angle, tol);
+  if (!st && !km__closure_metric_factor(p->chol)) st = KM_ENOCONVERGE;
+  if (!st) st = merged_breaks(&b, length, poll);
+  if (!st) st = make_atoms(&b, tolp, max_pieces, poll);
+  if (!st) st = group_atoms(&b, tolp, max_pieces, &np);
+  if (!st) st = alloc_breaks(p, np);
+  if (!st) st = plan_nodes(&b, p, tol, poll);
+  if (st) goto done;
+  break_tables(&b, p);
+  /* corners or the kept corrections (zero where corners close the
+   * frames: one they cannot close takes steps from zero) */
+  if (closed) choose_corner_closure(p, poll);
+  if (closed && !p->by_corners) st = warm_corrections(p, poll);
+  if (!st && poll && poll->stopped) st = KM_ECANCELLED;
+  if (!st) {
+    *out = p;
+    p = NULL;
+  }
+done:
+  builder_free(&b);
   km__frame_plan_free(p);
+  if (!st) return KM_OK;
   if (st == KM_ECANCELLED) return km__stopped(err);
   return km__fail(err, st, KM_FIELD_TOLERANCE, -1, NAN,
                   st == KM_ELIMIT ? "the frames need too many pieces at this "
