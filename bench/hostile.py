@@ -438,7 +438,6 @@ def s5_slow_readers(d, limit):
     time.sleep(0.3)
     rss0 = d.mark()
     t1 = time.monotonic()
-    deadline = t1 + limit
     socks = []
     for _ in range(8):
         s = socket.socket()
@@ -448,6 +447,46 @@ def s5_slow_readers(d, limit):
         s.sendall(get_bytes(path))
         s.setblocking(False)
         socks.append([s, 0, None])  # socket, bytes read, end
+    cut_at = read_slowly(d, socks, full, t1, t1 + limit)
+    rss1 = d.rss_max_kb
+    for item in socks:
+        item[0].close()
+    ends = [e for _, _, e in socks if e is not None]
+    counts = {}
+    for e in ends:
+        counts[e[0]] = counts.get(e[0], 0) + 1
+    text = ", ".join("%d %s by %.1f s" % (n, k, max(
+        e[1] for e in ends if e[0] == k)) for k, n in sorted(counts.items()))
+    if len(ends) < 8:
+        text += (", " if text else "") + "%d still reading" % (8 - len(ends))
+    if cut_at is not None:
+        text += "; the daemon cut all 8 by %.1f s" % cut_at
+    seconds = cut_at if cut_at is not None else (
+        max(e[1] for e in ends) if len(ends) == 8 else None)
+    return {"seconds": seconds, "answers": text,
+            "note": "result %.1f MB; RSS %.0f -> max %.0f MiB while read"
+            % (full / 1e6, rss0 / 1024, rss1 / 1024)}
+
+
+def late_sends(d):
+    """The daemon's count of connections cut because their answer was not
+    read in time (kmorph_connections_cut_total{reason="late_send"}), or
+    None if it has no such metric."""
+    r = exchange(d.port, get_bytes("/metrics"), time.monotonic() + 5)
+    key = b'kmorph_connections_cut_total{reason="late_send"} '
+    for line in body_of(r).splitlines():
+        if line.startswith(key):
+            return int(float(line[len(key):]))
+    return None
+
+
+def read_slowly(d, socks, full, t1, deadline):
+    """Read 1 KiB a second from each socket until each has ended (EOF or
+    reset), the daemon says it cut them all, or deadline. A connection the
+    daemon cut still delivers what its kernel buffers hold, so the reader
+    sees the end late: the daemon's own count says when it let go. Returns
+    the seconds until the daemon had cut them all, or None."""
+    cut_at = None
     while time.monotonic() < deadline and any(e is None for _, _, e in socks):
         for item in socks:
             if item[2] is not None:
@@ -462,22 +501,12 @@ def s5_slow_readers(d, limit):
                 pass
             except OSError:
                 item[2] = ("reset", time.monotonic() - t1)
+        n = late_sends(d)
+        if n is not None and n >= len(socks):
+            cut_at = time.monotonic() - t1
+            break
         time.sleep(1.0)
-    rss1 = d.rss_max_kb
-    for item in socks:
-        item[0].close()
-    ends = [e for _, _, e in socks if e is not None]
-    counts = {}
-    for e in ends:
-        counts[e[0]] = counts.get(e[0], 0) + 1
-    open_n = 8 - len(ends)
-    text = ", ".join("%d %s" % (n, k) for k, n in sorted(counts.items()))
-    if open_n:
-        text += (", " if text else "") + "%d still reading" % open_n
-    return {"seconds": max(e[1] for e in ends) if not open_n else None,
-            "answers": text,
-            "note": "result %.1f MB; RSS %.0f -> max %.0f MiB while read"
-            % (full / 1e6, rss0 / 1024, rss1 / 1024)}
+    return cut_at
 
 
 def s6_half_bodies(d, limit):
