@@ -184,17 +184,32 @@ static km_status smooth_nodes(const double *rho, const double *len, size_t K,
   return st;
 }
 
-/* Returns KM_EINVAL when the smooth map is not monotone for these matches
- * (the caller then keeps the piecewise-linear correspondence). */
-static km_status blend_smooth(const km_morph *m, double t, km_pp *out,
-                              corner_list *cl) {
-  const km__input *a = &m->in[0], *b = &m->in[1];
-  double La = a->sig.length, Lb = b->sig.length;
-  size_t K = m->nk - 1; /* segments */
-  double *buf = malloc((6 * K + 1) * sizeof(double));
+/* The smooth correspondence of frame t: per segment k its ratio rho[k] =
+ * ds_a/ds_t, its frame length len[k] and start S[k] (S[K] the frame's
+ * length), alpha's nodes (nl, mid, nr), and s_a as 2 K quadratic maps. */
+typedef struct smooth_map {
+  size_t K, nq;
+  double *buf; /* the six arrays below in one block */
+  double *rho, *len, *S, *nl, *nr, *mid;
+  quad_map *qm;
+} smooth_map;
+
+static void smooth_map_free(smooth_map *sm) {
+  free(sm->buf);
+  free(sm->qm);
+}
+
+/* KM_EINVAL when alpha and beta cannot be kept positive, KM_ENOMEM. */
+static km_status smooth_map_make(const km_morph *m, double t, smooth_map *sm) {
+  double La = m->in[0].sig.length, Lb = m->in[1].sig.length;
+  size_t K = sm->K = m->nk - 1;
+  sm->nq = 2 * K;
+  double *buf = sm->buf = malloc((6 * K + 1) * sizeof(double));
   if (!buf) return KM_ENOMEM;
-  double *rho = buf, *len = buf + K, *S = buf + 2 * K, *nl = buf + 3 * K + 1,
-         *nr = buf + 4 * K + 1, *mid = buf + 5 * K + 1;
+  double *rho = sm->rho = buf, *len = sm->len = buf + K, *S = sm->S = buf + 2 * K;
+  sm->nl = buf + 3 * K + 1;
+  sm->nr = buf + 4 * K + 1;
+  sm->mid = buf + 5 * K + 1;
   S[0] = 0.0;
   for (size_t k = 0; k < K; k++) {
     double la = (m->ra[k + 1] - m->ra[k]) * La, lb = (m->rb[k + 1] - m->rb[k]) * Lb;
@@ -202,34 +217,35 @@ static km_status blend_smooth(const km_morph *m, double t, km_pp *out,
     rho[k] = la / len[k];
     S[k + 1] = S[k] + len[k];
   }
-  km_status st = smooth_nodes(rho, len, K, m->closed, t, nl, nr, mid);
-  if (st) {
-    free(buf);
-    return st;
-  }
-  /* frame breaks: segment ends, middles, and the images of both inputs'
-   * breaks and corners */
-  size_t cap = 2 * K + 1 + a->kappa.m + b->kappa.m + 2, nb = 0;
-  double *br = malloc(cap * sizeof(double));
-  quad_map *qm = malloc(2 * K * sizeof *qm);
-  km_pp o;
-  km__pp_init(&o);
-  if (!br || !qm) {
-    st = KM_ENOMEM;
-    goto done;
-  }
+  km_status st = smooth_nodes(rho, len, K, m->closed, t, sm->nl, sm->nr, sm->mid);
+  if (st) return st;
+  quad_map *qm = sm->qm = malloc(2 * K * sizeof *qm);
+  if (!qm) return KM_ENOMEM;
   double sa_at = 0.0;
   for (size_t k = 0; k < K; k++) {
     double h = 0.5 * len[k];
-    qm[2 * k] = (quad_map){S[k], h, sa_at, nl[k], mid[k]};
+    qm[2 * k] = (quad_map){S[k], h, sa_at, sm->nl[k], sm->mid[k]};
     sa_at = qm_sa(&qm[2 * k], S[k] + h);
-    qm[2 * k + 1] = (quad_map){S[k] + h, h, sa_at, mid[k], nr[k]};
+    qm[2 * k + 1] = (quad_map){S[k] + h, h, sa_at, sm->mid[k], sm->nr[k]};
     sa_at = m->ra[k + 1] * La; /* exact at the match */
-    br[nb++] = S[k];
-    br[nb++] = S[k] + h;
   }
-  br[nb++] = S[K];
-  size_t nq = 2 * K;
+  return KM_OK;
+}
+
+/* The frame's breaks (*br, *nbr of them, sorted, distinct; the caller
+ * frees *br): segment ends, middles, and the images of both inputs'
+ * breaks. */
+static km_status smooth_breaks(const km_morph *m, double t,
+                               const smooth_map *sm, double **br_out,
+                               size_t *nbr) {
+  const km__input *a = &m->in[0], *b = &m->in[1];
+  const quad_map *qm = sm->qm;
+  size_t K = sm->K, nq = sm->nq, nb = 0;
+  size_t cap = 2 * K + 1 + a->kappa.m + b->kappa.m + 2;
+  double *br = malloc(cap * sizeof(double));
+  if (!br) return KM_ENOMEM;
+  for (size_t q = 0; q < nq; q++) br[nb++] = qm[q].x0;
+  br[nb++] = sm->S[K];
   for (size_t i = 1; i < a->kappa.m; i++) {
     double y = a->kappa.x[i];
     for (size_t q = 0; q < nq; q++) {
@@ -253,18 +269,31 @@ static km_status blend_smooth(const km_morph *m, double t, km_pp *out,
   qsort(br, nb, sizeof(double), km__cmp_double);
   size_t mb = 0;
   for (size_t i = 0; i < nb; i++)
-    if (mb == 0 || br[i] - br[mb - 1] > 1e-13 * S[K]) br[mb++] = br[i];
-  br[mb - 1] = S[K];
+    if (mb == 0 || br[i] - br[mb - 1] > 1e-13 * sm->S[K]) br[mb++] = br[i];
+  br[mb - 1] = sm->S[K];
+  *br_out = br;
+  *nbr = mb;
+  return KM_OK;
+}
+
+/* The blended curvature on the pieces between the breaks br (mb of
+ * them), each exactly a polynomial of degree 2d + 1, by interpolation at
+ * Chebyshev points. KM_ENOCONVERGE when an interpolation is singular. */
+static km_status smooth_pieces(const km_morph *m, double t,
+                               const smooth_map *sm, const double *br,
+                               size_t mb, km_pp *o) {
+  const km__input *a = &m->in[0], *b = &m->in[1];
+  double La = a->sig.length, Lb = b->sig.length;
   int da = a->kappa.degree, db = b->kappa.degree;
   int dd = 2 * (da > db ? da : db) + 1;
   if (dd > KM_MAX_FN_DEGREE) dd = KM_MAX_FN_DEGREE;
-  st = km__pp_alloc(&o, dd, mb - 1);
-  if (st) goto done;
+  km_status st = km__pp_alloc(o, dd, mb - 1);
+  if (st) return st;
   size_t q = 0;
   for (size_t i = 0; i + 1 < mb; i++) {
     double x0 = br[i], x1 = br[i + 1], xm = 0.5 * (x0 + x1);
-    while (q + 1 < nq && xm > qm[q].x0 + qm[q].h) q++;
-    const quad_map *Q = &qm[q];
+    while (q + 1 < sm->nq && xm > sm->qm[q].x0 + sm->qm[q].h) q++;
+    const quad_map *Q = &sm->qm[q];
     double u[KM_MAX_FN_DEGREE + 1], v[KM_MAX_FN_DEGREE + 1];
     for (int j = 0; j <= dd; j++) {
       u[j] = 0.5 - 0.5 * cos(KM_PI * (j + 0.5) / (dd + 1));
@@ -277,45 +306,49 @@ static km_status blend_smooth(const km_morph *m, double t, km_pp *out,
       v[j] = m->opt.blend == KM_BLEND_PAPER ? (1 - t) * ka + t * kb
                                              : (1 - t) * ka * al + t * kb * be;
     }
-    if (!bern_interp(u, v, dd)) {
-      st = KM_ENOCONVERGE;
-      goto done;
-    }
-    memcpy(o.c + i * (size_t)(dd + 1), v, (size_t)(dd + 1) * sizeof(double));
-    o.x[i] = x0;
+    if (!bern_interp(u, v, dd)) return KM_ENOCONVERGE;
+    memcpy(o->c + i * (size_t)(dd + 1), v, (size_t)(dd + 1) * sizeof(double));
+    o->x[i] = x0;
   }
-  o.x[0] = 0.0;
-  o.x[mb - 1] = S[K];
-  /* corners at the images of the inputs' corners */
+  o->x[0] = 0.0;
+  o->x[mb - 1] = sm->S[sm->K];
+  return KM_OK;
+}
+
+/* Frame position of input w's arc length y (0 <= y <= L): the first
+ * segment whose image reaches y - the ends of neighbouring images agree
+ * only up to rounding, and a corner at a match (as "auto" puts them) must
+ * not fall between them. */
+static double smooth_image(const smooth_map *sm, int w, double y, double L,
+                           double t) {
+  const quad_map *qm = sm->qm;
+  if (y >= L * (1 - 1e-12)) return sm->S[sm->K];
+  if (y <= 0) return 0.0;
+  for (size_t k = 0; k < sm->nq; k++) {
+    double y1 = w ? sb_of(&qm[k], qm[k].x0 + qm[k].h, t)
+                  : qm_sa(&qm[k], qm[k].x0 + qm[k].h);
+    if (y <= y1 + 1e-12 * L || k + 1 == sm->nq)
+      return w ? qm_inv_b(&qm[k], y, t) : qm_inv_a(&qm[k], y);
+  }
+  return -1.0;
+}
+
+/* Corners at the images of the inputs' corners. */
+static km_status smooth_corners(const km_morph *m, double t,
+                                const smooth_map *sm, corner_list *cl) {
+  const quad_map *qm = sm->qm;
+  km_status st = KM_OK;
   for (int w = 0; w < 2 && !st; w++) {
-    const km__input *in = w ? b : a;
-    double cw = w ? t : 1 - t;
+    const km__input *in = &m->in[w];
+    double cw = w ? t : 1 - t, L = in->sig.length;
     for (size_t i = 0; i < in->sig.ncorners && !st; i++) {
-      double y = in->sig.corners[i].s, x = -1.0;
-      double L = w ? Lb : La;
-      if (y >= L * (1 - 1e-12)) {
-        x = S[K];
-      } else if (y <= 0) {
-        x = 0.0;
-      } else {
-        /* the first segment whose image reaches y: the ends of
-         * neighbouring images agree only up to rounding, and a corner at a
-         * match (as "auto" puts them) must not fall between them */
-        for (size_t k = 0; k < nq; k++) {
-          double y1 = w ? sb_of(&qm[k], qm[k].x0 + qm[k].h, t)
-                        : qm_sa(&qm[k], qm[k].x0 + qm[k].h);
-          if (y <= y1 + 1e-12 * L || k + 1 == nq) {
-            x = w ? qm_inv_b(&qm[k], y, t) : qm_inv_a(&qm[k], y);
-            break;
-          }
-        }
-      }
+      double x = smooth_image(sm, w, in->sig.corners[i].s, L, t);
       if (x < 0) continue;
       double turn = cw * in->sig.corners[i].turn;
       if (m->opt.blend == KM_BLEND_PAPER) {
-        /* the delta scales with dx/ds of that km__input */
+        /* the delta scales with dx/ds of that input */
         size_t k = 0;
-        while (k + 1 < nq && x > qm[k].x0 + qm[k].h) k++;
+        while (k + 1 < sm->nq && x > qm[k].x0 + qm[k].h) k++;
         double al = qm[k].al0 + (qm[k].al1 - qm[k].al0) * (x - qm[k].x0) / qm[k].h;
         double be = (1 - (1 - t) * al) / t;
         turn /= w ? be : al;
@@ -325,15 +358,31 @@ static km_status blend_smooth(const km_morph *m, double t, km_pp *out,
       st = corner_push(cl, x, turn);
     }
   }
+  return st;
+}
+
+/* The frame's curvature pieces (*out) and corners (into cl) under the
+ * smooth correspondence. Returns KM_EINVAL when the smooth map is not
+ * monotone for these matches (the caller then keeps the piecewise-linear
+ * correspondence). */
+static km_status blend_smooth(const km_morph *m, double t, km_pp *out,
+                              corner_list *cl) {
+  smooth_map sm = {0, 0, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
+  double *br = NULL;
+  size_t mb = 0;
+  km_pp o;
+  km__pp_init(&o);
+  km_status st = smooth_map_make(m, t, &sm);
+  if (!st) st = smooth_breaks(m, t, &sm, &br, &mb);
+  if (!st) st = smooth_pieces(m, t, &sm, br, mb, &o);
+  if (!st) st = smooth_corners(m, t, &sm, cl);
   if (!st) {
     *out = o;
     km__pp_init(&o);
   }
-done:
   km__pp_free(&o);
   free(br);
-  free(qm);
-  free(buf);
+  smooth_map_free(&sm);
   return st;
 }
 

@@ -222,161 +222,157 @@ static km_status closure_nodes(const km_pp *kp, const km_pp *tp, double h,
   return KM_OK;
 }
 
-/* Closed curve nearest in curvature (L2, weighted by weights[iv] on the
- * basis interval iv when given) to sig: see the DESIGN note. With
- * by_corners, the interior corners take the whole correction when they can
- * (km__close_by_corners: the smooth curvature keeps its bound, straight
- * edges stay straight; *used_corners then true), else the smooth curvature
- * does. On success *out is the corrected signature and *gap0 the gap
- * before. */
-km_status km__close_lsq(const km_signature *sig, bool by_corners,
-                           const double *weights, km_signature *out,
-                           double *gap0, bool *used_corners, km__poll *poll,
-                           km_error *err) {
-  double L = sig->length, h = L / NB;
-  km_pp kp, tp, dpsi, kt;
-  km__pp_init(&kp);
-  km__pp_init(&tp);
-  km__pp_init(&dpsi);
-  km__pp_init(&kt);
-  qnode *q = NULL;
-  size_t nq = 0;
-  double c[NF] = {0};
-  km_status st = km__build_theta(sig, &kp, &tp);
-  if (!st) st = closure_nodes(&kp, &tp, h, poll, &q, &nq);
-  if (st) goto done;
-  /* the gap before any correction, and the integrals of the stretches
-   * between interior corners (for the closure by corners) */
-  size_t nc = 0;
-  double *S = NULL, *tau = NULL, *delta = NULL;
+/* The integrals of e^(i theta) over the stretches between the interior
+ * corners of sig (nc of them: S has 2 (nc + 1) values, tau their turns;
+ * delta room for nc changes, all in one block at S), and the gap they sum
+ * to. */
+typedef struct stretches {
+  double *S, *tau, *delta;
+  size_t nc;
+} stretches;
+
+static km_status stretch_sums(const km_signature *sig, const qnode *q,
+                              size_t nq, stretches *sc, double *gap) {
+  double L = sig->length;
+  size_t nc = 0, m = 0, ci = 0;
   for (size_t k = 0; k < sig->ncorners; k++)
     if (sig->corners[k].s > 0 && sig->corners[k].s < L) nc++;
-  S = malloc((4 * nc + 2) * sizeof(double));
-  if (!S) {
-    st = KM_ENOMEM;
-    goto done;
-  }
-  tau = S + 2 * (nc + 1);
-  delta = tau + nc;
-  {
-    size_t m = 0, ci = 0;
-    S[0] = S[1] = 0.0;
-    for (size_t n = 0; n < nq; n++) {
-      while (ci < sig->ncorners && sig->corners[ci].s <= q[n].s) {
-        if (sig->corners[ci].s > 0 && sig->corners[ci].s < L) {
-          tau[m++] = sig->corners[ci].turn;
-          S[2 * m] = S[2 * m + 1] = 0.0;
-        }
-        ci++;
+  double *S = sc->S = malloc((4 * nc + 2) * sizeof(double));
+  if (!S) return KM_ENOMEM;
+  sc->nc = nc;
+  sc->tau = S + 2 * (nc + 1);
+  sc->delta = sc->tau + nc;
+  S[0] = S[1] = 0.0;
+  for (size_t n = 0; n < nq; n++) {
+    while (ci < sig->ncorners && sig->corners[ci].s <= q[n].s) {
+      if (sig->corners[ci].s > 0 && sig->corners[ci].s < L) {
+        sc->tau[m++] = sig->corners[ci].turn;
+        S[2 * m] = S[2 * m + 1] = 0.0;
       }
-      S[2 * m] += q[n].w * cos(q[n].theta);
-      S[2 * m + 1] += q[n].w * sin(q[n].theta);
+      ci++;
     }
-    double gx = 0.0, gy = 0.0;
-    for (size_t k = 0; k <= nc; k++) {
-      gx += S[2 * k];
-      gy += S[2 * k + 1];
+    S[2 * m] += q[n].w * cos(q[n].theta);
+    S[2 * m + 1] += q[n].w * sin(q[n].theta);
+  }
+  double gx = 0.0, gy = 0.0;
+  for (size_t k = 0; k <= nc; k++) {
+    gx += S[2 * k];
+    gy += S[2 * k + 1];
+  }
+  *gap = hypot(gx, gy);
+  return KM_OK;
+}
+
+/* sig with its interior corners turned by delta more (in order). */
+static km_status turn_corners(const km_signature *sig, const double *delta,
+                              km_signature *out, km_error *err) {
+  double L = sig->length;
+  km_corner *cs = malloc((sig->ncorners + 1) * sizeof *cs);
+  if (!cs) return KM_ENOMEM;
+  for (size_t k = 0, m = 0; k < sig->ncorners; k++) {
+    cs[k] = sig->corners[k];
+    if (cs[k].s > 0 && cs[k].s < L) cs[k].turn += delta[m++];
+  }
+  km_status st = km_signature_create(out, L, sig->start, sig->angle,
+                                     &sig->kappa, cs, sig->ncorners,
+                                     sig->closed, err);
+  free(cs);
+  return st;
+}
+
+/* The closure's residual G = integral of e^(i (theta + psi)) over the
+ * nodes and its Jacobian J in the coefficients c; true when poll says
+ * stop (G and J then unusable). */
+static bool closure_residual(const qnode *q, size_t nq, double h,
+                             const double *c, double G[2], double J[2][NF],
+                             km__poll *poll) {
+  G[0] = G[1] = 0.0;
+  memset(J, 0, 2 * sizeof *J);
+  for (size_t n = 0; n < nq; n++) {
+    if ((n & 255) == 0 && km__poll_stop(poll, 512)) return true;
+    double u = q[n].s / h, th = q[n].theta;
+    int i0 = (int)floor(u) - 3;
+    double bv[4];
+    for (int k = 0; k < 4; k++) {
+      int i = i0 + k;
+      bv[k] = (i >= 0 && i < NF) ? km__bspline3(u - i) : 0.0;
+      th += (i >= 0 && i < NF) ? c[i] * bv[k] : 0.0;
     }
-    *gap0 = hypot(gx, gy);
-    if (*gap0 <= 1e-12 * L) {
-      /* closed already: either closure would change nothing */
-      free(S);
-      if (used_corners) *used_corners = by_corners;
-      st = km_signature_copy(out, sig, err);
-      goto done;
+    double cs = cos(th), sn = sin(th);
+    G[0] += q[n].w * cs;
+    G[1] += q[n].w * sn;
+    for (int k = 0; k < 4; k++) {
+      int i = i0 + k;
+      if (i < 0 || i >= NF) continue;
+      J[0][i] -= q[n].w * sn * bv[k];
+      J[1][i] += q[n].w * cs * bv[k];
     }
   }
-  if (by_corners && km__close_by_corners(S, tau, nc, delta)) {
-    km_corner *cs = malloc((sig->ncorners + 1) * sizeof *cs);
-    if (!cs) {
-      free(S);
-      st = KM_ENOMEM;
-      goto done;
-    }
-    for (size_t k = 0, m = 0; k < sig->ncorners; k++) {
-      cs[k] = sig->corners[k];
-      if (cs[k].s > 0 && cs[k].s < L) cs[k].turn += delta[m++];
-    }
-    free(S);
-    st = km_signature_create(out, L, sig->start, sig->angle, &sig->kappa, cs,
-                             sig->ncorners, sig->closed, err);
-    free(cs);
-    if (used_corners) *used_corners = st == KM_OK;
-    goto done;
+  return false;
+}
+
+/* One Gauss-Newton step of c in the metric M: with project, the
+ * projection (the least change of curvature that meets the linearised
+ * constraints), else a minimum-norm step (quadratic convergence); as in
+ * morph_plan_frame.c. False when a system is singular. */
+static bool closure_step(const double *M, double J[2][NF], const double G[2],
+                         bool project, double *c) {
+  double Y[2][NF];
+  for (int r = 0; r < 2; r++) {
+    double A[NF * NF];
+    memcpy(A, M, sizeof A);
+    memcpy(Y[r], J[r], sizeof Y[r]);
+    if (!km__solve_dense(A, Y[r], NF)) return false;
   }
-  free(S);
-  /* the metric: Gram matrix of the basis derivatives in s (see
-   * morph_plan.c) */
-  double M[NF * NF];
+  double S2[4] = {0, 0, 0, 0};
+  for (int r = 0; r < 2; r++)
+    for (int k = 0; k < 2; k++)
+      for (int i = 0; i < NF; i++) S2[r * 2 + k] += J[r][i] * Y[k][i];
+  double rhs[2];
+  for (int r = 0; r < 2; r++) {
+    rhs[r] = -G[r];
+    if (project)
+      for (int i = 0; i < NF; i++) rhs[r] += J[r][i] * c[i];
+  }
+  if (!km__solve_dense(S2, rhs, 2)) return false;
+  for (int i = 0; i < NF; i++)
+    c[i] = (project ? 0.0 : c[i]) + Y[0][i] * rhs[0] + Y[1][i] * rhs[1];
+  return true;
+}
+
+/* The coefficients c of psi (from zero) that close the frame to 1e-12 of
+ * its length L, in the metric of the basis derivatives in s (weighted by
+ * weights when not NULL). */
+static km_status closure_coefficients(const qnode *q, size_t nq, double L,
+                                      const double *weights, double *c,
+                                      km__poll *poll) {
+  double h = L / NB, M[NF * NF];
   if (weights)
     km__closure_metric_weighted(weights, M);
   else
     km__closure_metric(M);
   for (int i = 0; i < NF * NF; i++) M[i] /= h;
   for (int it = 0;; it++) {
-    double G[2] = {0, 0}, J[2][NF];
-    memset(J, 0, sizeof J);
-    for (size_t n = 0; n < nq; n++) {
-      if ((n & 255) == 0 && km__poll_stop(poll, 512)) {
-        st = KM_ECANCELLED;
-        goto done;
-      }
-      double u = q[n].s / h, th = q[n].theta;
-      int i0 = (int)floor(u) - 3;
-      double bv[4];
-      for (int k = 0; k < 4; k++) {
-        int i = i0 + k;
-        bv[k] = (i >= 0 && i < NF) ? km__bspline3(u - i) : 0.0;
-        th += (i >= 0 && i < NF) ? c[i] * bv[k] : 0.0;
-      }
-      double cs = cos(th), sn = sin(th);
-      G[0] += q[n].w * cs;
-      G[1] += q[n].w * sn;
-      for (int k = 0; k < 4; k++) {
-        int i = i0 + k;
-        if (i < 0 || i >= NF) continue;
-        J[0][i] -= q[n].w * sn * bv[k];
-        J[1][i] += q[n].w * cs * bv[k];
-      }
-    }
-    if (hypot(G[0], G[1]) <= 1e-12 * L) break;
-    if (it == 40) {
-      st = KM_ENOCONVERGE;
-      goto done;
-    }
-    /* Gauss-Newton in the metric M: project once (the least change of
-     * curvature that meets the linearised constraints), then minimum-norm
-     * steps (quadratic convergence); as in morph_plan.c */
-    bool project = it == 0;
-    double Y[2][NF];
-    for (int r = 0; r < 2; r++) {
-      double A[NF * NF];
-      memcpy(A, M, sizeof A);
-      memcpy(Y[r], J[r], sizeof Y[r]);
-      if (!km__solve_dense(A, Y[r], NF)) {
-        st = KM_ENOCONVERGE;
-        goto done;
-      }
-    }
-    double S2[4] = {0, 0, 0, 0};
-    for (int r = 0; r < 2; r++)
-      for (int k = 0; k < 2; k++)
-        for (int i = 0; i < NF; i++) S2[r * 2 + k] += J[r][i] * Y[k][i];
-    double rhs[2];
-    for (int r = 0; r < 2; r++) {
-      rhs[r] = -G[r];
-      if (project)
-        for (int i = 0; i < NF; i++) rhs[r] += J[r][i] * c[i];
-    }
-    if (!km__solve_dense(S2, rhs, 2)) {
-      st = KM_ENOCONVERGE;
-      goto done;
-    }
-    for (int i = 0; i < NF; i++)
-      c[i] = (project ? 0.0 : c[i]) + Y[0][i] * rhs[0] + Y[1][i] * rhs[1];
+    double G[2], J[2][NF];
+    if (closure_residual(q, nq, h, c, G, J, poll)) return KM_ECANCELLED;
+    if (hypot(G[0], G[1]) <= 1e-12 * L) return KM_OK;
+    if (it == 40) return KM_ENOCONVERGE;
+    if (!closure_step(M, J, G, it == 0, c)) return KM_ENOCONVERGE;
   }
-  /* kappa~ = kappa + psi' (psi' is quadratic on each basis interval) */
-  st = km__pp_alloc(&dpsi, 2, NB);
+}
+
+/* sig with kappa~ = kappa + psi' (psi' is quadratic on each basis
+ * interval, so exact in Bernstein form from three values). */
+static km_status add_correction(const km_signature *sig, const double *c,
+                                km_signature *out, km_error *err) {
+  double L = sig->length, h = L / NB;
+  km_pp dpsi, k0, kt;
+  km__pp_init(&dpsi);
+  km__pp_init(&k0);
+  km__pp_init(&kt);
+  km_fn kf;
+  km_fn_init(&kf);
+  km_status st = km__pp_alloc(&dpsi, 2, NB);
   if (st) goto done;
   for (int iv = 0; iv < NB; iv++) {
     double f[3];
@@ -392,25 +388,52 @@ km_status km__close_lsq(const km_signature *sig, bool by_corners,
     dpsi.x[iv] = iv * h;
   }
   dpsi.x[NB] = L;
-  km_pp k0;
-  km__pp_init(&k0);
   st = km__pp_from_fn(&k0, &sig->kappa);
   if (!st) st = km__pp_blend(&kt, &k0, 1.0, &dpsi, 1.0, 0.0, L);
-  km__pp_free(&k0);
-  if (st) goto done;
-  km_fn kf;
-  km_fn_init(&kf);
-  st = km__pp_to_fn(&kf, &kt);
-  if (st) goto done;
-  st = km_signature_create(out, L, sig->start, sig->angle, &kf, sig->corners,
-                           sig->ncorners, sig->closed, err);
+  if (!st) st = km__pp_to_fn(&kf, &kt);
+  if (!st)
+    st = km_signature_create(out, L, sig->start, sig->angle, &kf, sig->corners,
+                             sig->ncorners, sig->closed, err);
+done:
   km_fn_free(&kf);
+  km__pp_free(&dpsi);
+  km__pp_free(&k0);
+  km__pp_free(&kt);
+  return st;
+}
+
+/* The closure by the corners, else by psi (see the DESIGN note). */
+km_status km__close_lsq(const km_signature *sig, bool by_corners,
+                        const double *weights, km_signature *out,
+                        double *gap0, bool *used_corners, km__poll *poll,
+                        km_error *err) {
+  double L = sig->length, c[NF] = {0};
+  km_pp kp, tp;
+  km__pp_init(&kp);
+  km__pp_init(&tp);
+  qnode *q = NULL;
+  size_t nq = 0;
+  stretches sc = {NULL, NULL, NULL, 0};
+  km_status st = km__build_theta(sig, &kp, &tp);
+  if (!st) st = closure_nodes(&kp, &tp, L / NB, poll, &q, &nq);
+  if (!st) st = stretch_sums(sig, q, nq, &sc, gap0);
+  if (st) goto done;
+  if (*gap0 <= 1e-12 * L) {
+    /* closed already: either closure would change nothing */
+    if (used_corners) *used_corners = by_corners;
+    st = km_signature_copy(out, sig, err);
+  } else if (by_corners && km__close_by_corners(sc.S, sc.tau, sc.nc, sc.delta)) {
+    st = turn_corners(sig, sc.delta, out, err);
+    if (used_corners) *used_corners = st == KM_OK;
+  } else {
+    st = closure_coefficients(q, nq, L, weights, c, poll);
+    if (!st) st = add_correction(sig, c, out, err);
+  }
 done:
   free(q);
+  free(sc.S);
   km__pp_free(&kp);
   km__pp_free(&tp);
-  km__pp_free(&dpsi);
-  km__pp_free(&kt);
   if (st == KM_ECANCELLED) return km__stopped(err);
   if (st == KM_ENOMEM || st == KM_ENOCONVERGE || st == KM_ELIMIT)
     km__fail(err, st, KM_FIELD_NONE, -1, NAN,
