@@ -2,14 +2,20 @@
  *
  * One copy of each: the knot-span search and the cubic B-spline basis
  * (kernels.c), the dense solver, the Bernstein basis, the comparison of
- * doubles for qsort and the FFT (linalg.c). Every function here is pure:
- * it reads its arguments and writes only the arrays it is given.
+ * doubles for qsort and the FFT (linalg.c), Gauss-Legendre rules,
+ * adaptive quadrature and angle wrapping (status.c, curve.c), the
+ * spectral integral at the signature's nodes (signature_theta.c) and a
+ * fast sin and cos. Every function here is pure: it reads its arguments
+ * and writes only the arrays it is given.
  */
 #ifndef KM_KERNELS_H
 #define KM_KERNELS_H
 
+#include <math.h>
 #include <stdbool.h>
 #include <stddef.h>
+
+#define KM_PI 3.14159265358979323846
 
 /* Span index i in [p, n - 1] with U[i] <= u < U[i+1], for the knot vector
  * U[0 .. n + p] of n control points of degree p (non-decreasing knots,
@@ -40,5 +46,56 @@ int km__cmp_double(const void *a, const void *b);
  * the n/2 twiddles e^(-2 pi i k / n) from km__fft_twiddles (2 per k). */
 void km__fft_twiddles(int n, double *tw);
 void km__fft(double *re, double *im, int n, const double *tw, bool inverse);
+
+/* Gauss-Legendre rules on [-1, 1]. */
+extern const double km__gl8_x[8], km__gl8_w[8];
+extern const double km__gl16_x[16], km__gl16_w[16];
+
+/* Adaptive Gauss-Legendre (8 vs 16 points, bisection) of f over [a, b];
+ * NaN when the precision cannot be reached within a fixed amount of work
+ * (an integrand that is rounding noise, or nearly singular), so that no
+ * caller reports a length less precise than it promises. */
+typedef double (*km__scalar_fn)(const void *ctx, double t);
+double km__integrate_adaptive(km__scalar_fn f, const void *ctx, double a,
+                              double b, double abs_tol);
+
+/* F[k] = integral from -1 to x_k of the degree-14 interpolant of f at the
+ * 15 Chebyshev-Lobatto points x_k = -cos(k pi / 14) of [-1, 1] (the
+ * signature's nodes). */
+void km__cheb_cumulative15(const double *f, double *F);
+
+/* Wrap an angle to (-pi, pi]. */
+double km__wrap_angle(double a);
+
+/* sin x and cos x together, for the innermost loops of morph frames (one
+ * pair per quadrature node): x - n pi/2 by a three-part split of pi/2
+ * (33 + 33 + 53 bits, so n times each leading part is exact for |n| <
+ * 2^20), then the Taylor series of sin and cos on |r| <= pi/4 to r^17 and
+ * r^18, whose remainders are below 1e-19. Agrees with libm to a few units
+ * in the last place (tests/core/test_numerics.c); |x| >= 1e5 goes to libm. */
+static inline void km__sincos(double x, double *sn, double *cs) {
+  if (!(fabs(x) < 1e5)) {
+    *sn = sin(x);
+    *cs = cos(x);
+    return;
+  }
+  const double shift = 6755399441055744.0; /* 1.5 * 2^52: rounds to an integer */
+  double n = (x * 0.6366197723675814 + shift) - shift;
+  double r = ((x - n * 1.5707963267341256) - n * 6.077100506303966e-11) -
+             n * 2.0222662487959506e-21;
+  double z = r * r;
+  double sr = r + r * z * (-1.0 / 6 + z * (1.0 / 120 + z * (-1.0 / 5040 +
+              z * (1.0 / 362880 + z * (-1.0 / 39916800 + z * (1.0 / 6227020800.0 +
+              z * (-1.0 / 1307674368000.0 + z * (1.0 / 355687428096000.0))))))));
+  double cr = 1.0 + z * (-0.5 + z * (1.0 / 24 + z * (-1.0 / 720 + z * (1.0 / 40320 +
+              z * (-1.0 / 3628800 + z * (1.0 / 479001600 + z * (-1.0 / 87178291200.0 +
+              z * (1.0 / 20922789888000.0 + z * (-1.0 / 6402373705728000.0)))))))));
+  switch ((long)n & 3) {
+  case 0: *sn = sr; *cs = cr; break;
+  case 1: *sn = cr; *cs = -sr; break;
+  case 2: *sn = -sr; *cs = -cr; break;
+  default: *sn = -cr; *cs = sr; break;
+  }
+}
 
 #endif

@@ -13,7 +13,7 @@
 
 #include "internal.h"
 #include "km/limits.h"
-#include "signature_internal.h"
+#include "signature_builder.h"
 
 /* cos(m pi / 14), m = 0..14: the Chebyshev-Lobatto abscissae of
  * KM__THETA_NODES = 15 points */

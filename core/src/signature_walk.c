@@ -35,7 +35,7 @@
 #include "internal.h"
 #include "km/limits.h"
 #include "km/signature.h"
-#include "signature_internal.h"
+#include "signature_builder.h"
 
 #define SPAN_CACHE 20000 /* spans kept in Bezier form */
 
