@@ -103,6 +103,20 @@ static inline void at_problem(api_route route, const char *body, int status,
   cJSON_Delete(at_expect_problem(route, body, status, pointer));
 }
 
+/* The answer to body must be 200 with a JSON body; returns it parsed
+ * (caller deletes), printing the body when the status is not 200. */
+static inline cJSON *at_expect_json(api_route route, const char *body) {
+  api_response res;
+  cJSON *j = NULL;
+  int st = at_call(route, body, &res, &j);
+  if (st != 200)
+    print_error("status %d: %s\n", st, res.body);
+  assert_int_equal(st, 200);
+  assert_string_equal(res.content_type, "application/json");
+  api_response_free(&res);
+  return j;
+}
+
 /* Appending formatted text to a growing malloc'd buffer. */
 typedef struct at_buf {
   char *s;

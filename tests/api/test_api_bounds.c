@@ -16,17 +16,6 @@
 
 /* ---- stop conditions ---- */
 
-typedef struct countdown {
-  long left;  /* answers "go on" this many times, then "stop" */
-  long asked; /* questions asked */
-} countdown;
-
-static bool countdown_stop(void *ctx) {
-  countdown *c = ctx;
-  c->asked++;
-  return c->left-- <= 0;
-}
-
 static int call_with_stop(api_route route, const char *body, countdown *cd,
                           api_response *res) {
   api_config cfg;
@@ -219,8 +208,8 @@ static void prediction_bounds_the_real_answer(void **state) {
       ",\"frames\":9,\"format\":\"svg\"",
       ",\"frames\":9,\"format\":\"svg\",\"svg\":{\"layout\":\"overlay\"}",
       ",\"frames\":9,\"format\":\"svg\",\"svg\":{\"layout\":\"animate\"}",
-      ",\"frames\":4,\"format\":\"svg\",\"svg\":{\"layout\":"
-      "\"curvature_plot\"}",
+      (",\"frames\":4,\"format\":\"svg\",\"svg\":{\"layout\":"
+       "\"curvature_plot\"}"),
   };
   for (size_t k = 0; k < sizeof extras / sizeof extras[0]; k++) {
     char *body = morph_body(40, extras[k]);

@@ -138,15 +138,7 @@ static char *circles_request(double r0, double r1, const char *extra) {
 }
 
 static cJSON *morph_ok(const char *body) {
-  api_response res;
-  cJSON *j = NULL;
-  int st = at_call(MORPH, body, &res, &j);
-  if (st != 200)
-    print_error("status %d: %s\n", st, res.body);
-  assert_int_equal(st, 200);
-  assert_string_equal(res.content_type, "application/json");
-  api_response_free(&res);
-  return j;
+  return at_expect_json(MORPH, body);
 }
 
 static double metric(const cJSON *frame, const char *key) {

@@ -29,13 +29,7 @@ static char *request_for(const char *name, double tol, int degree) {
 
 /* Reconstruct and return the output curve and bound. */
 static cJSON *reconstruct(const char *body, at_curve *c, double *bound) {
-  api_response res;
-  cJSON *j = NULL;
-  int st = at_call(API_ROUTE_RECONSTRUCT, body, &res, &j);
-  if (st != 200)
-    print_error("status %d: %s\n", st, res.body);
-  assert_int_equal(st, 200);
-  api_response_free(&res);
+  cJSON *j = at_expect_json(API_ROUTE_RECONSTRUCT, body);
   at_curve_from_json(cJSON_GetObjectItemCaseSensitive(j, "curve"), c);
   const cJSON *eb = cJSON_GetObjectItemCaseSensitive(j, "error_bound");
   assert_true(cJSON_IsNumber(eb));

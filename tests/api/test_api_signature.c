@@ -6,15 +6,7 @@
 #include "testmain.h"
 
 static cJSON *signature_of(const char *body) {
-  api_response res;
-  cJSON *j = NULL;
-  int st = at_call(API_ROUTE_SIGNATURE, body, &res, &j);
-  if (st != 200)
-    print_error("status %d: %s\n", st, res.body);
-  assert_int_equal(st, 200);
-  assert_string_equal(res.content_type, "application/json");
-  api_response_free(&res);
-  return j;
+  return at_expect_json(API_ROUTE_SIGNATURE, body);
 }
 
 static double num(const cJSON *o, const char *key) {

@@ -14,14 +14,6 @@
 #include "testutil.h"
 #include "testmain.h"
 
-/* Build a curve that must be valid. */
-static void make_curve(km_curve *c, int p, size_t n, const double *knots,
-                       const double *cp, const double *w, bool closed) {
-  km_error err;
-  km_curve_init(c);
-  assert_status(km_curve_create(c, p, n, knots, cp, w, closed, &err), KM_OK);
-}
-
 /* Max of |a|, |b|, 1: the scale for a relative comparison of vectors. */
 static double scale2(double a, double b) {
   double m = fabs(a) > fabs(b) ? fabs(a) : fabs(b);

@@ -20,6 +20,7 @@
 #include "km/morph.h"
 #include "km/reconstruct.h"
 #include "km/signature.h"
+#include "curvecases.h"
 #include "curvedist.h"
 #include "testutil.h"
 #include "morphutil.h"
@@ -102,13 +103,6 @@ static double *pl_points(const pl_exact *e, size_t n) {
   return p;
 }
 
-static void make_curve(km_curve *c, int p, size_t n, const double *knots,
-                       const double *cp, const double *w, bool closed) {
-  km_error err;
-  km_curve_init(c);
-  assert_status(km_curve_create(c, p, n, knots, cp, w, closed, &err), KM_OK);
-}
-
 /* A random regular open cubic B-spline of n control points. */
 static void random_open_curve(km_curve *c, uint64_t *seed, size_t n, double x,
                               double y, double heading, double step) {
@@ -140,49 +134,7 @@ static void fixture_signature(const char *name, km_signature *sig) {
   tf_analytic_free(&a);
 }
 
-
 /* ---- geometry of results ------------------------------------------------ */
-
-/* Dense samples of a curve: `per` points per knot span, uniform in the
- * parameter, span ends included (corners sit on knots). */
-static double *curve_points(const km_curve *c, size_t per, size_t *np) {
-  size_t spans = 0;
-  for (size_t i = (size_t)c->degree; i < c->n; i++)
-    if (c->knots[i + 1] > c->knots[i]) spans++;
-  double *p = malloc(2 * (spans * per + 1) * sizeof *p);
-  assert_non_null(p);
-  size_t k = 0;
-  for (size_t i = (size_t)c->degree; i < c->n; i++) {
-    double a = c->knots[i], b = c->knots[i + 1];
-    if (!(b > a)) continue;
-    for (size_t j = 0; j < per; j++) {
-      double d[1][2];
-      km_curve_eval(c, a + (b - a) * (double)j / (double)per, 0, d);
-      p[2 * k] = d[0][0];
-      p[2 * k + 1] = d[0][1];
-      k++;
-    }
-  }
-  double t0, t1, d[1][2];
-  km_curve_domain(c, &t0, &t1);
-  km_curve_eval(c, t1, 0, d);
-  p[2 * k] = d[0][0];
-  p[2 * k + 1] = d[0][1];
-  *np = k + 1;
-  return p;
-}
-
-/* Samples per span so that the whole curve gets about `total` points. */
-static size_t per_span(const km_curve *c, size_t total) {
-  size_t spans = 0;
-  for (size_t i = (size_t)c->degree; i < c->n; i++)
-    if (c->knots[i + 1] > c->knots[i]) spans++;
-  size_t per = total / (spans ? spans : 1);
-  return per < 4 ? 4 : per;
-}
-
-
-
 
 /* Two-sided distance between a curve and exact points (a polyline whose
  * chord error is qerr); the curve's own chord error is measured. Returns
@@ -197,38 +149,6 @@ static double trace_distance(const km_curve *c, const double *Q, size_t nq,
   double d2 = directed_dist(Q, nq, P, np) - perr;
   free(P);
   return d1 > d2 ? d1 : d2;
-}
-
-static double curves_distance(const km_curve *a, const km_curve *b) {
-  size_t per = per_span(b, 1500), nq;
-  double *Q = curve_points(b, per, &nq);
-  double d = trace_distance(a, Q, nq, chord_error(b, per));
-  free(Q);
-  return d;
-}
-
-/* Arc-length centroid of a curve by 20-point Gauss-Legendre on 8 panels per
- * knot span, weighted by the speed. */
-static void curve_centroid(const km_curve *c, double out[2]) {
-  double x[20], w[20], L = 0.0, cx = 0.0, cy = 0.0;
-  tu_gauss_legendre(20, x, w);
-  for (size_t i = (size_t)c->degree; i < c->n; i++) {
-    double a = c->knots[i], b = c->knots[i + 1];
-    if (!(b > a)) continue;
-    for (int p = 0; p < 8; p++) {
-      double lo = a + (b - a) * p / 8.0, h = (b - a) / 8.0;
-      for (int k = 0; k < 20; k++) {
-        double d[2][2];
-        km_curve_eval(c, lo + 0.5 * h * (x[k] + 1.0), 1, d);
-        double ds = 0.5 * h * w[k] * hypot(d[1][0], d[1][1]);
-        L += ds;
-        cx += ds * d[0][0];
-        cy += ds * d[0][1];
-      }
-    }
-  }
-  out[0] = cx / L;
-  out[1] = cy / L;
 }
 
 static void curve_end(const km_curve *c, int which, double p[2]) {
@@ -686,8 +606,8 @@ static void end_frames_of_curve_inputs_trace_the_inputs(void **state) {
     frame f0, f1;
     frame_get(m, 0.0, &f0);
     frame_get(m, 1.0, &f1);
-    assert_le(curves_distance(&f0.c, &ca), tol);
-    assert_le(curves_distance(&f1.c, &cb), tol);
+    assert_le(curves_distance(&f0.c, &ca, 1500), tol);
+    assert_le(curves_distance(&f1.c, &cb, 1500), tol);
     frame_free(&f0);
     frame_free(&f1);
     km_morph_free(m);
@@ -1058,22 +978,6 @@ static void anchor_fit_keeps_the_end_frames_where_the_inputs_stand(void **state)
 }
 
 /* ---- errors ------------------------------------------------------------- */
-
-/* every integer written in a message (e.g. "from turns 1 times, to 2") */
-static int message_has_integer(const char *msg, long want) {
-  const char *p = msg;
-  while (*p) {
-    if ((*p >= '0' && *p <= '9') || (*p == '-' && p[1] >= '0' && p[1] <= '9')) {
-      char *end;
-      long v = strtol(p, &end, 10);
-      if (v == want && *end != '.') return 1;
-      p = end;
-    } else {
-      p++;
-    }
-  }
-  return 0;
-}
 
 /* closed circle signature of radius r turning `turns` times (sign =
  * orientation) */

@@ -21,19 +21,13 @@
 #include "km/morph.h"
 #include "km/reconstruct.h"
 #include "km/signature.h"
+#include "curvecases.h"
 #include "curvedist.h"
 #include "testutil.h"
 #include "morphutil.h"
 #include "testmain.h"
 
 /* ---- inputs ------------------------------------------------------------- */
-
-static void make_curve(km_curve *c, int p, size_t n, const double *knots,
-                       const double *cp, const double *w, bool closed) {
-  km_error err;
-  km_curve_init(c);
-  assert_status(km_curve_create(c, p, n, knots, cp, w, closed, &err), KM_OK);
-}
 
 /* constant-curvature closed signature: a circle of radius r through
  * (0, 0) heading +x, counter-clockwise */
@@ -105,84 +99,7 @@ static const char *const PAIRS[6] = {"circle_to_star", "square_to_circle",
                                      "U_to_S",         "spiral_open",
                                      "arrow_rot90",    "crescent_to_heart"};
 
-
 /* ---- geometry ------------------------------------------------------------ */
-
-static size_t spans_of(const km_curve *c) {
-  size_t spans = 0;
-  for (size_t i = (size_t)c->degree; i < c->n; i++)
-    if (c->knots[i + 1] > c->knots[i]) spans++;
-  return spans;
-}
-
-static size_t per_span(const km_curve *c, size_t total) {
-  size_t s = spans_of(c), per = total / (s ? s : 1);
-  return per < 4 ? 4 : per;
-}
-
-/* `per` samples per knot span, uniform in the parameter, plus the end */
-static double *curve_points(const km_curve *c, size_t per, size_t *np) {
-  double *p = malloc(2 * (spans_of(c) * per + 1) * sizeof *p);
-  assert_non_null(p);
-  size_t k = 0;
-  for (size_t i = (size_t)c->degree; i < c->n; i++) {
-    double a = c->knots[i], b = c->knots[i + 1];
-    if (!(b > a)) continue;
-    for (size_t j = 0; j < per; j++) {
-      double d[1][2];
-      km_curve_eval(c, a + (b - a) * (double)j / (double)per, 0, d);
-      p[2 * k] = d[0][0];
-      p[2 * k + 1] = d[0][1];
-      k++;
-    }
-  }
-  double t0, t1, d[1][2];
-  km_curve_domain(c, &t0, &t1);
-  km_curve_eval(c, t1, 0, d);
-  p[2 * k] = d[0][0];
-  p[2 * k + 1] = d[0][1];
-  *np = k + 1;
-  return p;
-}
-
-
-
-
-/* Distance between the traces of two curves, as point sets: each one's
- * samples against the other's polyline, less that polyline's measured chord
- * error. */
-static double curves_distance(const km_curve *a, const km_curve *b) {
-  size_t pa = per_span(a, 1200), pb = per_span(b, 1200), na, nb;
-  double *A = curve_points(a, pa, &na), *B = curve_points(b, pb, &nb);
-  double d1 = directed_dist(A, na, B, nb) - chord_error(b, pb);
-  double d2 = directed_dist(B, nb, A, na) - chord_error(a, pa);
-  free(A);
-  free(B);
-  return d1 > d2 ? d1 : d2;
-}
-
-/* arc-length centroid, 20-point Gauss-Legendre on 8 panels per span */
-static void curve_centroid(const km_curve *c, double out[2]) {
-  double x[20], w[20], L = 0.0, cx = 0.0, cy = 0.0;
-  tu_gauss_legendre(20, x, w);
-  for (size_t i = (size_t)c->degree; i < c->n; i++) {
-    double a = c->knots[i], b = c->knots[i + 1];
-    if (!(b > a)) continue;
-    for (int p = 0; p < 8; p++) {
-      double lo = a + (b - a) * p / 8.0, h = (b - a) / 8.0;
-      for (int k = 0; k < 20; k++) {
-        double d[2][2];
-        km_curve_eval(c, lo + 0.5 * h * (x[k] + 1.0), 1, d);
-        double ds = 0.5 * h * w[k] * hypot(d[1][0], d[1][1]);
-        L += ds;
-        cx += ds * d[0][0];
-        cy += ds * d[0][1];
-      }
-    }
-  }
-  out[0] = cx / L;
-  out[1] = cy / L;
-}
 
 /* position, tangent angle and curvature at the start (side +1) or the end
  * (side -1) of a curve */
@@ -792,7 +709,7 @@ static void fixture_pairs_end_frames_length_and_closure(void **state) {
       assert_rel(f.mt.length, (1 - t) * La + t * Lb, 1e-9);
       if (a.closed) assert_frame_closes(&f, PAIRS[p], t);
       if (t == 0.0 || t == 1.0) {
-        double d = curves_distance(&f.c, t == 0.0 ? &a : &b);
+        double d = curves_distance(&f.c, t == 0.0 ? &a : &b, 1200);
         if (d > tol)
           print_error("%s: frame %g is %.3g from the input (tolerance %.3g)\n",
                       PAIRS[p], t, d, tol);
@@ -908,7 +825,7 @@ static void fixture_pairs_with_auto_matches_degree_5_and_linear(void **state) {
           assert_close(hypot(p1[0] - p0[0], p1[1] - p0[1]), 0.0, 1e-12 * La);
         }
         if (t == 0.0 || t == 1.0) {
-          double d = curves_distance(&f.c, t == 0.0 ? &a : &b);
+          double d = curves_distance(&f.c, t == 0.0 ? &a : &b, 1200);
           if (d > tol)
             print_error("%s, variant %d: frame %g is %.3g from the input "
                         "(tolerance %.3g)\n",
@@ -1170,13 +1087,13 @@ static void reversed_copy_morphs_through_the_shape_itself(void **state) {
   for (int i = 0; i <= 4; i++) {
     frame f;
     frame_get(m, i / 4.0, &f);
-    assert_true(curves_distance(&f.c, &a) <= 2 * tol);
+    assert_true(curves_distance(&f.c, &a, 1200) <= 2 * tol);
     frame_free(&f);
     /* and the planned frame, without metrics */
     km_curve c;
     km_curve_init(&c);
     assert_status(km_morph_frame(m, i / 4.0, &c, NULL, NULL, NULL), KM_OK);
-    assert_true(curves_distance(&c, &a) <= 2 * tol);
+    assert_true(curves_distance(&c, &a, 1200) <= 2 * tol);
     km_curve_free(&c);
   }
   km_morph_free(m);
@@ -1226,22 +1143,6 @@ static void sharp_tips_are_not_counted_as_crossings(void **state) {
   km_morph_free(m);
   km_curve_free(&c[0]);
   km_curve_free(&c[1]);
-}
-
-/* whether an integer stands in a message as a whole number */
-static int message_has_integer(const char *msg, long want) {
-  const char *p = msg;
-  while (*p) {
-    if ((*p >= '0' && *p <= '9') || (*p == '-' && p[1] >= '0' && p[1] <= '9')) {
-      char *end;
-      long v = strtol(p, &end, 10);
-      if (v == want && *end != '.') return 1;
-      p = end;
-    } else {
-      p++;
-    }
-  }
-  return 0;
 }
 
 /* A limacon r = 0.5 + cos(phi) loops twice around its inner loop's

@@ -17,15 +17,9 @@
 #include "km/curve.h"
 #include "km/reconstruct.h"
 #include "km/signature.h"
+#include "curvecases.h"
 #include "testutil.h"
 #include "testmain.h"
-
-static void make_curve(km_curve *c, int p, size_t n, const double *knots,
-                       const double *cp, const double *w, bool closed) {
-  km_error err;
-  km_curve_init(c);
-  assert_status(km_curve_create(c, p, n, knots, cp, w, closed, &err), KM_OK);
-}
 
 /* ---- an exact curve given by its tangent angle ------------------------ */
 

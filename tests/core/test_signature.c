@@ -18,13 +18,6 @@
 #include "testutil.h"
 #include "testmain.h"
 
-static void make_curve(km_curve *c, int p, size_t n, const double *knots,
-                       const double *cp, const double *w, bool closed) {
-  km_error err;
-  km_curve_init(c);
-  assert_status(km_curve_create(c, p, n, knots, cp, w, closed, &err), KM_OK);
-}
-
 /* Signature that must succeed, at tolerance rel * length. */
 static void sign(const km_curve *c, double rel, km_signature *sig) {
   km_error err;

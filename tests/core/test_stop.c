@@ -18,17 +18,8 @@
 
 #include "km/kmorph.h"
 #include "km/stop.h"
+#include "testutil.h"
 #include "testmain.h"
-
-typedef struct countdown {
-  long left, asked;
-} countdown;
-
-static bool countdown_stop(void *ctx) {
-  countdown *c = ctx;
-  c->asked++;
-  return c->left-- <= 0;
-}
 
 /* A closed cubic B-spline of n control points on a wavy circle. */
 static void wavy(km_curve *c, size_t n, int waves, double amp) {

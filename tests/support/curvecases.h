@@ -1,11 +1,24 @@
-/* curvecases.h - curves that more than one test file needs, each with the
- * geometry that makes its expected values exact.
+/* curvecases.h - making curves in the tests: make_curve, and curves that
+ * more than one test file needs, each with the geometry that makes its
+ * expected values exact.
  */
 #ifndef TESTS_CURVECASES_H
 #define TESTS_CURVECASES_H
 
+#include <stdbool.h>
+
 #include "km/curve.h"
 #include "testutil.h"
+
+/* km_curve_create or fail the test: c is initialised first, so the caller
+ * frees it with km_curve_free whatever happened. */
+static inline void make_curve(km_curve *c, int p, size_t n,
+                              const double *knots, const double *cp,
+                              const double *w, bool closed) {
+  km_error err;
+  km_curve_init(c);
+  assert_status(km_curve_create(c, p, n, knots, cp, w, closed, &err), KM_OK);
+}
 
 /* A rational Bezier of degree 9 on the segment from (1e6, 1e6) to
  * (1e6 + 1, 1e6 + 0.5), its first point doubled (a degenerate leg) and its
@@ -32,9 +45,7 @@ static inline void tc_rational_segment_leaving_a_degenerate_leg(km_curve *c,
     cp[2 * i] = 1e6 + xs[i];
     cp[2 * i + 1] = 1e6 + 0.5 * xs[i];
   }
-  km_error err;
-  km_curve_init(c);
-  assert_status(km_curve_create(c, 9, 10, kn, cp, w, false, &err), KM_OK);
+  make_curve(c, 9, 10, kn, cp, w, false);
 }
 
 /* A parabola traced through its vertex as a hairpin: C'(u) = (u - U, E)
@@ -84,11 +95,7 @@ static inline void tc_hairpin(km_curve *c, int degree, double weight,
     kn[i + n] = 1;
     w[i] = weight;
   }
-  km_error err;
-  km_curve_init(c);
-  assert_status(km_curve_create(c, degree, (size_t)n, kn, cp,
-                                weight > 0 ? w : NULL, false, &err),
-                KM_OK);
+  make_curve(c, degree, (size_t)n, kn, cp, weight > 0 ? w : NULL, false);
 }
 
 #endif

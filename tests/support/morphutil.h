@@ -1,9 +1,11 @@
 /* morphutil.h - running a morph in the morph tests: create or fail the
- * test, frames with their metrics and signature (static functions, like
- * testutil.h, which must be included first). */
+ * test, frames with their metrics and signature, integers in error
+ * messages (static functions, like testutil.h, which must be included
+ * first). */
 #ifndef KM_TEST_MORPHUTIL_H
 #define KM_TEST_MORPHUTIL_H
 
+#include <stdlib.h>
 #include <string.h>
 
 #include "km/morph.h"
@@ -39,6 +41,23 @@ static void frame_get(const km_morph *m, double t, frame *f) {
 static void frame_free(frame *f) {
   km_curve_free(&f->c);
   km_signature_free(&f->sig);
+}
+
+/* whether an integer stands in a message as a whole number (e.g. the
+ * turning numbers in "from turns 1 times, to 2") */
+static inline int message_has_integer(const char *msg, long want) {
+  const char *p = msg;
+  while (*p) {
+    if ((*p >= '0' && *p <= '9') || (*p == '-' && p[1] >= '0' && p[1] <= '9')) {
+      char *end;
+      long v = strtol(p, &end, 10);
+      if (v == want && *end != '.') return 1;
+      p = end;
+    } else {
+      p++;
+    }
+  }
+  return 0;
 }
 
 #endif

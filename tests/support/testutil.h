@@ -20,6 +20,7 @@
 #include <cmocka.h>
 #include <math.h>
 #include <signal.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <sys/types.h>
 #include <sys/wait.h>
@@ -278,6 +279,21 @@ static inline int tu_is_regular(int p, size_t n, const double *knots,
 /* Tangent turn from direction (ax, ay) to (bx, by), in (-pi, pi]. */
 static inline double tu_turn(double ax, double ay, double bx, double by) {
   return atan2(ax * by - ay * bx, ax * bx + ay * by);
+}
+
+/* A km_stop condition (countdown_stop with a countdown as its context)
+ * that lets the work go on `left` times, then stops it, counting the
+ * questions: the tests of where long computations stop. Plain C, so it
+ * needs nothing from libkmorph. */
+typedef struct countdown {
+  long left;  /* answers "go on" this many times, then "stop" */
+  long asked; /* questions asked */
+} countdown;
+
+static inline bool countdown_stop(void *ctx) {
+  countdown *c = ctx;
+  c->asked++;
+  return c->left-- <= 0;
 }
 
 /* Run fn(ctx) in a child process bounded by `seconds`, so that a hang or a
