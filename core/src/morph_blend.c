@@ -455,30 +455,44 @@ static void drop_short_pieces(km_pp *p, double h) {
   p->m = q;
 }
 
-/* The blended signature of frame t (before closure), placed at the origin
- * with the blended start angle. */
-km_status km__blend_signature(const km_morph *m, double t,
-                                 km_signature *out, km_error *err) {
-  const km__input *a = &m->in[0], *b = &m->in[1];
-  double La = a->sig.length, Lb = b->sig.length;
-  double Lt = (1 - t) * La + t * Lb;
-  km_pp *segs = calloc(m->nk - 1, sizeof *segs);
-  corner_list cl = {NULL, 0, 0};
-  km_pp whole;
-  km__pp_init(&whole);
-  km_status st = segs ? KM_OK : KM_ENOMEM;
-  double S = 0.0;
+/* Corners of both inputs on segment k of frame t (at [S, S + l] of the
+ * frame, la and lb long on the inputs; a point of the frame when
+ * point), weighted by the blend. */
+static km_status segment_corners(const km_morph *m, double t, size_t k,
+                                 double S, double l, double la, double lb,
+                                 bool point, corner_list *cl) {
+  double cwa = m->opt.blend == KM_BLEND_PAPER ? (1 - t) * corner_scale(l, la) : (1 - t);
+  double cwb = m->opt.blend == KM_BLEND_PAPER ? t * corner_scale(l, lb) : t;
+  km_status st = KM_OK;
+  for (int w = 0; w < 2 && !st; w++) {
+    const km__input *in = &m->in[w];
+    double L = in->sig.length, r0 = w ? m->rb[k] : m->ra[k], r1 = w ? m->rb[k + 1] : m->ra[k + 1];
+    double cw = w ? cwb : cwa;
+    if (cw == 0) continue;
+    for (size_t i = 0; i < in->sig.ncorners && !st; i++) {
+      double r = in->sig.corners[i].s / L;
+      bool last = k + 2 == m->nk;
+      if (r < r0 || r > r1 || (r == r1 && !last) ) continue;
+      double turn = cw * in->sig.corners[i].turn;
+      if (turn >= KM_PI) turn = KM_PI - 1e-9;
+      if (turn <= -KM_PI) turn = -KM_PI + 1e-9;
+      st = corner_push(cl, point ? S : S + (r - r0) / (r1 - r0) * l, turn);
+    }
+  }
+  return st;
+}
+
+/* The frame's curvature pieces (*whole) and corners (into cl) under the
+ * piecewise-linear correspondence, segment by segment (segs: room for
+ * nk - 1 of them, initialised; the caller frees them). */
+static km_status blend_linear(const km_morph *m, double t, km_pp *segs,
+                              km_pp *whole, corner_list *cl) {
+  double La = m->in[0].sig.length, Lb = m->in[1].sig.length;
+  double Lt = (1 - t) * La + t * Lb, S = 0.0;
   size_t total = 0;
   int deg = 0;
-  bool smooth = false;
-  if (!st && m->nk > 2 && t > 0 && t < 1) {
-    km_status ss = blend_smooth(m, t, &whole, &cl);
-    if (ss == KM_OK)
-      smooth = true;
-    else if (ss != KM_EINVAL)
-      st = ss;
-  }
-  for (size_t k = 0; !st && !smooth && k + 1 < m->nk; k++) {
+  km_status st = KM_OK;
+  for (size_t k = 0; !st && k + 1 < m->nk; k++) {
     double la = (m->ra[k + 1] - m->ra[k]) * La, lb = (m->rb[k + 1] - m->rb[k]) * Lb;
     double l = (1 - t) * la + t * lb;
     /* a segment shorter than the frame resolves (a match next to an end or
@@ -492,63 +506,69 @@ km_status km__blend_signature(const km_morph *m, double t,
       total += segs[k].m;
       if (segs[k].degree > deg) deg = segs[k].degree;
     }
-    /* corners of both inputs inside this segment */
-    double cwa = m->opt.blend == KM_BLEND_PAPER ? (1 - t) * corner_scale(l, la) : (1 - t);
-    double cwb = m->opt.blend == KM_BLEND_PAPER ? t * corner_scale(l, lb) : t;
-    for (int w = 0; w < 2 && !st; w++) {
-      const km__input *in = w ? b : a;
-      double L = w ? Lb : La, r0 = w ? m->rb[k] : m->ra[k], r1 = w ? m->rb[k + 1] : m->ra[k + 1];
-      double cw = w ? cwb : cwa;
-      if (cw == 0) continue;
-      for (size_t i = 0; i < in->sig.ncorners && !st; i++) {
-        double r = in->sig.corners[i].s / L;
-        bool last = k + 2 == m->nk;
-        if (r < r0 || r > r1 || (r == r1 && !last) ) continue;
-        double turn = cw * in->sig.corners[i].turn;
-        if (turn >= KM_PI) turn = KM_PI - 1e-9;
-        if (turn <= -KM_PI) turn = -KM_PI + 1e-9;
-        st = corner_push(&cl, point ? S : S + (r - r0) / (r1 - r0) * l, turn);
-      }
-    }
+    st = segment_corners(m, t, k, S, l, la, lb, point, cl);
     S += l;
   }
-  if (!st && !smooth) st = km__pp_alloc(&whole, deg, total);
-  if (!st && !smooth) {
-    size_t q = 0;
-    for (size_t k = 0; k + 1 < m->nk; k++) {
-      for (size_t i = 0; i < segs[k].m; i++, q++) {
-        whole.x[q] = segs[k].x[i];
-        km__bern_elevate(segs[k].c + i * (size_t)(segs[k].degree + 1),
-                         segs[k].degree, deg, whole.c + q * (size_t)(deg + 1));
-      }
+  if (!st) st = km__pp_alloc(whole, deg, total);
+  if (st) return st;
+  size_t q = 0;
+  for (size_t k = 0; k + 1 < m->nk; k++) {
+    for (size_t i = 0; i < segs[k].m; i++, q++) {
+      whole->x[q] = segs[k].x[i];
+      km__bern_elevate(segs[k].c + i * (size_t)(segs[k].degree + 1),
+                       segs[k].degree, deg, whole->c + q * (size_t)(deg + 1));
     }
-    whole.x[0] = 0.0;
-    whole.x[total] = Lt;
   }
-  if (segs)
-    for (size_t k = 0; k + 1 < m->nk; k++) km__pp_free(&segs[k]);
-  free(segs);
-  if (st) goto done;
-  /* merge corners at the same place */
-  if (cl.n > 1) qsort(cl.c, cl.n, sizeof *cl.c, km__cmp_corner);
+  whole->x[0] = 0.0;
+  whole->x[total] = Lt;
+  return KM_OK;
+}
+
+/* Corners at the same place (within 1e-12 Lt) merged, clamped below a
+ * half turn and those of no turn dropped; returns how many stay. */
+static size_t merge_corners(corner_list *cl, double Lt) {
+  if (cl->n > 1) qsort(cl->c, cl->n, sizeof *cl->c, km__cmp_corner);
   size_t nc = 0;
-  for (size_t i = 0; i < cl.n; i++) {
-    if (cl.c[i].s > Lt) cl.c[i].s = Lt;
-    if (nc > 0 && cl.c[i].s - cl.c[nc - 1].s <= 1e-12 * Lt)
-      cl.c[nc - 1].turn += cl.c[i].turn;
+  for (size_t i = 0; i < cl->n; i++) {
+    if (cl->c[i].s > Lt) cl->c[i].s = Lt;
+    if (nc > 0 && cl->c[i].s - cl->c[nc - 1].s <= 1e-12 * Lt)
+      cl->c[nc - 1].turn += cl->c[i].turn;
     else
-      cl.c[nc++] = cl.c[i];
+      cl->c[nc++] = cl->c[i];
   }
   /* the paper blend's deltas are clamped below a half turn one by one;
    * two at one place (where a segment of one input has almost no length
    * and scales its corners past any bound) must not sum beyond it */
   for (size_t i = 0; i < nc; i++)
-    cl.c[i].turn = fmax(fmin(cl.c[i].turn, KM_PI - 1e-9), -KM_PI + 1e-9);
+    cl->c[i].turn = fmax(fmin(cl->c[i].turn, KM_PI - 1e-9), -KM_PI + 1e-9);
   size_t keep = 0;
   for (size_t i = 0; i < nc; i++)
-    if (fabs(cl.c[i].turn) > 1e-15) cl.c[keep++] = cl.c[i];
+    if (fabs(cl->c[i].turn) > 1e-15) cl->c[keep++] = cl->c[i];
+  return keep;
+}
+
+km_status km__blend_signature(const km_morph *m, double t, km_signature *out,
+                              km_error *err) {
+  const km__input *a = &m->in[0], *b = &m->in[1];
+  double Lt = (1 - t) * a->sig.length + t * b->sig.length;
+  km_pp *segs = calloc(m->nk - 1, sizeof *segs);
+  corner_list cl = {NULL, 0, 0};
+  km_pp whole;
+  km__pp_init(&whole);
   km_fn kf;
   km_fn_init(&kf);
+  km_status st = segs ? KM_OK : KM_ENOMEM;
+  bool smooth = false;
+  if (!st && m->nk > 2 && t > 0 && t < 1) {
+    km_status ss = blend_smooth(m, t, &whole, &cl);
+    if (ss == KM_OK)
+      smooth = true;
+    else if (ss != KM_EINVAL)
+      st = ss;
+  }
+  if (!st && !smooth) st = blend_linear(m, t, segs, &whole, &cl);
+  if (st) goto done;
+  size_t keep = merge_corners(&cl, Lt);
   drop_short_pieces(&whole, SHORT_PIECE * Lt);
   st = km__pp_to_fn(&kf, &whole);
   if (st) goto done;
@@ -557,8 +577,11 @@ km_status km__blend_signature(const km_morph *m, double t,
   double origin[2] = {0, 0};
   st = km_signature_create(out, Lt, origin, (1 - t) * phia + t * phib, &kf,
                            cl.c, keep, m->closed, err);
-  km_fn_free(&kf);
 done:
+  if (segs)
+    for (size_t k = 0; k + 1 < m->nk; k++) km__pp_free(&segs[k]);
+  free(segs);
+  km_fn_free(&kf);
   km__pp_free(&whole);
   free(cl.c);
   if (st == KM_ENOMEM) km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
