@@ -93,6 +93,17 @@ static inline bool api__stopped(api_ctx *ctx) {
                    "the computation was stopped before it finished");
 }
 
+/* The value of the hexadecimal digit c, or -1 when c is none. */
+static inline int api__hexval(int c) {
+  if (c >= '0' && c <= '9')
+    return c - '0';
+  if (c >= 'a' && c <= 'f')
+    return c - 'a' + 10;
+  if (c >= 'A' && c <= 'F')
+    return c - 'A' + 10;
+  return -1;
+}
+
 /* A request's stop as the core takes it; NULL when it has none. */
 static inline const km_stop *api__km_stop(const api_request *req,
                                           km_stop *buf) {
@@ -214,6 +225,16 @@ bool api__point(api_ctx *ctx, const cJSON *v, const char *ptr,
 /* Member must exist (422 "is required" otherwise). */
 const cJSON *api__require(api_ctx *ctx, const cJSON *obj, const char *base,
                           const char *key);
+/* "a number", "an array"... for messages; "nothing" for NULL. */
+const char *api__type_name(const cJSON *v);
+/* The "knots" member of obj (at base) of a curve (kind API_KIND_CURVE) or
+ * a kappa function (API_KIND_SIGNATURE) of ncoef control points or
+ * coefficients: present, numbers, ncoef + degree + 1 of them, never
+ * decreasing, the problem naming the knot at fault; *knots malloc'd,
+ * caller frees. */
+bool api__read_knots(api_ctx *ctx, const cJSON *obj, const char *base,
+                     size_t ncoef, long degree, api_kind kind,
+                     double **knots, size_t *nk);
 
 /* ---- curves and signatures from JSON ---- */
 
