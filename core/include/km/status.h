@@ -4,7 +4,10 @@
  * failure) and, when given a non-NULL km_error, fills it with the code, the
  * input field and element at fault, and a fixed-size message. The record
  * lives in the caller's memory: no heap (out-of-memory stays reportable), no
- * global (thread-safe).
+ * global (thread-safe). It is written by a call that fails and is to be
+ * read only then; on success its contents are unspecified. Each function's
+ * comment lists the statuses it returns and what field, index and param
+ * then name.
  */
 #ifndef KM_STATUS_H
 #define KM_STATUS_H
@@ -71,7 +74,9 @@ typedef struct km_error {
   char message[KM_ERROR_MESSAGE_MAX];
 } km_error;
 
-/* Name of a status ("KM_ECUSP") and its default message; static strings. */
+/* Name of a status ("KM_ECUSP") and its default message (the table above):
+ * static strings, never NULL, safe from any thread. A value not in the
+ * table gives "KM_UNKNOWN" and "unknown status". */
 const char *km_status_name(km_status s);
 const char *km_status_message(km_status s);
 
