@@ -6,6 +6,12 @@
  * Hermite B-spline in the arc-length parameter (degree 3: C1, degree 5: C2)
  * whose pieces are chosen so a rigorous a-priori bound on the distance to
  * the exact curve stays within the tolerance.
+ *
+ * The signature given must be a valid one (made by km_signature_create or
+ * km_signature_compute; it is not checked again). The point of the exact
+ * curve at one arc length is km_signature_point (km/signature.h). The
+ * conventions of km/kmorph.h hold; the curve made follows the inputs, as
+ * it is not of the signature's type.
  */
 #ifndef KM_RECONSTRUCT_H
 #define KM_RECONSTRUCT_H
@@ -14,21 +20,32 @@
 #include "km/signature.h"
 #include "km/stop.h"
 
-/* Reconstruct sig as a B-spline of degree 3 or 5 (else KM_EDEGREE) within
- * tol (tol <= 0: 1e-5 * length). Corners become knots of multiplicity
- * `degree`. The curve's parameter is arc length of the exact curve at its
- * knots. *error_bound (may be NULL) receives an upper bound on the
- * distance between the result and the exact curve at equal s; it is never
- * smaller than the true error. out->closed is set when sig->closed and the
- * exact curve closes to within tol (then the last point is made equal to
- * the first). */
+/* Reconstruct sig as a B-spline of degree 3 or 5 within tol, a distance
+ * (tol <= 0 or NaN: 1e-5 * length; raised to at least
+ * KM_MIN_RELATIVE_TOLERANCE * length). Corners become knots of
+ * multiplicity `degree`. The curve's parameter is arc length of the exact
+ * curve at its knots.
+ *   out          (out) the curve, owned by the caller (km_curve_free).
+ *                out->closed is set when sig->closed and the exact curve
+ *                closes to within tol (then the last point is made equal
+ *                to the first).
+ *   error_bound  (out, may be NULL) an upper bound on the distance
+ *                between out and the exact curve at equal s; never
+ *                smaller than the true error.
+ * Returns KM_OK, KM_EDEGREE (degree not 3 or 5; KM_FIELD_DEGREE),
+ * KM_ELIMIT (more output pieces than KM_MAX_OUTPUT_PIECES beyond two per
+ * piece of sig, or than KM_MAX_PIECES; KM_FIELD_TOLERANCE: a looser
+ * tolerance helps), KM_EINVAL (an internal inconsistency building the
+ * B-spline: a bug, never expected), KM_ENOMEM. */
 km_status km_reconstruct(const km_signature *sig, int degree, double tol,
                          km_curve *out, double *error_bound, km_error *err);
 
-/* km_reconstruct with at most max_points control points in the result
- * (0: the core's own bound, KM_MAX_OUTPUT_PIECES beyond two pieces per
- * piece of sig): more fails with KM_ELIMIT on the tolerance before the
- * curve is built. The service holds answers to its limit on curves. */
+/* km_reconstruct with the result's control points bounded by max_points
+ * (0: the core's own bound alone): a curve needing more fails with
+ * KM_ELIMIT (KM_FIELD_TOLERANCE) before it is built. The bound is counted
+ * as `degree` points per output piece, and the first piece has one more,
+ * so a result may have max_points + 1 points. The service holds answers
+ * to its limit on curves this way. Statuses as km_reconstruct. */
 km_status km_reconstruct_within(const km_signature *sig, int degree, double tol,
                                 size_t max_points, km_curve *out,
                                 double *error_bound, km_error *err);
@@ -36,15 +53,10 @@ km_status km_reconstruct_within(const km_signature *sig, int degree, double tol,
 /* km_reconstruct_within that ends early when stop (km/stop.h; NULL:
  * never) asks it to: then KM_ECANCELLED, *out and *error_bound untouched,
  * nothing leaked. Polled every KM_STOP_POLL_UNITS units of work (an output
- * piece planned, a quadrature node). */
+ * piece planned, a quadrature node). Other statuses as km_reconstruct. */
 km_status km_reconstruct_until(const km_signature *sig, int degree, double tol,
                                size_t max_points, const km_stop *stop,
                                km_curve *out, double *error_bound,
                                km_error *err);
-
-/* Exact curve point at arc length s (numerical quadrature to ~1e-15 L):
- * used by tests and metrics. pos and tangent angle. */
-km_status km_signature_point(const km_signature *sig, double s,
-                             double pos[2], double *theta);
 
 #endif
