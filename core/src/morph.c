@@ -108,13 +108,11 @@ static km_status plan_frames(km_morph *m, km_error *err) {
   return st;
 }
 
-/* The morph of a closed pair without matches with `to` started a further
- * fraction dshift of its length along: its inputs are copied, not
- * computed again. */
-static km_status morph_shifted(const km_morph *base, double dshift,
-                               km__poll *poll, km_morph **out, km_error *err) {
+/* An empty morph (every part initialised, km_morph_free-able) with the
+ * caller's poll, or NULL without memory. */
+static km_morph *morph_new(km__poll *poll) {
   km_morph *m = calloc(1, sizeof *m);
-  if (!m) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  if (!m) return NULL;
   for (int i = 0; i < 2; i++) {
     km_curve_init(&m->in[i].curve);
     km_signature_init(&m->in[i].sig);
@@ -122,11 +120,21 @@ static km_status morph_shifted(const km_morph *base, double dshift,
     km__pp_init(&m->in[i].theta);
     km_curve_init(&m->lin[i]);
   }
+  m->poll = poll;
+  return m;
+}
+
+/* The morph of a closed pair without matches with `to` started a further
+ * fraction dshift of its length along: its inputs are copied, not
+ * computed again. */
+static km_status morph_shifted(const km_morph *base, double dshift,
+                               km__poll *poll, km_morph **out, km_error *err) {
+  km_morph *m = morph_new(poll);
+  if (!m) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   m->opt = base->opt;
   m->tol = base->tol;
   m->closed = base->closed;
   m->kmax = base->kmax;
-  m->poll = poll;
   m->ra = malloc(2 * sizeof(double));
   m->rb = malloc(2 * sizeof(double));
   km_status st = m->ra && m->rb ? KM_OK
@@ -149,36 +157,20 @@ static km_status morph_shifted(const km_morph *base, double dshift,
   return KM_OK;
 }
 
-/* The start of a closed `to` is chosen by the alignment cost; the
- * candidates are returned in cand/ncand, best first. */
-static km_status create_impl(km_morph **out, const km_morph_input *from,
-                             const km_morph_input *to,
-                             const km_morph_options *opt,
-                             double *cand,
-                             size_t *ncand, km__poll *poll, km_error *err) {
-  km_morph *m = calloc(1, sizeof *m);
-  if (!m) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
-  m->poll = poll;
-  for (int i = 0; i < 2; i++) {
-    km_curve_init(&m->in[i].curve);
-    km_signature_init(&m->in[i].sig);
-    km_curve_init(&m->lin[i]);
-  }
-  km_status st = KM_OK;
-  m->opt = *opt;
-  m->opt.matches = NULL;
-  if (m->opt.degree != 5) m->opt.degree = 3;
-  /* Inputs' signatures at a tenth of the tolerance: their error adds to
-   * the frames'. The default tolerance, 1e-5 of the longer length, is
-   * known only with both lengths; a tenth of 1e-5 of each curve's own is
-   * at least as tight, and needs no length before the signature. */
+/* Both inputs made ready and the frame tolerance set. Inputs' signatures
+ * are held to a tenth of the tolerance: their error adds to the frames'.
+ * The default tolerance, 1e-5 of the longer length, is known only with
+ * both lengths; a tenth of 1e-5 of each curve's own is at least as tight,
+ * and needs no length before the signature. */
+static km_status prepare_inputs(km_morph *m, const km_morph_input *from,
+                                const km_morph_input *to, km_error *err) {
+  const km_morph_options *opt = &m->opt;
   double tol = opt->tolerance > 0 ? opt->tolerance : 0.0;
-  st = km__input_prepare(&m->in[0], from, 0.1 * tol, poll, err);
-  if (st) goto fail;
-  st = km__input_prepare(&m->in[1], to, 0.1 * tol, poll, err);
-  if (st) goto fail;
-  km__input *a = &m->in[0], *b = &m->in[1];
-  if (!(opt->tolerance > 0)) tol = 1e-5 * fmax(a->sig.length, b->sig.length);
+  km_status st = km__input_prepare(&m->in[0], from, 0.1 * tol, m->poll, err);
+  if (!st) st = km__input_prepare(&m->in[1], to, 0.1 * tol, m->poll, err);
+  if (st) return st;
+  if (!(opt->tolerance > 0))
+    tol = 1e-5 * fmax(m->in[0].sig.length, m->in[1].sig.length);
   m->tol = tol;
   /* Curvature frames need the signatures only: the curves would be turned
    * and copied with every change of start for nothing. */
@@ -187,83 +179,98 @@ static km_status create_impl(km_morph **out, const km_morph_input *from,
       km_curve_free(&m->in[i].curve);
       m->in[i].has_curve = false;
     }
-  if (a->sig.closed != b->sig.closed) {
-    st = km__fail(err, KM_EMIXED, KM_FIELD_CLOSED, -1, NAN,
-                  "cannot morph an open curve into a closed one (from is %s, "
-                  "to is %s)",
-                  a->sig.closed ? "closed" : "open",
-                  b->sig.closed ? "closed" : "open");
-    goto fail;
-  }
+  return KM_OK;
+}
+
+/* Open or closed alike; closed pairs of opposite turning have `to`
+ * reversed (orient auto) and, without matches, `to` started where it
+ * aligns best (the candidates in cand/ncand, best first). */
+static km_status orient_inputs(km_morph *m, double *cand, size_t *ncand,
+                               km_error *err) {
+  const km_morph_options *opt = &m->opt;
+  km__input *a = &m->in[0], *b = &m->in[1];
+  if (a->sig.closed != b->sig.closed)
+    return km__fail(err, KM_EMIXED, KM_FIELD_CLOSED, -1, NAN,
+                    "cannot morph an open curve into a closed one (from is %s, "
+                    "to is %s)",
+                    a->sig.closed ? "closed" : "open",
+                    b->sig.closed ? "closed" : "open");
   m->closed = a->sig.closed;
-  if (m->closed) {
-    double na = a->sig.turning / (2 * KM_PI), nb = b->sig.turning / (2 * KM_PI);
-    long ta = lround(na), tb = lround(nb);
-    if (ta == -tb && ta != 0 && opt->orient == KM_ORIENT_AUTO) {
-      st = km__input_reverse(b, poll, err);
-      if (st) goto fail;
-      tb = lround(b->sig.turning / (2 * KM_PI));
-    }
-    if (ta != tb) {
-      st = km__fail(err, KM_ETURNING, KM_FIELD_NONE, -1, NAN,
+  if (!m->closed) return KM_OK;
+  double na = a->sig.turning / (2 * KM_PI), nb = b->sig.turning / (2 * KM_PI);
+  long ta = lround(na), tb = lround(nb);
+  if (ta == -tb && ta != 0 && opt->orient == KM_ORIENT_AUTO) {
+    km_status st = km__input_reverse(b, m->poll, err);
+    if (st) return st;
+    tb = lround(b->sig.turning / (2 * KM_PI));
+  }
+  if (ta != tb)
+    return km__fail(err, KM_ETURNING, KM_FIELD_NONE, -1, NAN,
                     "closed curves must have equal turning numbers: from "
                     "turns %ld times, to turns %ld times",
                     ta, tb);
-      goto fail;
-    }
-    if (opt->nmatches == 0) {
-      double shift = 0.0;
-      *ncand = km__best_shifts(a, b, cand);
-      shift = cand[0];
-      if (shift > 0) {
-        st = km__input_rotate_start(b, shift * b->sig.length, poll, err);
-        if (st) goto fail;
-      }
-    }
-  }
-  /* correspondence */
+  if (opt->nmatches > 0) return KM_OK;
+  *ncand = km__best_shifts(a, b, cand);
+  if (!(cand[0] > 0)) return KM_OK;
+  return km__input_rotate_start(b, cand[0] * b->sig.length, m->poll, err);
+}
+
+/* The correspondence knots from the caller's matches (opt: the caller's
+ * options, m->opt holds none), or from "auto" without them. */
+static km_status set_correspondence(km_morph *m, const km_morph_options *opt,
+                                    km_error *err) {
   size_t nm = opt->nmatches;
   double auto_pairs[2 * 64];
   const double *pairs = opt->matches;
   if (opt->auto_matches && nm == 0) {
-    nm = km__auto_matches(a, b, auto_pairs, 64);
+    nm = km__auto_matches(&m->in[0], &m->in[1], auto_pairs, 64);
     pairs = auto_pairs;
   }
   m->ra = malloc((nm + 2) * sizeof(double));
   m->rb = malloc((nm + 2) * sizeof(double));
-  if (!m->ra || !m->rb) {
-    st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
-    goto fail;
-  }
+  if (!m->ra || !m->rb) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   m->ra[0] = m->rb[0] = 0.0;
   for (size_t i = 0; i < nm; i++) {
     double x = pairs[2 * i], y = pairs[2 * i + 1];
     if (!(x > m->ra[i]) || !(y > m->rb[i]) || !(x < 1) || !(y < 1) ||
-        !isfinite(x) || !isfinite(y)) {
-      st = km__fail(err, KM_EMATCH, KM_FIELD_MATCHES, (long)i, NAN,
-                    "match %zu must lie strictly inside (0, 1) and strictly "
-                    "after the previous match on both curves",
-                    i);
-      goto fail;
-    }
+        !isfinite(x) || !isfinite(y))
+      return km__fail(err, KM_EMATCH, KM_FIELD_MATCHES, (long)i, NAN,
+                      "match %zu must lie strictly inside (0, 1) and strictly "
+                      "after the previous match on both curves",
+                      i);
     m->ra[i + 1] = x;
     m->rb[i + 1] = y;
   }
   m->ra[nm + 1] = m->rb[nm + 1] = 1.0;
   m->nk = nm + 2;
   m->nuser = nm;
-  if (opt->method == KM_METHOD_LINEAR) {
-    st = km__input_ensure_curve(a, 0.1 * tol, opt->max_points, poll, err);
-    if (!st) st = km__input_ensure_curve(b, 0.1 * tol, opt->max_points, poll, err);
+  return KM_OK;
+}
+
+/* The morph with the start of a closed `to` chosen by the alignment cost;
+ * the candidates are returned in cand/ncand, best first. */
+static km_status create_impl(km_morph **out, const km_morph_input *from,
+                             const km_morph_input *to,
+                             const km_morph_options *opt, double *cand,
+                             size_t *ncand, km__poll *poll, km_error *err) {
+  km_morph *m = morph_new(poll);
+  if (!m) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  m->opt = *opt;
+  m->opt.matches = NULL;
+  if (m->opt.degree != 5) m->opt.degree = 3;
+  km__input *a = &m->in[0], *b = &m->in[1];
+  km_status st = prepare_inputs(m, from, to, err);
+  if (!st) st = orient_inputs(m, cand, ncand, err);
+  if (!st) st = set_correspondence(m, opt, err);
+  if (!st && opt->method == KM_METHOD_LINEAR) {
+    st = km__input_ensure_curve(a, 0.1 * m->tol, opt->max_points, poll, err);
+    if (!st) st = km__input_ensure_curve(b, 0.1 * m->tol, opt->max_points, poll, err);
     if (!st)
       st = km_curve_make_compatible(&a->curve, &b->curve, &m->lin[0],
                                     &m->lin[1], err);
-    if (st) goto fail;
   }
+  if (st) goto fail;
   m->kmax = fmax(km_signature_max_abs_kappa(&a->sig), km_signature_max_abs_kappa(&b->sig));
-  /* Frames of the default morph (turning blend, no matches, cubic output)
-   * are planned once: see morph_plan.c. Others are blended piece by piece
-   * and reconstructed frame by frame. */
   st = plan_frames(m, err);
   if (st) goto fail;
   *out = m;

@@ -343,61 +343,69 @@ km_status km__input_reverse(km__input *in, km__poll *poll, km_error *err) {
  * mean radius L / 2 pi. The position term decides where the turning term
  * cannot (a circle's every start is equally good by turning, but only one
  * keeps a square's corners on the circle's diagonals). */
-#define KM__SHIFT_CANDIDATES 4
 
-/* Fills cand[] with up to KM__SHIFT_CANDIDATES shifts, best first: the
- * deepest local minima of the cost over all shifts. Returns the count.
- * The cost of shift k,
- *   sum_j (d_j - mean d)^2 + |pa_j - pb_(j+k)|^2,  d_j = ta_j - tb'_(j+k)
- * (tb' continued by the total turning past the end), expands into sums of
- * squares, prefix sums and the cyclic correlations sum_j ta_j tb_(j+k) and
- * sum_j pa_j . pb_(j+k), which the FFT gives for all k at once. */
-size_t km__best_shifts(const km__input *a, const km__input *b, double *cand) {
-  static const int N = ALIGN_N;
-  double *buf = malloc(14 * (size_t)N * sizeof(double));
-  if (!buf) {
-    cand[0] = 0.0;
-    return 1;
-  }
-  double *ta = buf, *tb = buf + N, *cost = buf + 2 * N, *tw = buf + 3 * N;
-  double *ar = buf + 4 * N, *ai = buf + 5 * N, *br = buf + 6 * N, *bi = buf + 7 * N;
-  double *xr = buf + 8 * N, *xi = buf + 9 * N, *yr = buf + 10 * N, *yi = buf + 11 * N;
-  double *suffix_a = buf + 12 * N, *prefix_b = buf + 13 * N;
+/* Samples of both inputs for the alignment cost, at the midpoints of
+ * ALIGN_N equal parts: turning functions ta, tb (and copies ar, br for the
+ * FFT, with zero imaginary parts ai, bi) and positions about the
+ * centroids in units of the mean radius R (xr + i xi, yr + i yi), with
+ * their sums (s[0..5]: sum ta, sum tb, sum ta^2, sum tb^2, sum |pa|^2,
+ * sum |pb|^2). */
+typedef struct shift_work {
+  double *ta, *tb, *cost, *tw, *ar, *ai, *br, *bi, *xr, *xi, *yr, *yi;
+  double *suffix_a, *prefix_b;
+  double s[6];
+} shift_work;
+
+static void shift_samples(const km__input *a, const km__input *b,
+                          shift_work *w) {
+  enum { N = ALIGN_N };
   double La = a->sig.length, Lb = b->sig.length;
   double R = 0.5 * (La + Lb) / (2 * KM_PI);
   double sa = 0.0, sb = 0.0, saa = 0.0, sbb = 0.0, spa = 0.0, spb = 0.0;
   for (int j = 0; j < N; j++) {
     double r = (j + 0.5) / N, q[2];
-    ta[j] = km__input_theta_at(a, La * r);
-    tb[j] = km__input_theta_at(b, Lb * r);
+    w->ta[j] = km__input_theta_at(a, La * r);
+    w->tb[j] = km__input_theta_at(b, Lb * r);
     km__input_point_at(a, r, q);
-    xr[j] = (q[0] - a->centroid[0]) / R;
-    xi[j] = (q[1] - a->centroid[1]) / R;
+    w->xr[j] = (q[0] - a->centroid[0]) / R;
+    w->xi[j] = (q[1] - a->centroid[1]) / R;
     km__input_point_at(b, r, q);
-    yr[j] = (q[0] - b->centroid[0]) / R;
-    yi[j] = (q[1] - b->centroid[1]) / R;
-    ar[j] = ta[j];
-    br[j] = tb[j];
-    ai[j] = bi[j] = 0.0;
-    sa += ta[j];
-    sb += tb[j];
-    saa += ta[j] * ta[j];
-    sbb += tb[j] * tb[j];
-    spa += xr[j] * xr[j] + xi[j] * xi[j];
-    spb += yr[j] * yr[j] + yi[j] * yi[j];
+    w->yr[j] = (q[0] - b->centroid[0]) / R;
+    w->yi[j] = (q[1] - b->centroid[1]) / R;
+    w->ar[j] = w->ta[j];
+    w->br[j] = w->tb[j];
+    w->ai[j] = w->bi[j] = 0.0;
+    sa += w->ta[j];
+    sb += w->tb[j];
+    saa += w->ta[j] * w->ta[j];
+    sbb += w->tb[j] * w->tb[j];
+    spa += w->xr[j] * w->xr[j] + w->xi[j] * w->xi[j];
+    spb += w->yr[j] * w->yr[j] + w->yi[j] * w->yi[j];
   }
-  suffix_a[0] = 0.0; /* suffix_a[k]: sum of the last k of ta */
-  prefix_b[0] = 0.0; /* prefix_b[k]: sum of the first k of tb */
+  double s[6] = {sa, sb, saa, sbb, spa, spb};
+  memcpy(w->s, s, sizeof s);
+}
+
+/* The cost of every shift k (see km__best_shifts) into w->cost; T is b's
+ * total turning. */
+static void shift_costs(shift_work *w, double T) {
+  enum { N = ALIGN_N };
+  double sa = w->s[0], sb = w->s[1], saa = w->s[2], sbb = w->s[3];
+  double spa = w->s[4], spb = w->s[5];
+  double *ar = w->ar, *ai = w->ai, *br = w->br, *bi = w->bi;
+  double *xr = w->xr, *xi = w->xi, *yr = w->yr, *yi = w->yi;
+  w->suffix_a[0] = 0.0; /* suffix_a[k]: sum of the last k of ta */
+  w->prefix_b[0] = 0.0; /* prefix_b[k]: sum of the first k of tb */
   for (int k = 1; k < N; k++) {
-    suffix_a[k] = suffix_a[k - 1] + ta[N - k];
-    prefix_b[k] = prefix_b[k - 1] + tb[k - 1];
+    w->suffix_a[k] = w->suffix_a[k - 1] + w->ta[N - k];
+    w->prefix_b[k] = w->prefix_b[k - 1] + w->tb[k - 1];
   }
   /* correlations: IFFT(conj(FFT u) FFT v)[k] = sum_j conj(u_j) v_(j+k) */
-  km__fft_twiddles(N, tw);
-  km__fft(ar, ai, N, tw, false);
-  km__fft(br, bi, N, tw, false);
-  km__fft(xr, xi, N, tw, false);
-  km__fft(yr, yi, N, tw, false);
+  km__fft_twiddles(N, w->tw);
+  km__fft(ar, ai, N, w->tw, false);
+  km__fft(br, bi, N, w->tw, false);
+  km__fft(xr, xi, N, w->tw, false);
+  km__fft(yr, yi, N, w->tw, false);
   for (int m = 0; m < N; m++) {
     double r1 = ar[m] * br[m] + ai[m] * bi[m], i1 = ar[m] * bi[m] - ai[m] * br[m];
     double r2 = xr[m] * yr[m] + xi[m] * yi[m], i2 = xr[m] * yi[m] - xi[m] * yr[m];
@@ -406,18 +414,22 @@ size_t km__best_shifts(const km__input *a, const km__input *b, double *cand) {
     xr[m] = r2;
     xi[m] = i2;
   }
-  km__fft(ar, ai, N, tw, true); /* ar[k] = sum_j ta_j tb_(j+k) */
-  km__fft(xr, xi, N, tw, true); /* xr[k] = sum_j pa_j . pb_(j+k) */
-  double T = b->sig.turning;
+  km__fft(ar, ai, N, w->tw, true); /* ar[k] = sum_j ta_j tb_(j+k) */
+  km__fft(xr, xi, N, w->tw, true); /* xr[k] = sum_j pa_j . pb_(j+k) */
   for (int k = 0; k < N; k++) {
     double sum = sa - sb - T * k;
-    double cross = ar[k] + T * suffix_a[k];
-    double vv = sbb + 2 * T * prefix_b[k] + k * T * T;
+    double cross = ar[k] + T * w->suffix_a[k];
+    double vv = sbb + 2 * T * w->prefix_b[k] + k * T * T;
     double sum2 = saa - 2 * cross + vv;
     double pos = spa + spb - 2 * xr[k];
-    cost[k] = sum2 - sum * sum / N + pos;
+    w->cost[k] = sum2 - sum * sum / N + pos;
   }
-  /* local minima, deepest first; the given start wins ties */
+}
+
+/* The deepest local minima of cost, at most KM__SHIFT_CANDIDATES, as
+ * fractions into cand; the given start wins ties. */
+static size_t deepest_minima(const double *cost, double *cand) {
+  enum { N = ALIGN_N };
   size_t n = 0;
   int idx[KM__SHIFT_CANDIDATES];
   for (int k = 0; k < N; k++) {
@@ -436,6 +448,28 @@ size_t km__best_shifts(const km__input *a, const km__input *b, double *cand) {
     n = 1;
   }
   for (size_t q = 0; q < n; q++) cand[q] = (double)idx[q] / N;
+  return n;
+}
+
+/* The cost of shift k,
+ *   sum_j (d_j - mean d)^2 + |pa_j - pb_(j+k)|^2,  d_j = ta_j - tb'_(j+k)
+ * (tb' continued by the total turning past the end), expands into sums of
+ * squares, prefix sums and the cyclic correlations sum_j ta_j tb_(j+k) and
+ * sum_j pa_j . pb_(j+k), which the FFT gives for all k at once. */
+size_t km__best_shifts(const km__input *a, const km__input *b, double *cand) {
+  enum { N = ALIGN_N };
+  double *buf = malloc(14 * (size_t)N * sizeof(double));
+  if (!buf) {
+    cand[0] = 0.0;
+    return 1;
+  }
+  shift_work w = {buf,          buf + N,      buf + 2 * N,  buf + 3 * N,
+                  buf + 4 * N,  buf + 5 * N,  buf + 6 * N,  buf + 7 * N,
+                  buf + 8 * N,  buf + 9 * N,  buf + 10 * N, buf + 11 * N,
+                  buf + 12 * N, buf + 13 * N, {0, 0, 0, 0, 0, 0}};
+  shift_samples(a, b, &w);
+  shift_costs(&w, b->sig.turning);
+  size_t n = deepest_minima(w.cost, cand);
   free(buf);
   return n;
 }

@@ -308,68 +308,60 @@ static void warm_start(const km__frame_plan *p, double t, double *c) {
   }
 }
 
-km_status km__frame_plan_curve(const km__frame_plan *p, double t,
-                               double theta0, bool close_lsq, km_curve *out,
-                               double *ends, km__poll *poll, km_error *err) {
-  double Lt = (1 - t) * p->La + t * p->Lb, al = 1 - t, be = t;
-  size_t np = p->np;
-  double c[NF] = {0};
-  bool lsq = close_lsq && p->closed;
-  /* sums of the pieces, scratch of the nodes, and per corner its turn,
-   * its change and the stretch sums; per piece the turn added before it */
-  size_t nc = p->ncorners;
-  double *sum = malloc((km__plan_frame_scratch(p) + 4 * nc + 2 + np) * sizeof(double));
-  if (!sum) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+/* The closure of frame t from the plan: by the corners where the plan
+ * says so and they can (dp[k] then the turn added before piece k, else
+ * left zero), else by the smooth curvature. c receives psi's
+ * coefficients, sum the pieces' integrals (scratch: as
+ * km__frame_plan_curve allocates it). */
+static km_status frame_closure(const km__frame_plan *p, double t,
+                               double theta0, bool close_lsq, double *c,
+                               double *sum, double *dp, km__poll *poll) {
+  size_t np = p->np, nc = p->ncorners;
+  double *e = sum + 2 * np;
   double *tau = sum + km__plan_frame_scratch(p), *delta = tau + nc, *S = delta + nc;
-  double *dp = S + 2 * (nc + 1);
-  for (size_t k = 0; k < np; k++) dp[k] = 0.0;
+  bool lsq = close_lsq && p->closed, by_corners = false;
   km_status st = KM_OK;
-  bool by_corners = false;
+  for (size_t k = 0; k < np; k++) dp[k] = 0.0;
   if (lsq && p->by_corners) {
-    st = km__plan_close_frame(p, t, theta0, false, false, c, sum, sum + 2 * np, poll);
+    st = km__plan_close_frame(p, t, theta0, false, false, c, sum, e, poll);
     by_corners = !st && km__plan_corner_closure(p, t, sum, tau, delta, S, dp);
   }
-  if (!st && !by_corners) {
-    /* the smooth curvature takes the correction, by steps from the
-     * cubic through the kept ones (warm_start): closed at those points
-     * already, near it between them, so frames near each other take
-     * nearly the same correction (continuous in t), and the ends none.
-     * Should the steps fail, the projection from there, as the kept
-     * corrections were found. */
-    if (lsq) warm_start(p, t, c);
-    st = km__plan_close_frame(p, t, theta0, close_lsq, false, c, sum, sum + 2 * np,
-                     poll);
-    if (st == KM_ENOCONVERGE && lsq) {
-      warm_start(p, t, c);
-      st = km__plan_close_frame(p, t, theta0, true, true, c, sum, sum + 2 * np, poll);
-    }
+  if (st || by_corners) return st;
+  /* the smooth curvature takes the correction, by steps from the
+   * cubic through the kept ones (warm_start): closed at those points
+   * already, near it between them, so frames near each other take
+   * nearly the same correction (continuous in t), and the ends none.
+   * Should the steps fail, the projection from there, as the kept
+   * corrections were found. */
+  if (lsq) warm_start(p, t, c);
+  st = km__plan_close_frame(p, t, theta0, close_lsq, false, c, sum, e, poll);
+  if (st == KM_ENOCONVERGE && lsq) {
+    warm_start(p, t, c);
+    st = km__plan_close_frame(p, t, theta0, true, true, c, sum, e, poll);
   }
-  if (st == KM_ECANCELLED || (poll && poll->stopped)) {
-    free(sum);
-    return km__stopped(err);
-  }
-  if (st) {
-    free(sum);
-    return km__fail(err, st, KM_FIELD_NONE, -1, NAN,
-                    "closing the frame did not converge");
-  }
-  /* Hermite control points: P0, then Q1 Q2 of every piece, with the
-   * junction point itself at corners (triple knots; double elsewhere) */
-  size_t ncorner = 0;
+  return st;
+}
+
+/* The frame's cubic Hermite control points into *f (initialised, empty):
+ * P0, then Q1 Q2 of every piece, with the junction point itself at
+ * corners (triple knots; double elsewhere); ends as km__frame_plan_curve.
+ * *P the end point. KM_EINVAL (*msg) if the counts disagree. */
+static km_status hermite_points(const km__frame_plan *p, double t,
+                                double theta0, const double *c,
+                                const double *sum, const double *dp,
+                                km_curve *f, double *ends, double P[2],
+                                const char **msg) {
+  double Lt = (1 - t) * p->La + t * p->Lb, al = 1 - t, be = t;
+  size_t np = p->np, ncorner = 0;
   for (size_t k = 1; k < np; k++) ncorner += p->corner[k];
   size_t ncp = 2 * np + 2 + ncorner, nknots = ncp + 4;
-  km_curve f;
-  km_curve_init(&f);
-  st = km__curve_alloc(&f, 3, ncp, false);
-  if (st) {
-    free(sum);
-    return km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
-  }
+  km_status st = km__curve_alloc(f, 3, ncp, false);
+  if (st) return st;
   size_t cc = 0, kk = 0;
-  double P[2] = {0.0, 0.0};
-  for (int r = 0; r < 4; r++) f.knots[kk++] = 0.0;
-  f.cp[cc++] = 0.0;
-  f.cp[cc++] = 0.0;
+  P[0] = P[1] = 0.0;
+  for (int r = 0; r < 4; r++) f->knots[kk++] = 0.0;
+  f->cp[cc++] = 0.0;
+  f->cp[cc++] = 0.0;
   if (ends) ends[0] = ends[1] = 0.0;
   /* the tangent a piece ends with is the next one's start but at corners
    * (theta is continuous there to 1e-12, and so is the turn dp) */
@@ -380,8 +372,8 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t,
                  psi_at_break(p, c, k + 1) + dp[k];
     double Pn[2] = {P[0] + Lt * sum[2 * k], P[1] + Lt * sum[2 * k + 1]};
     if (k > 0 && p->corner[k]) {
-      f.cp[cc++] = P[0];
-      f.cp[cc++] = P[1];
+      f->cp[cc++] = P[0];
+      f->cp[cc++] = P[1];
     }
     double c0 = c1, s0 = s1;
     if (k == 0 || p->corner[k]) {
@@ -390,13 +382,13 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t,
       km__sincos(th0, &s0, &c0);
     }
     km__sincos(th1, &s1, &c1);
-    f.cp[cc++] = P[0] + h / 3.0 * c0;
-    f.cp[cc++] = P[1] + h / 3.0 * s0;
-    f.cp[cc++] = Pn[0] - h / 3.0 * c1;
-    f.cp[cc++] = Pn[1] - h / 3.0 * s1;
+    f->cp[cc++] = P[0] + h / 3.0 * c0;
+    f->cp[cc++] = P[1] + h / 3.0 * s0;
+    f->cp[cc++] = Pn[0] - h / 3.0 * c1;
+    f->cp[cc++] = Pn[1] - h / 3.0 * s1;
     if (k + 1 < np) {
       int mult = p->corner[k + 1] ? 3 : 2;
-      for (int r = 0; r < mult; r++) f.knots[kk++] = Lt * p->x[k + 1];
+      for (int r = 0; r < mult; r++) f->knots[kk++] = Lt * p->x[k + 1];
     }
     P[0] = Pn[0];
     P[1] = Pn[1];
@@ -405,25 +397,52 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t,
       ends[2 * k + 3] = P[1];
     }
   }
-  f.cp[cc++] = P[0];
-  f.cp[cc++] = P[1];
-  for (int r = 0; r < 4; r++) f.knots[kk++] = Lt;
-  free(sum);
+  f->cp[cc++] = P[0];
+  f->cp[cc++] = P[1];
+  for (int r = 0; r < 4; r++) f->knots[kk++] = Lt;
   if (cc != 2 * ncp || kk != nknots) {
-    km_curve_free(&f);
-    return km__fail(err, KM_EINVAL, KM_FIELD_NONE, -1, NAN,
-                    "internal inconsistency building a frame");
+    *msg = "internal inconsistency building a frame";
+    return KM_EINVAL;
   }
+  return KM_OK;
+}
+
+km_status km__frame_plan_curve(const km__frame_plan *p, double t,
+                               double theta0, bool close_lsq, km_curve *out,
+                               double *ends, km__poll *poll, km_error *err) {
+  double c[NF] = {0}, P[2];
+  /* sums of the pieces, scratch of the nodes, and per corner its turn,
+   * its change and the stretch sums; per piece the turn added before it */
+  size_t nc = p->ncorners, scratch = km__plan_frame_scratch(p) + 4 * nc + 2;
+  double *sum = malloc((scratch + p->np) * sizeof(double));
+  if (!sum) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  const char *msg = "closing the frame did not converge";
+  km_curve f;
+  km_curve_init(&f);
+  km_status st = frame_closure(p, t, theta0, close_lsq, c, sum, sum + scratch,
+                               poll);
+  if (st == KM_ECANCELLED || (poll && poll->stopped)) {
+    st = KM_ECANCELLED;
+    goto done;
+  }
+  if (st) goto done;
+  msg = NULL;
+  st = hermite_points(p, t, theta0, c, sum, sum + scratch, &f, ends, P, &msg);
+  if (st) goto done;
   f.closed = false;
-  if (p->closed) {
-    double g = hypot(P[0], P[1]);
-    if (g <= p->tol) {
-      f.cp[2 * (ncp - 1)] = f.cp[0];
-      f.cp[2 * (ncp - 1) + 1] = f.cp[1];
-      f.closed = true;
-    }
+  if (p->closed && hypot(P[0], P[1]) <= p->tol) {
+    size_t ncp = f.n;
+    f.cp[2 * (ncp - 1)] = f.cp[0];
+    f.cp[2 * (ncp - 1) + 1] = f.cp[1];
+    f.closed = true;
   }
   *out = f;
+  km_curve_init(&f);
+done:
+  free(sum);
+  km_curve_free(&f);
+  if (st == KM_ECANCELLED) return km__stopped(err);
+  if (st) return km__fail(err, st, KM_FIELD_NONE, -1, NAN, msg);
   return KM_OK;
 }
 
