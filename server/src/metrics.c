@@ -128,54 +128,70 @@ static void put(buf *b, const char *fmt, ...)
   }
 }
 
-char *srv_metrics_render(srv_metrics *m, const srv_gauges *g, size_t *len)
+/* Requests answered, by route and status (m->mu held). */
+static void put_requests(buf *b, const srv_metrics *m)
 {
-  buf b = {malloc(16384), 0, 16384, 0};
-  if (b.p == NULL)
-    return NULL;
-  b.p[0] = '\0';
-  pthread_mutex_lock(&m->mu);
-  put(&b, "# HELP kmorph_http_requests_total HTTP requests answered, by "
-          "route and status.\n"
-          "# TYPE kmorph_http_requests_total counter\n");
+  put(b, "# HELP kmorph_http_requests_total HTTP requests answered, by "
+         "route and status.\n"
+         "# TYPE kmorph_http_requests_total counter\n");
   for (int r = 0; r < SRV_R_COUNT; r++)
     for (size_t s = 0; s < NSTATUS; s++)
       if (m->count[r][s] > 0) {
         if (STATUSES[s] == 0)
-          put(&b, "kmorph_http_requests_total{route=\"%s\",status=\"other\"} %llu\n",
+          put(b,
+              "kmorph_http_requests_total{route=\"%s\",status=\"other\"} "
+              "%llu\n",
               ROUTE_NAMES[r], m->count[r][s]);
         else
-          put(&b, "kmorph_http_requests_total{route=\"%s\",status=\"%d\"} %llu\n",
+          put(b,
+              "kmorph_http_requests_total{route=\"%s\",status=\"%d\"} "
+              "%llu\n",
               ROUTE_NAMES[r], STATUSES[s], m->count[r][s]);
       }
-  put(&b, "# HELP kmorph_http_request_duration_seconds Time from request "
-          "headers to response, by route.\n"
-          "# TYPE kmorph_http_request_duration_seconds histogram\n");
+}
+
+/* The duration histogram of every route seen (m->mu held). */
+static void put_durations(buf *b, const srv_metrics *m)
+{
+  put(b, "# HELP kmorph_http_request_duration_seconds Time from request "
+         "headers to response, by route.\n"
+         "# TYPE kmorph_http_request_duration_seconds histogram\n");
   for (int r = 0; r < SRV_R_COUNT; r++) {
     if (m->observed[r] == 0)
       continue;
     for (size_t k = 0; k < NBUCKET; k++)
-      put(&b,
-          "kmorph_http_request_duration_seconds_bucket{route=\"%s\",le=\"%g\"} %llu\n",
+      put(b,
+          "kmorph_http_request_duration_seconds_bucket{route=\"%s\","
+          "le=\"%g\"} %llu\n",
           ROUTE_NAMES[r], BUCKETS[k], m->bucket[r][k]);
-    put(&b,
-        "kmorph_http_request_duration_seconds_bucket{route=\"%s\",le=\"+Inf\"} %llu\n"
+    put(b,
+        "kmorph_http_request_duration_seconds_bucket{route=\"%s\","
+        "le=\"+Inf\"} %llu\n"
         "kmorph_http_request_duration_seconds_sum{route=\"%s\"} %.9g\n"
         "kmorph_http_request_duration_seconds_count{route=\"%s\"} %llu\n",
         ROUTE_NAMES[r], m->observed[r], ROUTE_NAMES[r], m->sum[r],
         ROUTE_NAMES[r], m->observed[r]);
   }
-  put(&b,
+}
+
+/* Requests refused, by reason (m->mu held). */
+static void put_rejections(buf *b, const srv_metrics *m)
+{
+  put(b,
       "# HELP kmorph_rejected_total Requests refused to protect the daemon: "
       "at once because it was full (queue, jobs, memory for bodies or "
       "results, connection slots), or a computation stopped at its time "
       "limit.\n"
       "# TYPE kmorph_rejected_total counter\n");
   for (size_t i = 0; i < NREASON; i++)
-    put(&b, "kmorph_rejected_total{reason=\"%s\"} %llu\n", REASONS[i],
+    put(b, "kmorph_rejected_total{reason=\"%s\"} %llu\n", REASONS[i],
         m->rejected[i]);
-  pthread_mutex_unlock(&m->mu);
-  put(&b,
+}
+
+/* The caller's gauges, read at render time. */
+static void put_gauges(buf *b, const srv_gauges *g)
+{
+  put(b,
       "# HELP kmorph_queue_depth Compute requests waiting for a worker.\n"
       "# TYPE kmorph_queue_depth gauge\n"
       "kmorph_queue_depth %zu\n"
@@ -212,8 +228,22 @@ char *srv_metrics_render(srv_metrics *m, const srv_gauges *g, size_t *len)
       g->connections, g->body_bytes, g->result_bytes, g->late_requests,
       g->late_sends);
   for (int s = 0; s < 5; s++)
-    put(&b, "kmorph_jobs{state=\"%s\"} %zu\n", g->job_state_names[s],
+    put(b, "kmorph_jobs{state=\"%s\"} %zu\n", g->job_state_names[s],
         g->jobs[s]);
+}
+
+char *srv_metrics_render(srv_metrics *m, const srv_gauges *g, size_t *len)
+{
+  buf b = {malloc(16384), 0, 16384, 0};
+  if (b.p == NULL)
+    return NULL;
+  b.p[0] = '\0';
+  pthread_mutex_lock(&m->mu);
+  put_requests(&b, m);
+  put_durations(&b, m);
+  put_rejections(&b, m);
+  pthread_mutex_unlock(&m->mu);
+  put_gauges(&b, g);
   if (b.oom) {
     free(b.p);
     return NULL;

@@ -39,9 +39,11 @@ void srv_metrics_destroy(srv_metrics *m);
 void srv_metrics_observe(srv_metrics *m, srv_route route, int status,
                          double seconds);
 
-/* Count a request refused to protect the daemon (reason: "queue_full",
- * "jobs_full" by admission control; "morph_time": a synchronous morph
- * stopped at its compute time limit). */
+/* Count a request refused to protect the daemon. reason is one of
+ * "queue_full", "jobs_full", "body_memory", "result_memory",
+ * "connections_full" (admission control), "morph_time", "compute_time"
+ * (a synchronous computation stopped at its time limit); any other
+ * string counts as "queue_full". */
 void srv_metrics_reject(srv_metrics *m, const char *reason);
 
 /* Gauges supplied by the caller at render time. */
