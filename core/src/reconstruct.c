@@ -324,6 +324,192 @@ km_status km_reconstruct_until(const km_signature *sig, int degree, double tol,
                          NULL, err);
 }
 
+/* ---- the phases of km__reconstruct -------------------------------------
+ * Output pieces planned over the theta pieces (and merged, for cubics),
+ * the positions at their ends integrated, the continuity at every
+ * junction decided (which sets the knots' multiplicities), then the
+ * Hermite pieces' Bezier points written as one B-spline. */
+
+/* The output pieces of every theta piece within 0.9 tol; a cubic's
+ * neighbours merged where the bound allows. */
+static km_status plan_pieces(plan *pl, const theta_pieces *tp, int degree,
+                             double tol, const km_signature *sig,
+                             km_error *err) {
+  for (size_t i = 0; i < tp->theta.m; i++) {
+    km_status st = plan_range(pl, tp, i, 0.0, 1.0, degree, 0.9 * tol, 0);
+    if (st == KM_ECANCELLED) {
+      km__stopped(err);
+      return st;
+    }
+    if (st)
+      return km__fail(err, st, KM_FIELD_TOLERANCE, -1, NAN,
+                      st == KM_ELIMIT ? "the curve needs more than %zu pieces "
+                                        "of degree %d at this tolerance (it "
+                                        "turns %g times): loosen the tolerance"
+                                      : "out of memory",
+                      pl->limit, degree, fabs(sig->turning) / (2 * KM_PI));
+  }
+  if (degree == 3) merge_cubic(pl, tp, 0.9 * tol);
+  return KM_OK;
+}
+
+/* pos[2 j], pos[2 j + 1]: the position at the start of output piece j
+ * (np + 1 points), by integrating e^(i theta) over the theta pieces it
+ * covers; *max_bound the largest of the pieces' bounds. */
+static km_status integrate_positions(const plan *pl, const theta_pieces *tp,
+                                     const km_signature *sig, km__poll *poll,
+                                     double *pos, double *max_bound,
+                                     km_error *err) {
+  int dk = tp->kappa.degree, dt = dk + 1;
+  pos[0] = sig->start[0];
+  pos[1] = sig->start[1];
+  *max_bound = 0.0;
+  for (size_t j = 0; j < pl->n; j++) {
+    const out_piece *op = &pl->p[j];
+    double sx = 0.0, sy = 0.0;
+    for (size_t i = op->piece; i <= op->piece_end; i++) {
+      double h = tp->theta.x[i + 1] - tp->theta.x[i];
+      double u0 = i == op->piece ? op->u0 : 0.0;
+      double u1 = i == op->piece_end ? op->u1 : 1.0;
+      double kb[1], d[2];
+      km__kappa_bounds(tp->kappa.c + i * (size_t)(dk + 1), dk, h, u0, u1, 1,
+                       kb);
+      km__integrate_exp(tp->theta.c + i * (size_t)(dt + 1), dt, h, u0, u1,
+                        kb[0], d);
+      sx += d[0];
+      sy += d[1];
+      /* 16 nodes a chunk of at most half a radian (km__integrate_exp) */
+      if (km__poll_stop(poll, 16 + (long)fmin(32.0 * kb[0] * (u1 - u0) * h, 1e9)))
+        return km__stopped(err);
+    }
+    pos[2 * j + 2] = pos[2 * j] + sx;
+    pos[2 * j + 3] = pos[2 * j + 1] + sy;
+    *max_bound = fmax(*max_bound, op->bound);
+  }
+  return KM_OK;
+}
+
+/* Junction continuity cont[j] between output pieces j - 1 and j: 0 = a
+ * corner (C0), 1 = a jump of kappa (C1; also every cubic junction, the
+ * Hermite pieces being C1), 2 = C2. Returns the knot count of the
+ * B-spline. */
+static size_t junctions(const plan *pl, const theta_pieces *tp, int p,
+                        double L, int *cont) {
+  int dk = tp->kappa.degree, dt = dk + 1;
+  size_t nknots = 2 * (size_t)(p + 1);
+  double kscale = km__pp_max_abs(&tp->kappa) + 1.0 / L;
+  for (size_t j = 1; j < pl->n; j++) {
+    const out_piece *a = &pl->p[j - 1], *b = &pl->p[j];
+    double tha = km__bern_eval(tp->theta.c + a->piece_end * (size_t)(dt + 1), dt, a->u1);
+    double thb = km__bern_eval(tp->theta.c + b->piece * (size_t)(dt + 1), dt, b->u0);
+    double ka = km__bern_eval(tp->kappa.c + a->piece_end * (size_t)(dk + 1), dk, a->u1);
+    double kb = km__bern_eval(tp->kappa.c + b->piece * (size_t)(dk + 1), dk, b->u0);
+    if (fabs(thb - tha) > 1e-13)
+      cont[j] = 0;
+    else if (fabs(kb - ka) > 1e-12 * kscale)
+      cont[j] = 1;
+    else
+      cont[j] = 2;
+    if (p == 3 && cont[j] == 2) cont[j] = 1; /* cubic Hermite is C1 */
+    nknots += (size_t)(p - cont[j]);
+  }
+  return nknots;
+}
+
+/* The Bezier points Q[0..p] of output piece j: Hermite data (position,
+ * tangent, and for quintics curvature) at both ends. */
+static void piece_bezier(const plan *pl, const theta_pieces *tp,
+                         const double *pos, size_t j, int p, double Q[6][2]) {
+  int dk = tp->kappa.degree, dt = dk + 1;
+  const out_piece *op = &pl->p[j];
+  size_t i = op->piece, ie = op->piece_end;
+  const double *tc = tp->theta.c + i * (size_t)(dt + 1);
+  const double *kc = tp->kappa.c + i * (size_t)(dk + 1);
+  const double *tce = tp->theta.c + ie * (size_t)(dt + 1);
+  const double *kce = tp->kappa.c + ie * (size_t)(dk + 1);
+  double h = op->h;
+  double t0 = km__bern_eval(tc, dt, op->u0), t1 = km__bern_eval(tce, dt, op->u1);
+  double T0[2] = {cos(t0), sin(t0)}, T1[2] = {cos(t1), sin(t1)};
+  double P0[2] = {pos[2 * j], pos[2 * j + 1]};
+  double P1[2] = {pos[2 * j + 2], pos[2 * j + 3]};
+  if (p == 3) {
+    for (int a = 0; a < 2; a++) {
+      Q[0][a] = P0[a];
+      Q[1][a] = P0[a] + h / 3.0 * T0[a];
+      Q[2][a] = P1[a] - h / 3.0 * T1[a];
+      Q[3][a] = P1[a];
+    }
+    return;
+  }
+  double k0 = km__bern_eval(kc, dk, op->u0), k1 = km__bern_eval(kce, dk, op->u1);
+  double N0[2] = {-T0[1], T0[0]}, N1[2] = {-T1[1], T1[0]};
+  for (int a = 0; a < 2; a++) {
+    Q[0][a] = P0[a];
+    Q[1][a] = P0[a] + h / 5.0 * T0[a];
+    Q[2][a] = 2 * Q[1][a] - Q[0][a] + h * h / 20.0 * k0 * N0[a];
+    Q[5][a] = P1[a];
+    Q[4][a] = P1[a] - h / 5.0 * T1[a];
+    Q[3][a] = 2 * Q[4][a] - Q[5][a] + h * h / 20.0 * k1 * N1[a];
+  }
+}
+
+static void put_point(km_curve *c, size_t *cc, const double q[2]) {
+  c->cp[2 * *cc] = q[0];
+  c->cp[2 * *cc + 1] = q[1];
+  (*cc)++;
+}
+
+/* The B-spline's knots and control points from the pieces' Bezier points,
+ * junction by junction (c allocated for them). *ncp_out and *nk_out
+ * receive the counts written, for the caller's consistency check. */
+static void write_bspline(const plan *pl, const theta_pieces *tp,
+                          const double *pos, const int *cont, int p, double L,
+                          km_curve *c, size_t *ncp_out, size_t *nk_out) {
+  size_t kk = 0, cc = 0;
+  double s_at = 0.0;
+  for (int r = 0; r <= p; r++) c->knots[kk++] = 0.0;
+  double prevQ[6][2] = {{0}};
+  double prev_h = 0.0;
+  for (size_t j = 0; j < pl->n; j++) {
+    double h = pl->p[j].h, Q[6][2];
+    piece_bezier(pl, tp, pos, j, p, Q);
+    int cin = j == 0 ? -1 : cont[j];
+    if (j == 0) {
+      put_point(c, &cc, Q[0]);
+    } else {
+      /* close the previous piece according to the junction type: at C0
+       * its Q(p-1) and the shared point, at C1 its Q(p-1) (the shared
+       * point is implied); at a quintic's C2 Q4 of the left piece, the
+       * junction and Q1 of the right piece collapse into one point
+       * (blossom f(a,u,u,u,b)) */
+      if (cin == 0) {
+        put_point(c, &cc, prevQ[p - 1]);
+        put_point(c, &cc, Q[0]);
+      } else if (cin == 1) {
+        put_point(c, &cc, prevQ[p - 1]);
+      } else {
+        for (int a = 0; a < 2; a++)
+          c->cp[2 * cc + (size_t)a] =
+              prevQ[4][a] + (h / prev_h) * (prevQ[4][a] - prevQ[3][a]);
+        cc++;
+      }
+      for (int r = 0; r < p - cin; r++) c->knots[kk++] = s_at;
+    }
+    /* interior points of this piece, except those a C2 junction owns;
+     * Q(p-1) is emitted at the next junction or the end */
+    int first = (j > 0 && cin == 2) ? 2 : 1;
+    for (int q = first; q < p - 1; q++) put_point(c, &cc, Q[q]);
+    memcpy(prevQ, Q, sizeof Q);
+    prev_h = h;
+    s_at += h;
+  }
+  put_point(c, &cc, prevQ[p - 1]);
+  put_point(c, &cc, prevQ[p]);
+  for (int r = 0; r <= p; r++) c->knots[kk++] = L;
+  *ncp_out = cc;
+  *nk_out = kk;
+}
+
 km_status km__reconstruct(const km_signature *sig, int degree, double tol,
                           size_t max_points, km__poll *poll, km_curve *out,
                           double *error_bound, size_t *points_only,
@@ -337,204 +523,50 @@ km_status km__reconstruct(const km_signature *sig, int degree, double tol,
   theta_pieces tp;
   plan pl = {NULL, 0, 0, 0, poll};
   double *pos = NULL;
+  int *cont = NULL;
   km_curve c;
   km_curve_init(&c);
   km_status st = km__build_theta(sig, &tp.kappa, &tp.theta);
   if (st) return km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
-  int dk = tp.kappa.degree, dt = dk + 1;
   pl.limit = KM_MAX_OUTPUT_PIECES + 2 * tp.theta.m;
   if (pl.limit > KM_MAX_PIECES) pl.limit = KM_MAX_PIECES;
   /* a piece adds at most `degree` control points (a corner on each side) */
   if (max_points > 0 && max_points / (size_t)degree < pl.limit)
     pl.limit = max_points / (size_t)degree;
-  for (size_t i = 0; i < tp.theta.m; i++) {
-    st = plan_range(&pl, &tp, i, 0.0, 1.0, degree, 0.9 * tol, 0);
-    if (st == KM_ECANCELLED) {
-      km__stopped(err);
-      goto cleanup;
-    }
-    if (st) {
-      st = km__fail(err, st, KM_FIELD_TOLERANCE, -1, NAN,
-                    st == KM_ELIMIT ? "the curve needs more than %zu pieces "
-                                      "of degree %d at this tolerance (it "
-                                      "turns %g times): loosen the tolerance"
-                                    : "out of memory",
-                    pl.limit, degree, fabs(sig->turning) / (2 * KM_PI));
-      goto cleanup;
-    }
-  }
-  if (degree == 3) merge_cubic(&pl, &tp, 0.9 * tol);
+  st = plan_pieces(&pl, &tp, degree, tol, sig, err);
+  if (st) goto cleanup;
   size_t np = pl.n;
-  /* positions and tangent data at every piece boundary */
   pos = malloc((np + 1) * 2 * sizeof(double));
-  if (!pos) {
+  cont = malloc((np + 1) * sizeof(int));
+  if (!pos || !cont) {
     st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
     goto cleanup;
   }
-  pos[0] = sig->start[0];
-  pos[1] = sig->start[1];
   double max_bound = 0.0;
-  for (size_t j = 0; j < np && !points_only; j++) {
-    const out_piece *op = &pl.p[j];
-    double sx = 0.0, sy = 0.0;
-    for (size_t i = op->piece; i <= op->piece_end; i++) {
-      double h = tp.theta.x[i + 1] - tp.theta.x[i];
-      double u0 = i == op->piece ? op->u0 : 0.0;
-      double u1 = i == op->piece_end ? op->u1 : 1.0;
-      double kb[1], d[2];
-      km__kappa_bounds(tp.kappa.c + i * (size_t)(dk + 1), dk, h, u0, u1, 1, kb);
-      km__integrate_exp(tp.theta.c + i * (size_t)(dt + 1), dt, h, u0, u1,
-                        kb[0], d);
-      sx += d[0];
-      sy += d[1];
-      /* 16 nodes a chunk of at most half a radian (km__integrate_exp) */
-      if (km__poll_stop(poll, 16 + (long)fmin(32.0 * kb[0] * (u1 - u0) * h, 1e9))) {
-        st = km__stopped(err);
-        goto cleanup;
-      }
-    }
-    pos[2 * j + 2] = pos[2 * j] + sx;
-    pos[2 * j + 3] = pos[2 * j + 1] + sy;
-    max_bound = fmax(max_bound, op->bound);
+  if (!points_only) {
+    st = integrate_positions(&pl, &tp, sig, poll, pos, &max_bound, err);
+    if (st) goto cleanup;
   }
-  /* junction continuity: 0 = corner (C0), 1 = kappa jump (C1), 2 = C2 */
   int p = degree;
-  size_t ncp = 1, nknots = 2 * (size_t)(p + 1);
-  int *cont = malloc((np + 1) * sizeof(int));
-  if (!cont) {
-    st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
-    goto cleanup;
-  }
-  double kscale = km__pp_max_abs(&tp.kappa) + 1.0 / L;
-  for (size_t j = 1; j < np; j++) {
-    const out_piece *a = &pl.p[j - 1], *b = &pl.p[j];
-    double tha = km__bern_eval(tp.theta.c + a->piece_end * (size_t)(dt + 1), dt, a->u1);
-    double thb = km__bern_eval(tp.theta.c + b->piece * (size_t)(dt + 1), dt, b->u0);
-    double ka = km__bern_eval(tp.kappa.c + a->piece_end * (size_t)(dk + 1), dk, a->u1);
-    double kb = km__bern_eval(tp.kappa.c + b->piece * (size_t)(dk + 1), dk, b->u0);
-    if (fabs(thb - tha) > 1e-13)
-      cont[j] = 0;
-    else if (fabs(kb - ka) > 1e-12 * kscale)
-      cont[j] = 1;
-    else
-      cont[j] = 2;
-    if (p == 3 && cont[j] == 2) cont[j] = 1; /* cubic Hermite is C1 */
-    int mult = p - cont[j];
-    nknots += (size_t)mult;
-  }
-  ncp = nknots - (size_t)p - 1;
+  size_t nknots = junctions(&pl, &tp, p, L, cont);
+  size_t ncp = nknots - (size_t)p - 1;
   if (points_only) {
-    free(cont);
     *points_only = ncp;
     goto cleanup;
   }
   st = km__curve_alloc(&c, p, ncp, false);
   if (st) {
-    free(cont);
     st = km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
     goto cleanup;
   }
-  /* Bezier points of every piece, then the B-spline points per junction */
-  size_t kk = 0, cc = 0;
-  double s_at[2] = {0, 0};
-  for (int r = 0; r <= p; r++) c.knots[kk++] = 0.0;
-  double prevQ[6][2] = {{0}};
-  double prev_h = 0.0;
-  for (size_t j = 0; j < np; j++) {
-    const out_piece *op = &pl.p[j];
-    size_t i = op->piece, ie = op->piece_end;
-    const double *tc = tp.theta.c + i * (size_t)(dt + 1);
-    const double *kc = tp.kappa.c + i * (size_t)(dk + 1);
-    const double *tce = tp.theta.c + ie * (size_t)(dt + 1);
-    const double *kce = tp.kappa.c + ie * (size_t)(dk + 1);
-    double h = op->h;
-    double t0 = km__bern_eval(tc, dt, op->u0), t1 = km__bern_eval(tce, dt, op->u1);
-    double T0[2] = {cos(t0), sin(t0)}, T1[2] = {cos(t1), sin(t1)};
-    double P0[2] = {pos[2 * j], pos[2 * j + 1]};
-    double P1[2] = {pos[2 * j + 2], pos[2 * j + 3]};
-    double Q[6][2];
-    if (p == 3) {
-      for (int a = 0; a < 2; a++) {
-        Q[0][a] = P0[a];
-        Q[1][a] = P0[a] + h / 3.0 * T0[a];
-        Q[2][a] = P1[a] - h / 3.0 * T1[a];
-        Q[3][a] = P1[a];
-      }
-    } else {
-      double k0 = km__bern_eval(kc, dk, op->u0), k1 = km__bern_eval(kce, dk, op->u1);
-      double N0[2] = {-T0[1], T0[0]}, N1[2] = {-T1[1], T1[0]};
-      for (int a = 0; a < 2; a++) {
-        Q[0][a] = P0[a];
-        Q[1][a] = P0[a] + h / 5.0 * T0[a];
-        Q[2][a] = 2 * Q[1][a] - Q[0][a] + h * h / 20.0 * k0 * N0[a];
-        Q[5][a] = P1[a];
-        Q[4][a] = P1[a] - h / 5.0 * T1[a];
-        Q[3][a] = 2 * Q[4][a] - Q[5][a] + h * h / 20.0 * k1 * N1[a];
-      }
-    }
-    int cin = j == 0 ? -1 : cont[j];
-    if (j == 0) {
-      c.cp[2 * cc] = Q[0][0];
-      c.cp[2 * cc + 1] = Q[0][1];
-      cc++;
-    } else {
-      /* close the previous piece according to the junction type */
-      int last = p - 1; /* previous piece emitted Q1..Q(last-1) so far */
-      (void)last;
-      if (cin == 0) {
-        /* C0: previous Q(p-1), shared point */
-        c.cp[2 * cc] = prevQ[p - 1][0];
-        c.cp[2 * cc + 1] = prevQ[p - 1][1];
-        cc++;
-        c.cp[2 * cc] = Q[0][0];
-        c.cp[2 * cc + 1] = Q[0][1];
-        cc++;
-      } else if (cin == 1) {
-        /* C1: the shared point is implied */
-        c.cp[2 * cc] = prevQ[p - 1][0];
-        c.cp[2 * cc + 1] = prevQ[p - 1][1];
-        cc++;
-      } else {
-        /* C2 quintic: Q4 of the left piece, the junction and Q1 of the
-         * right piece collapse into one point (blossom f(a,u,u,u,b)) */
-        for (int a = 0; a < 2; a++)
-          c.cp[2 * cc + (size_t)a] =
-              prevQ[4][a] + (h / prev_h) * (prevQ[4][a] - prevQ[3][a]);
-        cc++;
-      }
-      int mult = p - cin;
-      for (int r = 0; r < mult; r++) c.knots[kk++] = s_at[0];
-    }
-    /* interior points of this piece, except those a C2 junction owns */
-    int first = (j > 0 && cin == 2) ? 2 : 1;
-    int lastq = p - 1; /* Q(p-1) is emitted at the next junction or end */
-    for (int q = first; q < lastq; q++) {
-      c.cp[2 * cc] = Q[q][0];
-      c.cp[2 * cc + 1] = Q[q][1];
-      cc++;
-    }
-    memcpy(prevQ, Q, sizeof Q);
-    prev_h = h;
-    s_at[0] += h;
-    (void)s_at[1];
-  }
-  /* finish: for a following C2 junction the left piece's Q3 was needed;
-   * handle by emitting Q(p-1) and Qp at the end */
-  c.cp[2 * cc] = prevQ[p - 1][0];
-  c.cp[2 * cc + 1] = prevQ[p - 1][1];
-  cc++;
-  c.cp[2 * cc] = prevQ[p][0];
-  c.cp[2 * cc + 1] = prevQ[p][1];
-  cc++;
-  for (int r = 0; r <= p; r++) c.knots[kk++] = L;
-  free(cont);
+  size_t cc, kk;
+  write_bspline(&pl, &tp, pos, cont, p, L, &c, &cc, &kk);
   if (cc != ncp || kk != nknots) {
     st = km__fail(err, KM_EINVAL, KM_FIELD_NONE, -1, NAN,
                   "internal inconsistency building the B-spline");
     goto cleanup;
   }
-  /* knots are the exact curve's arc length at the piece ends; the pieces
-   * were measured in the theta pieces' own coordinates, so snap the last */
+  /* the ends' positions carry the rounding of every integral before them */
   double bound = max_bound + 8e-16 * (double)(np + 1) *
                                  (L + fabs(sig->start[0]) + fabs(sig->start[1]));
   c.closed = false;
@@ -553,6 +585,7 @@ km_status km__reconstruct(const km_signature *sig, int degree, double tol,
   if (error_bound) *error_bound = bound;
 cleanup:
   km_curve_free(&c);
+  free(cont);
   free(pos);
   free(pl.p);
   theta_pieces_free(&tp);
