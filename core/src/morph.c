@@ -299,6 +299,42 @@ static long preview_crossings(const km_morph *m, long cap) {
   return total;
 }
 
+/* Among starts that align about as well, prefer one whose frames do not
+ * cross themselves: the first candidate, in order of alignment, none of
+ * whose five preview frames crosses (each stops at its first crossing);
+ * failing that the one with the fewest crossings, the better aligned
+ * among equals. Only planned morphs preview (the default: turning blend,
+ * cubic output): a frame of any other costs a blend and a reconstruction,
+ * twenty of them more than the whole morph. Returns the morph kept (m or
+ * one made from it) and frees the others. */
+static km_morph *pick_start(km_morph *m, const double *cand, size_t ncand,
+                            km__poll *poll) {
+  km_morph *alts[KM__SHIFT_CANDIDATES] = {m};
+  size_t n = 1, pick = SIZE_MAX;
+  if (preview_crossings(m, 1) == 0) pick = 0;
+  for (size_t i = 1; i < ncand && pick == SIZE_MAX; i++) {
+    km_morph *alt = NULL;
+    double d = cand[i] - cand[0];
+    if (morph_shifted(m, d < 0 ? d + 1.0 : d, poll, &alt, NULL) != KM_OK)
+      continue;
+    alts[n++] = alt;
+    if (preview_crossings(alt, 1) == 0) pick = n - 1;
+  }
+  if (pick == SIZE_MAX) {
+    long best = LONG_MAX;
+    for (size_t k = 0; k < n; k++) {
+      long x = preview_crossings(alts[k], best);
+      if (x < best || pick == SIZE_MAX) {
+        best = x;
+        pick = k;
+      }
+    }
+  }
+  for (size_t k = 0; k < n; k++)
+    if (k != pick) km_morph_free(alts[k]);
+  return alts[pick];
+}
+
 km_status km_morph_create(km_morph **out, const km_morph_input *from,
                           const km_morph_input *to,
                           const km_morph_options *opt, km_error *err) {
@@ -310,39 +346,8 @@ km_status km_morph_create(km_morph **out, const km_morph_input *from,
   km_status st = create_impl(&m, from, to, opt, cand, &ncand, &poll, err);
   if (st == KM_ECANCELLED || (st && poll.stopped)) return km__stopped(err);
   if (st) return st;
-  /* Among starts that align about as well, prefer one whose frames do not
-   * cross themselves: the first candidate, in order of alignment, none of
-   * whose five preview frames crosses (each stops at its first crossing);
-   * failing that the one with the fewest crossings, the better aligned
-   * among equals. Only planned morphs preview (the default: turning
-   * blend, cubic output): a frame of any other costs a blend and a
-   * reconstruction, twenty of them more than the whole morph. */
-  if (ncand > 1 && opt->method == KM_METHOD_CURVATURE && m->plan) {
-    km_morph *alts[KM__SHIFT_CANDIDATES] = {m};
-    size_t n = 1, pick = SIZE_MAX;
-    if (preview_crossings(m, 1) == 0) pick = 0;
-    for (size_t i = 1; i < ncand && pick == SIZE_MAX; i++) {
-      km_morph *alt = NULL;
-      double d = cand[i] - cand[0];
-      if (morph_shifted(m, d < 0 ? d + 1.0 : d, &poll, &alt, NULL) != KM_OK)
-        continue;
-      alts[n++] = alt;
-      if (preview_crossings(alt, 1) == 0) pick = n - 1;
-    }
-    if (pick == SIZE_MAX) {
-      long best = LONG_MAX;
-      for (size_t k = 0; k < n; k++) {
-        long x = preview_crossings(alts[k], best);
-        if (x < best || pick == SIZE_MAX) {
-          best = x;
-          pick = k;
-        }
-      }
-    }
-    for (size_t k = 0; k < n; k++)
-      if (k != pick) km_morph_free(alts[k]);
-    m = alts[pick];
-  }
+  if (ncand > 1 && opt->method == KM_METHOD_CURVATURE && m->plan)
+    m = pick_start(m, cand, ncand, &poll);
   if (poll.stopped) {
     km_morph_free(m);
     return km__stopped(err);
@@ -438,7 +443,7 @@ static km_status frame_impl(const km_morph *m, double t, km__poll *poll,
     st = km__stopped(err);
   if (st) goto done;
   if (m->closed && how == KM_CLOSURE_LSQ) {
-    /* close_lsq measures the gap itself (its first residual) */
+    /* the closure measures the gap itself (its first residual) */
     st = km__close_within_bound(m, &blended, &closed, &gap, poll, err);
     if (st) goto done;
     use = &closed;
@@ -502,12 +507,9 @@ static km_status frame_signature(const km_morph *m, double t, km__poll *poll,
   if (!st && m->closed && how == KM_CLOSURE_LSQ) {
     double gap;
     st = km__close_within_bound(m, &blended, out, &gap, poll, err);
-    km_signature_free(&blended);
-    return st;
-  }
-  if (!st) {
+  } else if (!st) {
     *out = blended;
-    return KM_OK;
+    km_signature_init(&blended);
   }
   km_signature_free(&blended);
   return st;

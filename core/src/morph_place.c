@@ -47,6 +47,25 @@ km_status km__place_plan_targets(km_morph *m, km_error *err) {
   return KM_OK;
 }
 
+/* The rotation about the origin (*rot) and translation T that map the
+ * points F (weights w, weighted mean fc) best onto Q (mean qc) in the
+ * least-squares sense: 2-D Procrustes in closed form. */
+static void procrustes(const double (*F)[2], const double (*Q)[2],
+                       const double *w, size_t n, const double fc[2],
+                       const double qc[2], double *rot, double T[2]) {
+  double sx = 0.0, sy = 0.0;
+  for (size_t j = 0; j < n; j++) {
+    double fx = F[j][0] - fc[0], fy = F[j][1] - fc[1];
+    double qx = Q[j][0] - qc[0], qy = Q[j][1] - qc[1];
+    sx += w[j] * (fx * qx + fy * qy);
+    sy += w[j] * (fx * qy - fy * qx);
+  }
+  *rot = atan2(sy, sx);
+  double cr = cos(*rot), sr = sin(*rot);
+  T[0] = qc[0] - (cr * fc[0] - sr * fc[1]);
+  T[1] = qc[1] - (sr * fc[0] + cr * fc[1]);
+}
+
 /* Rigid motion (rotation about the origin by *rot, then translation) that
  * places a frame given by samples F at frame arc lengths s[j] (weights w,
  * arc length the samples stand for): "fit" maps them in the least-squares
@@ -85,38 +104,22 @@ static void place_samples(const km_morph *m, double t, const double (*F)[2],
      * line between the inputs' centroids */
     T[0] = (1 - t) * a->centroid[0] + t * b->centroid[0] - fc[0];
     T[1] = (1 - t) * a->centroid[1] + t * b->centroid[1] - fc[1];
-    free(Q);
-    return;
+  } else {
+    procrustes(F, (const double (*)[2])Q, w, n, fc, qc, rot, T);
   }
-  double sx = 0.0, sy = 0.0;
-  for (size_t j = 0; j < n; j++) {
-    double fx = F[j][0] - fc[0], fy = F[j][1] - fc[1];
-    double qx = Q[j][0] - qc[0], qy = Q[j][1] - qc[1];
-    sx += w[j] * (fx * qx + fy * qy);
-    sy += w[j] * (fx * qy - fy * qx);
-  }
-  *rot = atan2(sy, sx);
-  double cr = cos(*rot), sr = sin(*rot);
-  T[0] = qc[0] - (cr * fc[0] - sr * fc[1]);
-  T[1] = qc[1] - (sr * fc[0] + cr * fc[1]);
   free(Q);
 }
 
 /* Placement of a frame curve whose parameter is arc length: samples at the
  * midpoints of FIT_N equal parts. */
 void km__place_frame(const km_morph *m, double t, const km_curve *f,
-                      double Lt, double *rot, double T[2]) {
+                     double Lt, double *rot, double T[2]) {
   static const size_t N = FIT_N;
   double (*F)[2] = malloc(N * sizeof *F);
   double *s = malloc(2 * N * sizeof(double));
-  if (!F || !s) {
-    free(F);
-    free(s);
-    place_samples(m, t, NULL, NULL, NULL, 0, rot, T); /* by the start */
-    return;
-  }
-  double *w = s + N;
-  for (size_t j = 0; j < N; j++) {
+  double *w = s ? s + N : NULL;
+  size_t n = F && s ? N : 0; /* without memory: by the start */
+  for (size_t j = 0; j < n; j++) {
     double d[1][2];
     s[j] = Lt * ((double)j + 0.5) / (double)N;
     w[j] = 1.0;
@@ -124,7 +127,7 @@ void km__place_frame(const km_morph *m, double t, const km_curve *f,
     F[j][0] = d[0][0];
     F[j][1] = d[0][1];
   }
-  place_samples(m, t, (const double (*)[2])F, s, w, N, rot, T);
+  place_samples(m, t, (const double (*)[2])F, s, w, n, rot, T);
   free(F);
   free(s);
 }

@@ -21,13 +21,7 @@
  *     bound, K_n h^(2n+1) max|f^(2n)| with |d^m e^(i theta)| <= B_m(|theta'|,
  *     ..., |theta^(m)|) (complete Bell polynomial), meets its share of the
  *     tolerance: smooth inputs need two or three nodes a piece, not eight.
- * A frame is then a pass of sin/cos over the nodes, a pass turning them by
- * the closure's first change, a bounded first-order finish (close_frame)
- * and the Hermite control points: no piecewise-polynomial blending, no
- * planning, no allocation but the output. The closure is the one of morph_closure.c: interior uniform
- * cubic B-splines psi added to theta, minimum-norm steps in the metric
- * integral psi'^2 (the Gram matrix of their derivatives is Toeplitz with
- * entries 2/3, -1/8, -1/5, -1/120), so the seam stays G2.
+ * Frames are built from the plan in morph_plan_frame.c.
  */
 #include <math.h>
 #include <stdlib.h>

@@ -1,6 +1,14 @@
-/* morph_plan_frame.c - a frame built from its morph's plan (morph_plan.c):
- * passes of sin/cos over the plan's nodes, the lsq closure's steps and the
- * cubic Hermite control points.
+/* morph_plan_frame.c - a frame built from its morph's plan (morph_plan.c).
+ *
+ * DESIGN. A frame is a pass of sin/cos over the plan's nodes, a pass
+ * turning them by the closure's first change, a bounded first-order finish
+ * (km__plan_close_frame) and the Hermite control points: no
+ * piecewise-polynomial blending, no planning, no allocation but the
+ * output. The closure is the one of morph_closure.c: interior uniform
+ * cubic B-splines psi added to theta, minimum-norm steps in the metric
+ * integral psi'^2 (the Gram matrix of their derivatives is Toeplitz with
+ * entries 2/3, -1/8, -1/5, -1/120), so the seam stays G2; or, where the
+ * plan says so, a turn of the frame's corners.
  */
 #include <math.h>
 #include <stdlib.h>
