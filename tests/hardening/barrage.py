@@ -490,8 +490,8 @@ def main():
     a = ap.parse_args()
     ck = hlib.Checks(a.name)
     items = Gen(20240611).build(a.count)
-    d = hlib.Daemon(a.daemon, "--threads", "2", "--queue", "256",
-                    "--access-log", "0", sanitized=a.asan)
+    d = hlib.Daemon("--threads", "2", "--queue", "256", "--access-log", "0",
+                    exe=a.daemon, sanitized=a.asan)
     try:
         # warm up with valid requests so the baseline includes the pools,
         # then measure

@@ -1,157 +1,29 @@
-"""hlib.py - shared pieces of the hardening tests: a kmorphd on a free
-loopback port (its stderr kept, sanitizer reports collected), HTTP on
-fresh or raw connections, the daemon's resident memory and open file
-descriptors from /proc, and the result lines summarise.sh totals.
+"""hlib.py - the hardening tests' view of tests/pylib/kmdaemon.py (the
+daemon, its stderr, sanitizer reports, memory and descriptors, HTTP on
+fresh or raw connections) plus what only they need: requests sent
+exactly as given, raw requests whose answer is read even when the server
+closes early, problem checks, and the result lines summarise.sh totals.
 
 Standard library only; every wait is bounded.
 """
-import glob
-import http.client
-import json
 import os
-import shutil
-import signal
-import socket
-import subprocess
-import tempfile
-import time
+import sys
 
-ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
-HOST = "127.0.0.1"
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                                "..", "pylib"))
+import kmdaemon  # noqa: E402
+from kmdaemon import (DAEMON, HOST, ROOT, Daemon,  # noqa: E402,F401
+                      Reply, raw_exchange)
+
 RESULTS = os.environ.get("KM_RESULTS",
                          os.path.join(ROOT, "build", "test-results.txt"))
 
 
-class Daemon:
-    """kmorphd on --port 0. With sanitized=True, ASan/UBSan/LSan reports go
-    to files in a private folder (reports() lists them)."""
-
-    def __init__(self, exe, *flags, sanitized=False):
-        self.dir = tempfile.mkdtemp(prefix="kmorph-hardening-")
-        self.logpath = os.path.join(self.dir, "kmorphd.log")
-        self.log = open(self.logpath, "wb")
-        env = {k: v for k, v in os.environ.items()
-               if not k.startswith("KMORPH_")}
-        if sanitized:
-            env["ASAN_OPTIONS"] = ("log_path=%s/asan:detect_leaks=1:"
-                                   "abort_on_error=0:halt_on_error=1"
-                                   % self.dir)
-            env["UBSAN_OPTIONS"] = ("log_path=%s/ubsan:print_stacktrace=1:"
-                                    "halt_on_error=1" % self.dir)
-            env["LSAN_OPTIONS"] = "log_path=%s/lsan" % self.dir
-        self.proc = subprocess.Popen(
-            [exe, "--bind", HOST, "--port", "0", *flags],
-            stdout=subprocess.DEVNULL, stderr=self.log, env=env)
-        self.port = None
-        deadline = time.monotonic() + 20
-        while time.monotonic() < deadline and self.port is None:
-            if self.proc.poll() is not None:
-                raise RuntimeError("kmorphd exited: " + self.text()[-2000:])
-            for line in self.text().splitlines():
-                if "listening on http://" in line:
-                    self.port = int(line.split("http://", 1)[1]
-                                    .split(" ", 1)[0].rsplit(":", 1)[1])
-            time.sleep(0.02)
-        if self.port is None:
-            self.kill()
-            raise RuntimeError("kmorphd did not start: " + self.text())
-
-    def text(self):
-        with open(self.logpath, encoding="utf-8", errors="replace") as f:
-            return f.read()
-
-    def reports(self):
-        """Sanitizer report files written so far (name, first lines)."""
-        out = []
-        for p in sorted(glob.glob(os.path.join(self.dir, "*san*"))):
-            with open(p, encoding="utf-8", errors="replace") as f:
-                out.append((os.path.basename(p), f.read()[:3000]))
-        return out
-
-    def rss_kb(self):
-        with open("/proc/%d/status" % self.proc.pid) as f:
-            for line in f:
-                if line.startswith("VmRSS:"):
-                    return int(line.split()[1])
-        return 0
-
-    def fds(self):
-        return len(os.listdir("/proc/%d/fd" % self.proc.pid))
-
-    def alive(self):
-        return self.proc.poll() is None
-
-    def request(self, method, path, body=None, headers=None, timeout=30.0):
-        return request(self.port, method, path, body, headers, timeout)
-
-    def terminate(self, timeout=30.0):
-        """SIGTERM; returns (exit status or None, seconds to exit)."""
-        t0 = time.monotonic()
-        if self.proc.poll() is None:
-            self.proc.send_signal(signal.SIGTERM)
-        try:
-            rc = self.proc.wait(timeout=timeout)
-        except subprocess.TimeoutExpired:
-            rc = None
-        return rc, time.monotonic() - t0
-
-    def kill(self):
-        if self.proc.poll() is None:
-            self.proc.kill()
-            self.proc.wait(timeout=10)
-
-    def close(self):
-        self.kill()
-        self.log.close()
-        shutil.rmtree(self.dir, ignore_errors=True)
-
-
-class Reply:
-    def __init__(self, status, headers, body):
-        self.status = status
-        self.headers = {k.lower(): v for k, v in headers}
-        self.body = body
-
-    @property
-    def ctype(self):
-        return (self.headers.get("content-type") or "").split(";")[0].strip()
-
-    def json(self):
-        return json.loads(self.body.decode("utf-8"))
-
-
 def request(port, method, path, body=None, headers=None, timeout=30.0):
-    """One request on a fresh connection."""
-    hdrs = dict(headers or {})
-    if body is not None and not isinstance(body, bytes):
-        body = json.dumps(body).encode()
-    conn = http.client.HTTPConnection(HOST, port, timeout=timeout)
-    try:
-        conn.request(method, path, body=body, headers=hdrs)
-        r = conn.getresponse()
-        return Reply(r.status, r.getheaders(), r.read())
-    finally:
-        conn.close()
-
-
-def raw(port, data, timeout=10.0):
-    """Send raw bytes, read until the server closes or timeout."""
-    out = b""
-    with socket.create_connection((HOST, port), timeout=timeout) as s:
-        try:
-            s.sendall(data)
-        except OSError:
-            pass
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            try:
-                b = s.recv(65536)
-            except OSError:
-                break
-            if not b:
-                break
-            out += b
-    return out
+    """One request on a fresh connection with no Content-Type added: the
+    barrage sends some bodies without one on purpose."""
+    return kmdaemon.request(port, method, path, body, headers, timeout,
+                            content_type=None)
 
 
 def raw_request(port, method, path, headers, body, timeout=30.0):
@@ -164,7 +36,7 @@ def raw_request(port, method, path, headers, body, timeout=30.0):
         if k != "X-Raw":
             head += "%s: %s\r\n" % (k, v)
     head += "Content-Length: %d\r\n\r\n" % len(body or b"")
-    data = raw(port, head.encode() + (body or b""), timeout)
+    data = raw_exchange(port, head.encode() + (body or b""), timeout)
     hdr, _, rest = data.partition(b"\r\n\r\n")
     lines = hdr.decode("latin-1").split("\r\n")
     try:

@@ -14,7 +14,9 @@ import math
 import os
 import sys
 
-ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                                "..", "pylib"))
+from kmdaemon import ROOT, circle_svg, square_svg  # noqa: E402,F401
 
 
 def _load(rel):
@@ -24,17 +26,6 @@ def _load(rel):
 
 def compact(doc):
     return json.dumps(doc, separators=(",", ":")).encode()
-
-
-def circle_svg(r, cx=0.0, cy=0.0):
-    return {"type": "svg",
-            "d": "M %r %r A %r %r 0 1 1 %r %r A %r %r 0 1 1 %r %r Z" % (
-                cx + r, cy, r, r, cx - r, cy, r, r, cx + r, cy)}
-
-
-def square_svg(side):
-    return {"type": "svg",
-            "d": "M 0 0 L %r 0 L %r %r L 0 %r Z" % (side, side, side, side)}
 
 
 def cubic_bspline():

@@ -41,8 +41,7 @@ LOAD_SECONDS = float(os.environ.get("LOAD_SECONDS", 120 if LONG else 20))
 IDLE_CONNECTIONS = int(os.environ.get("IDLE_CONNECTIONS", 10000))
 CLIENTS = 64
 RSS_BOUND_MB = 512
-DAEMON = os.environ.get("KMORPHD", os.path.join(hlib.ROOT, "build",
-                                                "kmorphd"))
+DAEMON = hlib.DAEMON
 JSON = {"Content-Type": "application/json"}
 
 
@@ -123,8 +122,8 @@ def refusal_ok(r):
 # ------------------------------------------------------------------ load
 
 def part_load(ck):
-    d = hlib.Daemon(DAEMON, "--access-log", "0", "--max-jobs", "64",
-                    "--queue", "128")
+    d = hlib.Daemon("--access-log", "0", "--max-jobs", "64",
+                    "--queue", "128", exe=DAEMON)
     stats = {"sig": 0, "morph": 0, "job": 0, "cancelled": 0, "health": 0,
              "refused": 0}
     lat = []
@@ -338,10 +337,10 @@ def part_faults(ck):
     batch = min(2000, max(100, (want - 512) // 2))
     # One address opens the idle connections here, so the limit per
     # address is lifted to the connection limit (test_bounds.py covers it).
-    d = hlib.Daemon(DAEMON, "--access-log", "0", "--timeout", "3",
+    d = hlib.Daemon("--access-log", "0", "--timeout", "3",
                     "--request-time", "4", "--max-connections",
                     str(batch + 200), "--per-ip", str(batch + 200),
-                    "--queue", "256")
+                    "--queue", "256", exe=DAEMON)
     try:
         body = json.dumps({"curve": kmreq.circle_svg(2.0)}).encode()
         for _ in range(5):
@@ -504,8 +503,8 @@ def part_faults(ck):
 
 def part_sigterm(ck):
     grace = 10.0
-    d = hlib.Daemon(DAEMON, "--access-log", "0", "--shutdown-grace",
-                    str(grace), "--max-jobs", "64")
+    d = hlib.Daemon("--access-log", "0", "--shutdown-grace",
+                    str(grace), "--max-jobs", "64", exe=DAEMON)
     try:
         heavy = {"from": kmreq.circle_svg(10.0), "to": kmreq.square_svg(15.0),
                  "frames": 3000, "metrics": True}

@@ -49,14 +49,6 @@ def heavy_prepare_body(frames=2):
             "metrics": True}
 
 
-def rss_kb(pid):
-    with open("/proc/%d/status" % pid) as f:
-        for line in f:
-            if line.startswith("VmRSS:"):
-                return int(line.split()[1])
-    return 0
-
-
 def connect_from(addr, port, timeout=10.0):
     """A TCP connection to the daemon from a chosen loopback address, so
     that tests can stand for clients of different addresses."""
@@ -257,7 +249,7 @@ class ResultMemory(ContractCase):
             size = len(d.request("GET", "/v1/jobs/%s/result" % jid).body)
             self.assertGreater(size, 4 << 20)
             time.sleep(0.3)
-            rss0 = rss_kb(d.proc.pid)
+            rss0 = d.rss_kb()
             readers = []
             for _ in range(8):
                 s = socket.socket()
@@ -267,7 +259,7 @@ class ResultMemory(ContractCase):
                            "\r\n" % jid).encode())
                 readers.append(s)
             time.sleep(1.0)
-            rss1 = rss_kb(d.proc.pid)
+            rss1 = d.rss_kb()
             for s in readers:
                 s.close()
             grown = (rss1 - rss0) * 1024
