@@ -169,36 +169,288 @@ static double extent_of(const km_path *p) {
   return e;
 }
 
+/* Where drawing stands: the path so far, the current point, the
+ * subpath's start, the last control point and command (for S and T). */
+typedef struct pen {
+  km_path path;
+  char prev;             /* previous command, for S and T reflection */
+  bool drawn;            /* a drawing command (or Z) was seen */
+  bool done;             /* Z seen: further drawing is a second subpath */
+  double cx, cy;         /* current point */
+  double sx, sy;         /* subpath start */
+  double lcx, lcy;       /* last control point (S, T) */
+} pen;
+
+/* The path data must start with a moveto. */
+static km_status expect_moveto(parser *ps) {
+  char fb[16];
+  skip_wsp(ps);
+  if (ps->pos >= ps->len)
+    return fail(ps, ps->pos, KM_EINVAL, "%s",
+                "expected a moveto (M or m): path data is empty");
+  if (ps->s[ps->pos] != 'M' && ps->s[ps->pos] != 'm')
+    return fail(ps, ps->pos, KM_EINVAL,
+                "expected a moveto (M or m) at the start, found %s",
+                found(ps, fb));
+  return KM_OK;
+}
+
+/* Z: close the path (a second Z on a closed path draws nothing). */
+static km_status close_path(parser *ps, pen *pn, size_t cmd_off) {
+  km_error e;
+  if (!pn->done) {
+    if (!pn->drawn)
+      return fail(ps, cmd_off, KM_EDEGENERATE, "%s",
+                  "closepath before any drawing command: path draws "
+                  "nothing");
+    km_status st = km_path_close(&pn->path, &e);
+    if (st) return geom_fail(ps, cmd_off, st, &e);
+    pn->done = true;
+  }
+  pn->cx = pn->sx;
+  pn->cy = pn->sy;
+  pn->prev = 'Z';
+  return KM_OK;
+}
+
+/* Between argument sets: comma-wsp, none after the last one. *more says
+ * whether another set follows. */
+static km_status next_set(parser *ps, bool *more) {
+  char fb[16];
+  skip_wsp(ps);
+  *more = true;
+  if (ps->pos < ps->len && ps->s[ps->pos] == ',') {
+    ps->pos++;
+    skip_wsp(ps);
+    if (!number_ahead(ps))
+      return fail(ps, ps->pos, KM_EINVAL,
+                  "expected a number after ',', found %s", found(ps, fb));
+  } else if (!number_ahead(ps)) {
+    *more = false;
+  }
+  return KM_OK;
+}
+
+/* M's argument set at (ox, oy) + (x, y). */
+static km_status move_to(parser *ps, pen *pn, double ox, double oy,
+                         size_t cmd_off, size_t arg_off) {
+  double v[2];
+  km_error e;
+  km_status st = parse_args(ps, 2, N_XY, v);
+  if (st) return st;
+  if (pn->drawn) {
+    /* Only a trailing moveto that draws nothing is tolerated. */
+    skip_wsp(ps);
+    if (ps->pos < ps->len)
+      return fail(ps, cmd_off, KM_EINVAL, "%s",
+                  "a second subpath (moveto after drawing): one "
+                  "subpath per curve");
+    pn->cx = ox + v[0];
+    pn->cy = oy + v[1];
+    return KM_OK;
+  }
+  pn->cx = pn->sx = ox + v[0];
+  pn->cy = pn->sy = oy + v[1];
+  /* Consecutive movetos before drawing just move the start. */
+  km_path_free(&pn->path);
+  km_path_init(&pn->path);
+  st = km_path_move_to(&pn->path, pn->cx, pn->cy, &e);
+  return st ? geom_fail(ps, arg_off, st, &e) : KM_OK;
+}
+
+/* L, H or V's argument set. */
+static km_status line_to(parser *ps, pen *pn, char up, double ox,
+                         double oy) {
+  double v[2];
+  km_error e;
+  km_status st;
+  size_t arg_off = ps->pos;
+  if (up == 'L') {
+    if ((st = parse_args(ps, 2, N_XY, v))) return st;
+    pn->cx = ox + v[0];
+    pn->cy = oy + v[1];
+  } else if (up == 'H') {
+    if ((st = parse_args(ps, 1, N_H, v))) return st;
+    pn->cx = ox + v[0];
+  } else {
+    if ((st = parse_args(ps, 1, N_V, v))) return st;
+    pn->cy = oy + v[0];
+  }
+  st = km_path_line_to(&pn->path, pn->cx, pn->cy, &e);
+  return st ? geom_fail(ps, arg_off, st, &e) : KM_OK;
+}
+
+/* C or S's argument set. */
+static km_status cubic_to(parser *ps, pen *pn, char up, double ox,
+                          double oy) {
+  double v[6], x1 = pn->cx, y1 = pn->cy;
+  km_error e;
+  km_status st;
+  size_t arg_off = ps->pos;
+  if (up == 'C') {
+    if ((st = parse_args(ps, 6, N_C, v))) return st;
+    x1 = ox + v[0];
+    y1 = oy + v[1];
+  } else {
+    if ((st = parse_args(ps, 4, N_S, v + 2))) return st;
+    /* First control point: reflection of the previous cubic's second
+     * one, else the current point (SVG 1.1, 8.3.6). */
+    if (pn->prev == 'C' || pn->prev == 'S') {
+      x1 = 2 * pn->cx - pn->lcx;
+      y1 = 2 * pn->cy - pn->lcy;
+    }
+  }
+  pn->lcx = ox + v[2];
+  pn->lcy = oy + v[3];
+  pn->cx = ox + v[4];
+  pn->cy = oy + v[5];
+  st = km_path_cubic_to(&pn->path, x1, y1, pn->lcx, pn->lcy, pn->cx, pn->cy,
+                        &e);
+  return st ? geom_fail(ps, arg_off, st, &e) : KM_OK;
+}
+
+/* Q or T's argument set. */
+static km_status quad_to(parser *ps, pen *pn, char up, double ox,
+                         double oy) {
+  double v[4];
+  km_error e;
+  km_status st;
+  size_t arg_off = ps->pos;
+  if (up == 'Q') {
+    if ((st = parse_args(ps, 4, N_Q, v))) return st;
+    pn->lcx = ox + v[0];
+    pn->lcy = oy + v[1];
+  } else {
+    if ((st = parse_args(ps, 2, N_XY, v + 2))) return st;
+    if (pn->prev == 'Q' || pn->prev == 'T') {
+      pn->lcx = 2 * pn->cx - pn->lcx;
+      pn->lcy = 2 * pn->cy - pn->lcy;
+    } else {
+      pn->lcx = pn->cx;
+      pn->lcy = pn->cy;
+    }
+  }
+  pn->cx = ox + v[2];
+  pn->cy = oy + v[3];
+  st = km_path_quad_to(&pn->path, pn->lcx, pn->lcy, pn->cx, pn->cy, &e);
+  return st ? geom_fail(ps, arg_off, st, &e) : KM_OK;
+}
+
+/* A's argument set: rx ry rotation large-arc sweep x y. */
+static km_status arc_to(parser *ps, pen *pn, double ox, double oy) {
+  double v[5];
+  bool large = false, sweep = false;
+  km_error e;
+  size_t arg_off = ps->pos;
+  km_status st = parse_number(ps, "rx", &v[0]);
+  if (!st) {
+    skip_comma_wsp(ps);
+    st = parse_number(ps, "ry", &v[1]);
+  }
+  if (!st) {
+    skip_comma_wsp(ps);
+    st = parse_number(ps, "x-axis-rotation", &v[2]);
+  }
+  if (!st) {
+    skip_comma_wsp(ps);
+    st = parse_flag(ps, "large-arc-flag", &large);
+  }
+  if (!st) {
+    skip_comma_wsp(ps);
+    st = parse_flag(ps, "sweep-flag", &sweep);
+  }
+  if (!st) {
+    skip_comma_wsp(ps);
+    st = parse_args(ps, 2, N_XY, v + 3);
+  }
+  if (st) return st;
+  pn->cx = ox + v[3];
+  pn->cy = oy + v[4];
+  st = km_path_arc_to(&pn->path, v[0], v[1], v[2], large, sweep, pn->cx,
+                      pn->cy, &e);
+  return st ? geom_fail(ps, arg_off, st, &e) : KM_OK;
+}
+
+/* One argument set of command up (M after its first set is L), relative
+ * when rel; offsets name the command and the set in errors. */
+static km_status argument_set(parser *ps, pen *pn, char up, bool rel,
+                              bool first, size_t cmd_off, size_t arg_off) {
+  double ox = rel ? pn->cx : 0.0, oy = rel ? pn->cy : 0.0;
+  km_status st = KM_OK;
+  if ((up != 'M') && pn->done)
+    return fail(ps, first ? cmd_off : arg_off, KM_EINVAL, "%s",
+                "a second subpath: one subpath per curve (the path "
+                "was closed)");
+  switch (up) {
+  case 'M': st = move_to(ps, pn, ox, oy, cmd_off, arg_off); break;
+  case 'L':
+  case 'H':
+  case 'V': st = line_to(ps, pn, up, ox, oy); break;
+  case 'C':
+  case 'S': st = cubic_to(ps, pn, up, ox, oy); break;
+  case 'Q':
+  case 'T': st = quad_to(ps, pn, up, ox, oy); break;
+  case 'A': st = arc_to(ps, pn, ox, oy); break;
+  default: break;
+  }
+  if (st) return st;
+  if (up != 'M') pn->drawn = true;
+  /* Coordinates reached by relative sums must stay representable. */
+  if (!isfinite(pn->cx) || !isfinite(pn->cy))
+    return fail(ps, arg_off, KM_ERANGE, "%s",
+                "coordinate is too large for a double");
+  pn->prev = up;
+  return KM_OK;
+}
+
+/* A command at cmd_off (its letter read) and all its argument sets; the
+ * first is required, more repeat the command. */
+static km_status command(parser *ps, pen *pn, char cmd, size_t cmd_off) {
+  bool rel = cmd >= 'a', first = true, more = true;
+  char up = (char)(rel ? cmd - 32 : cmd);
+  if (up == 'Z') return close_path(ps, pn, cmd_off);
+  for (;;) {
+    size_t arg_off = ps->pos;
+    if (!first) {
+      km_status st = next_set(ps, &more);
+      if (st) return st;
+      if (!more) return KM_OK;
+      arg_off = ps->pos;
+      if (up == 'M') up = 'L'; /* implicit lineto */
+    }
+    km_status st = argument_set(ps, pn, up, rel, first, cmd_off, arg_off);
+    if (st) return st;
+    first = false;
+  }
+}
+
+/* The path as one curve: pieces within min(tol, 1e-9 x extent) of a
+ * point dropped. */
+static km_status to_curve(parser *ps, const pen *pn, double tol,
+                          km_curve *out) {
+  double eps = 1e-9 * extent_of(&pn->path);
+  km_curve c;
+  km_error e;
+  km_status st;
+  if (tol > 0 && tol < eps) eps = tol;
+  km_curve_init(&c);
+  st = km_path_to_curve(&pn->path, eps, &c, &e);
+  if (st) return fail(ps, 0, st, "%s", e.message);
+  *out = c;
+  return KM_OK;
+}
+
 km_status api_svg_parse_path(const char *d, size_t len, double tol,
                              km_curve *out, size_t *err_offset, char *msg,
                              size_t msgcap) {
   parser ps = {d ? d : "", d ? len : 0, 0, 0, msg, msgcap};
-  km_path path;
-  km_path_init(&path);
-  km_error e;
-  km_status st = KM_OK;
+  pen pn = {.prev = 0};
+  km_status st;
   char fb[16];
-  char cmd = 0;          /* current command letter */
-  char prev = 0;         /* previous command, for S and T reflection */
-  bool drawn = false;    /* a drawing command (or Z) was seen */
-  bool done = false;     /* Z seen: further drawing is a second subpath */
-  double cx = 0, cy = 0; /* current point */
-  double sx = 0, sy = 0; /* subpath start */
-  double lcx = 0, lcy = 0; /* last control point (S, T) */
+  km_path_init(&pn.path);
   if (msg && msgcap) msg[0] = '\0';
 
-  skip_wsp(&ps);
-  if (ps.pos >= ps.len) {
-    st = fail(&ps, ps.pos, KM_EINVAL, "%s",
-              "expected a moveto (M or m): path data is empty");
-    goto cleanup;
-  }
-  if (ps.s[ps.pos] != 'M' && ps.s[ps.pos] != 'm') {
-    st = fail(&ps, ps.pos, KM_EINVAL,
-              "expected a moveto (M or m) at the start, found %s",
-              found(&ps, fb));
-    goto cleanup;
-  }
+  if ((st = expect_moveto(&ps))) goto cleanup;
   while (ps.pos < ps.len) {
     size_t cmd_off = ps.pos;
     char c = ps.s[ps.pos];
@@ -208,239 +460,14 @@ km_status api_svg_parse_path(const char *d, size_t len, double tol,
                 found(&ps, fb));
       goto cleanup;
     }
-    cmd = c;
     ps.pos++;
     skip_wsp(&ps);
-    bool rel = cmd >= 'a';
-    char up = (char)(rel ? cmd - 32 : cmd);
-
-    if (up == 'Z') {
-      /* A second Z on an already closed path draws nothing. */
-      if (!done) {
-        if (!drawn) {
-          st = fail(&ps, cmd_off, KM_EDEGENERATE, "%s",
-                    "closepath before any drawing command: path draws "
-                    "nothing");
-          goto cleanup;
-        }
-        st = km_path_close(&path, &e);
-        if (st) {
-          st = geom_fail(&ps, cmd_off, st, &e);
-          goto cleanup;
-        }
-        done = true;
-      }
-      cx = sx;
-      cy = sy;
-      prev = 'Z';
-      continue;
-    }
-
-    /* Argument sets; the first is required, more repeat the command. */
-    bool first = true;
-    for (;;) {
-      size_t arg_off = ps.pos;
-      if (!first) {
-        /* comma-wsp between argument sets, none after the last one. */
-        skip_wsp(&ps);
-        if (ps.pos < ps.len && ps.s[ps.pos] == ',') {
-          ps.pos++;
-          skip_wsp(&ps);
-          if (!number_ahead(&ps)) {
-            st = fail(&ps, ps.pos, KM_EINVAL,
-                      "expected a number after ',', found %s",
-                      found(&ps, fb));
-            goto cleanup;
-          }
-        } else if (!number_ahead(&ps)) {
-          break;
-        }
-        arg_off = ps.pos;
-      }
-      double v[7];
-      double ox = rel ? cx : 0.0, oy = rel ? cy : 0.0;
-      if (up == 'M' && !first) up = 'L'; /* implicit lineto */
-      if ((up != 'M') && done) {
-        st = fail(&ps, first ? cmd_off : arg_off, KM_EINVAL, "%s",
-                  "a second subpath: one subpath per curve (the path "
-                  "was closed)");
-        goto cleanup;
-      }
-      switch (up) {
-      case 'M':
-        st = parse_args(&ps, 2, N_XY, v);
-        if (st) goto cleanup;
-        if (drawn) {
-          /* Only a trailing moveto that draws nothing is tolerated. */
-          skip_wsp(&ps);
-          size_t save = ps.pos;
-          if (ps.pos < ps.len) {
-            st = fail(&ps, cmd_off, KM_EINVAL, "%s",
-                      "a second subpath (moveto after drawing): one "
-                      "subpath per curve");
-            goto cleanup;
-          }
-          ps.pos = save;
-          cx = ox + v[0];
-          cy = oy + v[1];
-          break;
-        }
-        cx = sx = ox + v[0];
-        cy = sy = oy + v[1];
-        /* Consecutive movetos before drawing just move the start. */
-        km_path_free(&path);
-        km_path_init(&path);
-        st = km_path_move_to(&path, cx, cy, &e);
-        if (st) {
-          st = geom_fail(&ps, arg_off, st, &e);
-          goto cleanup;
-        }
-        break;
-      case 'L':
-        st = parse_args(&ps, 2, N_XY, v);
-        if (!st) {
-          cx = ox + v[0];
-          cy = oy + v[1];
-          st = km_path_line_to(&path, cx, cy, &e);
-          if (st) st = geom_fail(&ps, arg_off, st, &e);
-        }
-        break;
-      case 'H':
-        st = parse_args(&ps, 1, N_H, v);
-        if (!st) {
-          cx = ox + v[0];
-          st = km_path_line_to(&path, cx, cy, &e);
-          if (st) st = geom_fail(&ps, arg_off, st, &e);
-        }
-        break;
-      case 'V':
-        st = parse_args(&ps, 1, N_V, v);
-        if (!st) {
-          cy = oy + v[0];
-          st = km_path_line_to(&path, cx, cy, &e);
-          if (st) st = geom_fail(&ps, arg_off, st, &e);
-        }
-        break;
-      case 'C':
-        st = parse_args(&ps, 6, N_C, v);
-        if (!st) {
-          double x1 = ox + v[0], y1 = oy + v[1];
-          lcx = ox + v[2];
-          lcy = oy + v[3];
-          cx = ox + v[4];
-          cy = oy + v[5];
-          st = km_path_cubic_to(&path, x1, y1, lcx, lcy, cx, cy, &e);
-          if (st) st = geom_fail(&ps, arg_off, st, &e);
-        }
-        break;
-      case 'S':
-        st = parse_args(&ps, 4, N_S, v);
-        if (!st) {
-          /* First control point: reflection of the previous cubic's
-           * second one, else the current point (SVG 1.1, 8.3.6). */
-          double x1 = cx, y1 = cy;
-          if (prev == 'C' || prev == 'S') {
-            x1 = 2 * cx - lcx;
-            y1 = 2 * cy - lcy;
-          }
-          lcx = ox + v[0];
-          lcy = oy + v[1];
-          cx = ox + v[2];
-          cy = oy + v[3];
-          st = km_path_cubic_to(&path, x1, y1, lcx, lcy, cx, cy, &e);
-          if (st) st = geom_fail(&ps, arg_off, st, &e);
-        }
-        break;
-      case 'Q':
-        st = parse_args(&ps, 4, N_Q, v);
-        if (!st) {
-          lcx = ox + v[0];
-          lcy = oy + v[1];
-          cx = ox + v[2];
-          cy = oy + v[3];
-          st = km_path_quad_to(&path, lcx, lcy, cx, cy, &e);
-          if (st) st = geom_fail(&ps, arg_off, st, &e);
-        }
-        break;
-      case 'T':
-        st = parse_args(&ps, 2, N_XY, v);
-        if (!st) {
-          if (prev == 'Q' || prev == 'T') {
-            lcx = 2 * cx - lcx;
-            lcy = 2 * cy - lcy;
-          } else {
-            lcx = cx;
-            lcy = cy;
-          }
-          cx = ox + v[0];
-          cy = oy + v[1];
-          st = km_path_quad_to(&path, lcx, lcy, cx, cy, &e);
-          if (st) st = geom_fail(&ps, arg_off, st, &e);
-        }
-        break;
-      case 'A': {
-        bool large = false, sweep = false;
-        st = parse_number(&ps, "rx", &v[0]);
-        if (!st) {
-          skip_comma_wsp(&ps);
-          st = parse_number(&ps, "ry", &v[1]);
-        }
-        if (!st) {
-          skip_comma_wsp(&ps);
-          st = parse_number(&ps, "x-axis-rotation", &v[2]);
-        }
-        if (!st) {
-          skip_comma_wsp(&ps);
-          st = parse_flag(&ps, "large-arc-flag", &large);
-        }
-        if (!st) {
-          skip_comma_wsp(&ps);
-          st = parse_flag(&ps, "sweep-flag", &sweep);
-        }
-        if (!st) {
-          skip_comma_wsp(&ps);
-          st = parse_args(&ps, 2, N_XY, v + 3);
-        }
-        if (!st) {
-          cx = ox + v[3];
-          cy = oy + v[4];
-          st = km_path_arc_to(&path, v[0], v[1], v[2], large, sweep, cx, cy,
-                              &e);
-          if (st) st = geom_fail(&ps, arg_off, st, &e);
-        }
-        break;
-      }
-      default:
-        break;
-      }
-      if (st) goto cleanup;
-      if (up != 'M') drawn = true;
-      /* Coordinates reached by relative sums must stay representable. */
-      if (!isfinite(cx) || !isfinite(cy)) {
-        st = fail(&ps, arg_off, KM_ERANGE, "%s",
-                  "coordinate is too large for a double");
-        goto cleanup;
-      }
-      prev = up;
-      first = false;
-    }
+    if ((st = command(&ps, &pn, c, cmd_off))) goto cleanup;
   }
-
-  {
-    double eps = 1e-9 * extent_of(&path);
-    if (tol > 0 && tol < eps) eps = tol;
-    km_curve c;
-    km_curve_init(&c);
-    st = km_path_to_curve(&path, eps, &c, &e);
-    if (st) {
-      st = fail(&ps, 0, st, "%s", e.message);
-      goto cleanup;
-    }
-    *out = c;
-  }
+  st = to_curve(&ps, &pn, tol, out);
 
 cleanup:
   if (st && err_offset) *err_offset = ps.err_off;
-  km_path_free(&path);
+  km_path_free(&pn.path);
   return st;
 }
