@@ -200,18 +200,10 @@ static km_status solve_closed(const double *Q, const double *h,
  * KM_EDEGENERATE (fewer than 2 distinct points, 3 when closed; field
  * KM_FIELD_POINTS), KM_ELIMIT (n absurdly large), KM_ENOMEM. out owned by
  * the caller. Thread-safe. */
-km_status km_curve_interpolate(km_curve *out, const double *pts, size_t n,
-                               bool closed, km_error *err) {
-  double *Q = NULL, *u = NULL, *h = NULL;
-  km_curve c;
-  km_curve_init(&c);
-  km_status st = KM_OK;
-  if (n > 0 && !pts)
-    return km__fail(err, KM_EINVAL, KM_FIELD_POINTS, -1, NAN,
-                    "points array is missing");
-  if (n > ((size_t)-1) / (16 * sizeof(double)))
-    return km__fail(err, KM_ELIMIT, KM_FIELD_POINTS, -1, NAN,
-                    "too many points");
+/* ---- the phases of km_curve_interpolate -------------------------------- */
+
+/* Every coordinate finite and within KM_MAX_COORDINATE. */
+static km_status check_points(const double *pts, size_t n, km_error *err) {
   for (size_t i = 0; i < n; i++) {
     for (int k = 0; k < 2; k++) {
       double v = pts[2 * i + (size_t)k];
@@ -224,15 +216,14 @@ km_status km_curve_interpolate(km_curve *out, const double *pts, size_t n,
                         KM_MAX_COORDINATE);
     }
   }
-  Q = malloc((2 * n + 2) * sizeof(double));
-  u = malloc((n + 2) * sizeof(double));
-  h = malloc((n + 2) * sizeof(double));
-  if (!Q || !u || !h) {
-    st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
-    goto cleanup;
-  }
-  /* drop consecutive duplicates (and, closed, a repeat of the first point
-   * at the end): a zero chord has no parameter interval to live in */
+  return KM_OK;
+}
+
+/* The points into Q without consecutive duplicates (and, closed, a repeat
+ * of the first point at the end): a zero chord has no parameter interval
+ * to live in. Returns the number kept. */
+static size_t distinct_points(const double *pts, size_t n, bool closed,
+                              double *Q) {
   size_t N = 0;
   for (size_t i = 0; i < n; i++) {
     double x = pts[2 * i], y = pts[2 * i + 1];
@@ -243,24 +234,22 @@ km_status km_curve_interpolate(km_curve *out, const double *pts, size_t n,
   }
   if (closed)
     while (N > 1 && hypot(Q[2 * N - 2] - Q[0], Q[2 * N - 1] - Q[1]) == 0.0) N--;
-  if (N < 2 || (closed && N < 3)) {
-    st = km__fail(err, KM_EDEGENERATE, KM_FIELD_POINTS, -1, NAN,
-                  closed ? "a closed curve needs at least 3 distinct points"
-                         : "an open curve needs at least 2 distinct points");
-    goto cleanup;
-  }
-  /* chord lengths; closed adds the closing chord */
-  size_t nspan = closed ? N : N - 1;
+  return N;
+}
+
+/* Chord-length breaks u[0..nspan] in [0, 1] and the spans h between them
+ * (closed adds the closing chord); KM_EDEGENERATE when two breaks do not
+ * separate. */
+static km_status chord_breaks(const double *Q, size_t N, size_t nspan,
+                              double *u, double *h, km_error *err) {
   double total = 0.0;
   for (size_t k = 0; k < nspan; k++) {
     size_t k1 = (k + 1) % N;
     h[k] = hypot(Q[2 * k1] - Q[2 * k], Q[2 * k1 + 1] - Q[2 * k + 1]);
     total += h[k];
   }
-  if (!(total > 0) || !isfinite(total)) {
-    st = km__fail(err, KM_EDEGENERATE, KM_FIELD_POINTS, -1, NAN, NULL);
-    goto cleanup;
-  }
+  if (!(total > 0) || !isfinite(total))
+    return km__fail(err, KM_EDEGENERATE, KM_FIELD_POINTS, -1, NAN, NULL);
   /* breaks as cumulative chord / total: each is rounded once, not
    * accumulated */
   double cum = 0.0;
@@ -274,44 +263,78 @@ km_status km_curve_interpolate(km_curve *out, const double *pts, size_t n,
     /* spans measured on the rounded breaks, so that they agree with the
      * knots */
     h[k] = u[k + 1] - u[k];
-    if (!(h[k] > 0)) {
-      st = km__fail(err, KM_EDEGENERATE, KM_FIELD_POINTS, (long)k, NAN,
-                    "points %zu and %zu are too close to separate", k,
-                    (k + 1) % N);
-      goto cleanup;
-    }
+    if (!(h[k] > 0))
+      return km__fail(err, KM_EDEGENERATE, KM_FIELD_POINTS, (long)k, NAN,
+                      "points %zu and %zu are too close to separate", k,
+                      (k + 1) % N);
   }
+  return KM_OK;
+}
+
+/* One cubic piece through N = 2 or 3 points: the segment (uniform speed)
+ * or the parabola through three points, degree-elevated. */
+static void one_piece(const double *Q, const double *u, size_t N,
+                      km_curve *c) {
+  for (int j = 0; j < 4; j++) {
+    c->knots[j] = 0.0;
+    c->knots[4 + j] = 1.0;
+  }
+  for (int k = 0; k < 2; k++) {
+    double q0 = Q[k], qe = Q[2 * (N - 1) + (size_t)k], b1;
+    if (N == 2) {
+      b1 = 0.5 * (q0 + qe);
+    } else {
+      double t = u[1], q1 = Q[2 + k];
+      b1 = (q1 - (1 - t) * (1 - t) * q0 - t * t * qe) / (2.0 * t * (1 - t));
+    }
+    c->cp[k] = q0;
+    c->cp[2 + k] = (q0 + 2.0 * b1) / 3.0;
+    c->cp[4 + k] = (2.0 * b1 + qe) / 3.0;
+    c->cp[6 + k] = qe;
+  }
+}
+
+km_status km_curve_interpolate(km_curve *out, const double *pts, size_t n,
+                               bool closed, km_error *err) {
+  double *Q = NULL, *u = NULL, *h = NULL;
+  km_curve c;
+  km_curve_init(&c);
+  if (n > 0 && !pts)
+    return km__fail(err, KM_EINVAL, KM_FIELD_POINTS, -1, NAN,
+                    "points array is missing");
+  if (n > ((size_t)-1) / (16 * sizeof(double)))
+    return km__fail(err, KM_ELIMIT, KM_FIELD_POINTS, -1, NAN,
+                    "too many points");
+  km_status st = check_points(pts, n, err);
+  if (st) return st;
+  Q = malloc((2 * n + 2) * sizeof(double));
+  u = malloc((n + 2) * sizeof(double));
+  h = malloc((n + 2) * sizeof(double));
+  if (!Q || !u || !h) {
+    st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+    goto cleanup;
+  }
+  size_t N = distinct_points(pts, n, closed, Q);
+  if (N < 2 || (closed && N < 3)) {
+    st = km__fail(err, KM_EDEGENERATE, KM_FIELD_POINTS, -1, NAN,
+                  closed ? "a closed curve needs at least 3 distinct points"
+                         : "an open curve needs at least 2 distinct points");
+    goto cleanup;
+  }
+  st = chord_breaks(Q, N, closed ? N : N - 1, u, h, err);
+  if (st) goto cleanup;
   size_t ncp = closed ? N + 3 : (N < 4 ? 4 : N);
   st = km__curve_alloc(&c, 3, ncp, false);
   if (st) {
     km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
     goto cleanup;
   }
-  if (closed) {
+  if (closed)
     st = solve_closed(Q, h, u, N, c.knots, c.cp);
-  } else if (N >= 4) {
+  else if (N >= 4)
     st = solve_open(Q, u, N, c.knots, c.cp);
-  } else {
-    /* one cubic piece: the segment (uniform speed) or the parabola through
-     * three points, degree-elevated */
-    for (int j = 0; j < 4; j++) {
-      c.knots[j] = 0.0;
-      c.knots[4 + j] = 1.0;
-    }
-    for (int k = 0; k < 2; k++) {
-      double q0 = Q[k], qe = Q[2 * (N - 1) + (size_t)k], b1;
-      if (N == 2) {
-        b1 = 0.5 * (q0 + qe);
-      } else {
-        double t = u[1], q1 = Q[2 + k];
-        b1 = (q1 - (1 - t) * (1 - t) * q0 - t * t * qe) / (2.0 * t * (1 - t));
-      }
-      c.cp[k] = q0;
-      c.cp[2 + k] = (q0 + 2.0 * b1) / 3.0;
-      c.cp[4 + k] = (2.0 * b1 + qe) / 3.0;
-      c.cp[6 + k] = qe;
-    }
-  }
+  else
+    one_piece(Q, u, N, &c);
   if (st) {
     km__fail(err, st, KM_FIELD_POINTS, -1, NAN, NULL);
     goto cleanup;
