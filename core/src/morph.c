@@ -418,6 +418,64 @@ km_status km_morph_frame_until(const km_morph *m, double t,
   return frame_impl(m, t, &poll, out, metrics, sig_out, err);
 }
 
+/* Frame t's exact signature, the blend and the closure of the general
+ * path (lsq when the morph closes so), into *out (the caller frees it);
+ * gap (if not NULL) receives the gap before closure (0 when open). */
+static km_status frame_signature(const km_morph *m, double t, km__poll *poll,
+                                 km_signature *out, double *gap,
+                                 km_error *err) {
+  km_closure how = m->opt.closure == KM_CLOSURE_AUTO ? KM_CLOSURE_LSQ : m->opt.closure;
+  km_signature blended;
+  km_signature_init(&blended);
+  double g = 0.0;
+  km_status st = km__blend_signature(m, t, &blended, err);
+  /* the blend is linear in the pieces: a few units each */
+  if (!st && km__poll_stop(poll, 4 * (long)blended.kappa.n)) st = km__stopped(err);
+  if (!st && m->closed && how == KM_CLOSURE_LSQ) {
+    /* the closure measures the gap itself (its first residual) */
+    st = km__close_within_bound(m, &blended, out, &g, poll, err);
+  } else if (!st) {
+    double end[2];
+    if (m->closed && gap)
+      st = km_signature_point(&blended, blended.length, end, NULL);
+    if (!st && m->closed && gap)
+      g = hypot(end[0] - blended.start[0], end[1] - blended.start[1]);
+    if (!st) {
+      *out = blended;
+      km_signature_init(&blended);
+    }
+  }
+  if (!st && gap) *gap = g;
+  km_signature_free(&blended);
+  return st;
+}
+
+/* Metrics of the exact frame sig, its placed curve and its gap. */
+static km_status exact_metrics(const km_morph *m, const km_signature *sig,
+                               const km_curve *placed, double gap,
+                               km__poll *poll, km_frame_metrics *metrics,
+                               km_error *err) {
+  metrics->length = sig->length;
+  metrics->max_abs_kappa = km_signature_max_abs_kappa(sig);
+  metrics->bending_energy = km_signature_bending_energy(sig);
+  metrics->self_intersections = km__self_intersections(placed, m->tol, poll);
+  metrics->closure_gap = m->closed ? gap : 0.0;
+  return poll && poll->stopped ? km__stopped(err) : KM_OK;
+}
+
+/* sig moved by the frame's placement (rotation rot about the origin, then
+ * T) into *out. */
+static km_status placed_signature(const km_signature *sig, double rot,
+                                  const double T[2], km_signature *out,
+                                  km_error *err) {
+  double cr = cos(rot), sr = sin(rot);
+  double start[2] = {cr * sig->start[0] - sr * sig->start[1] + T[0],
+                     sr * sig->start[0] + cr * sig->start[1] + T[1]};
+  return km_signature_create(out, sig->length, start, sig->angle + rot,
+                             &sig->kappa, sig->corners, sig->ncorners,
+                             sig->closed, err);
+}
+
 static km_status frame_impl(const km_morph *m, double t, km__poll *poll,
                             km_curve *out, km_frame_metrics *metrics,
                             km_signature *sig_out, km_error *err) {
@@ -429,89 +487,34 @@ static km_status frame_impl(const km_morph *m, double t, km__poll *poll,
   km_closure how = m->opt.closure == KM_CLOSURE_AUTO ? KM_CLOSURE_LSQ : m->opt.closure;
   if (m->plan && !metrics && !sig_out)
     return planned_frame(m, t, how, poll, out, err);
-  km_signature blended, closed;
-  km_signature_init(&blended);
-  km_signature_init(&closed);
+  km_signature sig;
+  km_signature_init(&sig);
   km_curve f, placed;
   km_curve_init(&f);
   km_curve_init(&placed);
-  const km_signature *use = &blended;
-  double gap = 0.0, bound = 0.0;
-  km_status st = km__blend_signature(m, t, &blended, err);
-  /* the blend is linear in the pieces: a few units each */
-  if (!st && km__poll_stop(poll, 4 * (long)blended.kappa.n))
-    st = km__stopped(err);
-  if (st) goto done;
-  if (m->closed && how == KM_CLOSURE_LSQ) {
-    /* the closure measures the gap itself (its first residual) */
-    st = km__close_within_bound(m, &blended, &closed, &gap, poll, err);
-    if (st) goto done;
-    use = &closed;
-  } else if (m->closed) {
-    double end[2];
-    st = km_signature_point(&blended, blended.length, end, NULL);
-    if (st) goto done;
-    gap = hypot(end[0] - blended.start[0], end[1] - blended.start[1]);
-  }
-  st = km__reconstruct(use, m->opt.degree, 0.9 * m->tol, m->opt.max_points,
-                       poll, &f, &bound, NULL, err);
+  double gap = 0.0, bound = 0.0, rot, T[2];
+  km_status st = frame_signature(m, t, poll, &sig, &gap, err);
+  if (!st)
+    st = km__reconstruct(&sig, m->opt.degree, 0.9 * m->tol, m->opt.max_points,
+                         poll, &f, &bound, NULL, err);
   if (st) goto done;
   if (m->closed && !f.closed && how != KM_CLOSURE_NONE && how != KM_CLOSURE_LSQ)
     km__close_polygon(&f, how);
   else if (m->closed && !f.closed && how == KM_CLOSURE_LSQ)
     km__close_polygon(&f, KM_CLOSURE_C0); /* residual below rounding */
-  double rot, T[2];
-  km__place_frame(m, t, &f, use->length, &rot, T);
+  km__place_frame(m, t, &f, sig.length, &rot, T);
   st = km_curve_transform(&placed, &f, rot, T[0], T[1], err);
   if (st) goto done;
   placed.closed = f.closed;
-  if (metrics) {
-    metrics->length = use->length;
-    metrics->max_abs_kappa = km_signature_max_abs_kappa(use);
-    metrics->bending_energy = km_signature_bending_energy(use);
-    metrics->self_intersections = km__self_intersections(&placed, m->tol, poll);
-    metrics->closure_gap = m->closed ? gap : 0.0;
-    if (poll && poll->stopped) {
-      st = km__stopped(err);
-      goto done;
-    }
-  }
-  if (sig_out) {
-    double cr = cos(rot), sr = sin(rot);
-    double start[2] = {cr * use->start[0] - sr * use->start[1] + T[0],
-                       sr * use->start[0] + cr * use->start[1] + T[1]};
-    st = km_signature_create(sig_out, use->length, start, use->angle + rot,
-                             &use->kappa, use->corners, use->ncorners,
-                             use->closed, err);
-    if (st) goto done;
-  }
+  if (metrics) st = exact_metrics(m, &sig, &placed, gap, poll, metrics, err);
+  if (!st && sig_out) st = placed_signature(&sig, rot, T, sig_out, err);
+  if (st) goto done;
   *out = placed;
   km_curve_init(&placed);
 done:
-  km_signature_free(&blended);
-  km_signature_free(&closed);
+  km_signature_free(&sig);
   km_curve_free(&f);
   km_curve_free(&placed);
-  return st;
-}
-
-/* The frame's closed signature as frame_impl makes it, without the curve
- * (the blend and the closure of the general path). */
-static km_status frame_signature(const km_morph *m, double t, km__poll *poll,
-                                 km_signature *out, km_error *err) {
-  km_closure how = m->opt.closure == KM_CLOSURE_AUTO ? KM_CLOSURE_LSQ : m->opt.closure;
-  km_signature blended;
-  km_signature_init(&blended);
-  km_status st = km__blend_signature(m, t, &blended, err);
-  if (!st && km__poll_stop(poll, 4 * (long)blended.kappa.n)) st = km__stopped(err);
-  if (!st && m->closed && how == KM_CLOSURE_LSQ) {
-    double gap;
-    st = km__close_within_bound(m, &blended, out, &gap, poll, err);
-  } else if (!st) {
-    *out = blended;
-    km_signature_init(&blended);
-  }
-  km_signature_free(&blended);
   return st;
 }
 
@@ -534,7 +537,7 @@ km_status km_morph_frame_points(const km_morph *m, double t,
   km_signature sig;
   km_signature_init(&sig);
   size_t n = 0;
-  km_status st = frame_signature(m, t, &poll, &sig, err);
+  km_status st = frame_signature(m, t, &poll, &sig, NULL, err);
   if (!st)
     st = km__reconstruct(&sig, m->opt.degree, 0.9 * m->tol, m->opt.max_points,
                          &poll, NULL, NULL, &n, err);
