@@ -155,6 +155,14 @@ static enum MHD_Result on_headers(srv_req *r)
       r->too_large = true;
       return dispatch(r); /* 413 at once; the body is never read */
     }
+    /* A declared body is counted in the budget of bodies in flight before
+     * any of it is read: when it does not fit, the client hears so at once
+     * (503) instead of sending it to be dropped. */
+    if (end != cl && srv__route_is_compute(r->route) &&
+        !hold_body_bytes(r, (size_t)n + 1)) {
+      r->no_memory = true;
+      return dispatch(r);
+    }
   }
   return MHD_YES;
 }
@@ -185,6 +193,8 @@ static enum MHD_Result on_body(srv_req *r, const char *data, size_t size)
       ncap *= 2;
     if (ncap > s->cfg.max_body + 1)
       ncap = s->cfg.max_body + 1;
+    if (r->held >= r->len + size + 1 && ncap > r->held)
+      ncap = r->held; /* the declared length, counted already */
     if (!hold_body_bytes(r, ncap)) {
       /* Counted and dropped like a body over the size limit; answered
        * 503 when it has arrived. */

@@ -308,25 +308,43 @@ class BodyMemory(ContractCase):
     """Bodies in flight share one budget: past it, 503 naming it."""
 
     def test_bodies_past_the_budget_get_503(self):
-        # Two unfinished bodies hold buffers of 1 MiB each (buffers grow
-        # by doubling); a third of some 500 kB then does not fit.
+        # Two unfinished bodies declare 1,000,000 bytes each, counted
+        # before they are read; a third declaring some 700 kB does not fit
+        # 2,500,000 and is refused at once, before its body is sent.
         d = Daemon("--body-memory", "2500000")
         try:
-            part = b"x" * 700000
             holders = []
             for _ in range(2):
                 s = socket.create_connection((HOST, d.port))
                 s.sendall(b"POST /v1/signature HTTP/1.1\r\nHost: x\r\n"
                           b"Content-Type: application/json\r\n"
-                          b"Content-Length: 1500000\r\n\r\n" + part)
+                          b"Content-Length: 1000000\r\n\r\n" +
+                          b"x" * 500000)
                 holders.append(s)
             time.sleep(0.5)
-            big = {"curve": {"type": "points", "closed": False,
-                             "points": [[i, (i * 7) % 13] for i in
-                                        range(40000)]}}
-            r = d.request("POST", "/v1/signature", body=big)
+            big = json.dumps({"curve": {
+                "type": "points", "closed": False,
+                "points": [[i, (i * 7) % 13] for i in range(60000)]}})
+            self.assertGreater(len(big), 600000)
+            s = socket.create_connection((HOST, d.port))
+            s.settimeout(10)
+            t0 = time.monotonic()
+            s.sendall(("POST /v1/signature HTTP/1.1\r\nHost: x\r\n"
+                       "Content-Type: application/json\r\n"
+                       "Content-Length: %d\r\n\r\n" % len(big)).encode())
+            head = s.recv(65536)
+            dt = time.monotonic() - t0
+            s.close()
+            self.assertEqual(raw_status(head), 503, head[:200])
+            self.assertIn(b"KMORPH_BODY_MEMORY", head)
+            self.assertLess(dt, 2.0, "refused before the body was sent")
+            r = d.request("POST", "/v1/signature", body=json.loads(big))
             doc = self.assertProblem(r, 503, "/v1/signature", "post")
             self.assertIn("KMORPH_BODY_MEMORY", doc["detail"])
+            m = d.request("GET", "/metrics").body.decode()
+            self.assertGreaterEqual(
+                metric(m, "kmorph_rejected_total", {"reason": "body_memory"}),
+                2)
             for s in holders:
                 s.close()
             time.sleep(0.3)
