@@ -144,31 +144,19 @@ static double vec_angle(double ux, double uy, double vx, double vy) {
   return atan2(ux * vy - uy * vx, ux * vx + uy * vy);
 }
 
-km_status km_path_arc_to(km_path *p, double rx, double ry, double x_rot_deg,
-                         bool large_arc, bool sweep, double x, double y,
-                         km_error *err) {
-  km_status st = check_open(p, err);
-  if (st) return st;
-  double args[5] = {rx, ry, x_rot_deg, x, y};
-  for (int i = 0; i < 5; i++)
-    if (!isfinite(args[i]))
-      return km__fail(err, KM_ENONFINITE, KM_FIELD_CONTROL_POINTS, i, NAN,
-                      "arc argument is not finite");
-  for (int i = 0; i < 2; i++) {
-    st = check_coord(args[i], i, err);
-    if (st) return st;
-  }
-  double v[2] = {x, y};
-  st = check_coords(v, 2, err);
-  if (st) return st;
+/* An SVG arc in centre parameterisation (F.6.5): centre, radii (scaled
+ * up where they cannot reach the end point), rotation, start angle and
+ * sweep. */
+typedef struct arc_centre {
+  double cx, cy, rx, ry, cphi, sphi, theta1, dtheta;
+} arc_centre;
 
-  double x1 = p->cur[0], y1 = p->cur[1];
-  /* F.6.2: identical end points omit the arc; zero radius is a line. */
-  if (x1 == x && y1 == y) return KM_OK;
-  rx = fabs(rx);
-  ry = fabs(ry);
-  if (rx == 0.0 || ry == 0.0) return km_path_line_to(p, x, y, err);
-
+/* The arc from (x1, y1) to (x, y) of positive radii rx, ry in centre form;
+ * KM_ERANGE when it cannot be computed in double precision. */
+static km_status arc_to_centre(double x1, double y1, double rx, double ry,
+                               double x_rot_deg, bool large_arc, bool sweep,
+                               double x, double y, arc_centre *ac,
+                               km_error *err) {
   double phi = fmod(x_rot_deg, 360.0) * (KM_PI / 180.0);
   double cphi = cos(phi), sphi = sin(phi);
   /* F.6.5.1 */
@@ -210,16 +198,23 @@ km_status km_path_arc_to(km_path *p, double rx, double ry, double x_rot_deg,
   if (!isfinite(cx) || !isfinite(cy) || !isfinite(dtheta))
     return km__fail(err, KM_ERANGE, KM_FIELD_CONTROL_POINTS, 0, NAN,
                     "arc cannot be computed");
+  *ac = (arc_centre){cx, cy, rx, ry, cphi, sphi, theta1, dtheta};
+  return KM_OK;
+}
 
-  /* At most 90 degrees a piece; the small allowance keeps an exact
-   * quarter from becoming two pieces through rounding. */
-  int nseg = (int)ceil(fabs(dtheta) / (0.5 * KM_PI) - 1e-9);
+/* The arc as nseg rational quadratic pieces of at most 90 degrees each,
+ * starting exactly at (x1, y1) and ending exactly at (x, y). */
+static km_status arc_pieces(const arc_centre *ac, double x1, double y1,
+                            double x, double y, km_path_piece pcs[5],
+                            int *nseg_out, km_error *err) {
+  /* the small allowance keeps an exact quarter from becoming two pieces
+   * through rounding */
+  int nseg = (int)ceil(fabs(ac->dtheta) / (0.5 * KM_PI) - 1e-9);
   if (nseg < 1) nseg = 1;
-  double delta = dtheta / nseg;
+  double delta = ac->dtheta / nseg;
   double wmid = cos(0.5 * delta);
-  km_path_piece pcs[5];
   for (int k = 0; k < nseg; k++) {
-    double a0 = theta1 + k * delta, a1 = theta1 + (k + 1) * delta;
+    double a0 = ac->theta1 + k * delta, a1 = ac->theta1 + (k + 1) * delta;
     double am = 0.5 * (a0 + a1);
     double uv[3][2] = {{cos(a0), sin(a0)},
                        {cos(am) / wmid, sin(am) / wmid},
@@ -233,9 +228,9 @@ km_status km_path_arc_to(km_path *p, double rx, double ry, double x_rot_deg,
     pc->w[2] = 1.0;
     pc->w[3] = 1.0;
     for (int j = 0; j < 3; j++) {
-      double ex = rx * uv[j][0], ey = ry * uv[j][1];
-      pc->p[j][0] = cx + cphi * ex - sphi * ey;
-      pc->p[j][1] = cy + sphi * ex + cphi * ey;
+      double ex = ac->rx * uv[j][0], ey = ac->ry * uv[j][1];
+      pc->p[j][0] = ac->cx + ac->cphi * ex - ac->sphi * ey;
+      pc->p[j][1] = ac->cy + ac->sphi * ex + ac->cphi * ey;
     }
     /* Exact junctions: the path's points, not their recomputation. */
     if (k == 0) {
@@ -250,10 +245,46 @@ km_status km_path_arc_to(km_path *p, double rx, double ry, double x_rot_deg,
       pc->p[2][1] = y;
     }
     for (int j = 0; j < 3; j++) {
-      st = check_coords(pc->p[j], 2, err);
+      km_status st = check_coords(pc->p[j], 2, err);
       if (st) return st;
     }
   }
+  *nseg_out = nseg;
+  return KM_OK;
+}
+
+km_status km_path_arc_to(km_path *p, double rx, double ry, double x_rot_deg,
+                         bool large_arc, bool sweep, double x, double y,
+                         km_error *err) {
+  km_status st = check_open(p, err);
+  if (st) return st;
+  double args[5] = {rx, ry, x_rot_deg, x, y};
+  for (int i = 0; i < 5; i++)
+    if (!isfinite(args[i]))
+      return km__fail(err, KM_ENONFINITE, KM_FIELD_CONTROL_POINTS, i, NAN,
+                      "arc argument is not finite");
+  for (int i = 0; i < 2; i++) {
+    st = check_coord(args[i], i, err);
+    if (st) return st;
+  }
+  double v[2] = {x, y};
+  st = check_coords(v, 2, err);
+  if (st) return st;
+
+  double x1 = p->cur[0], y1 = p->cur[1];
+  /* F.6.2: identical end points omit the arc; zero radius is a line. */
+  if (x1 == x && y1 == y) return KM_OK;
+  rx = fabs(rx);
+  ry = fabs(ry);
+  if (rx == 0.0 || ry == 0.0) return km_path_line_to(p, x, y, err);
+  arc_centre ac = {0, 0, 0, 0, 0, 0, 0, 0};
+  st = arc_to_centre(x1, y1, rx, ry, x_rot_deg, large_arc, sweep, x, y, &ac,
+                     err);
+  if (st) return st;
+  km_path_piece pcs[5];
+  int nseg = 0;
+  st = arc_pieces(&ac, x1, y1, x, y, pcs, &nseg, err);
+  if (st) return st;
   for (int k = 0; k < nseg; k++) {
     st = push(p, &pcs[k], err);
     if (st) return st;
@@ -305,18 +336,11 @@ static bool within(const double a[2], const double b[2], double eps) {
          hypot(a[0] - b[0], a[1] - b[1]) <= eps;
 }
 
-km_status km_path_to_curve(const km_path *p, double eps, km_curve *out,
-                           km_error *err) {
-  km_status st = KM_OK;
-  double *knots = NULL, *cp = NULL, *w = NULL;
-  km_path_piece *kept = NULL;
-  if (!(eps >= 0.0) || !isfinite(eps)) eps = 0.0;
-  if (!p->started || p->npieces == 0)
-    return km__fail(err, KM_EDEGENERATE, KM_FIELD_CONTROL_POINTS, -1, NAN,
-                    "path draws nothing");
-
-  kept = malloc(p->npieces * sizeof *kept);
-  if (!kept) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+/* The path's pieces without those that are points (within eps of the end
+ * so far), each starting exactly where the last kept one ends; a closed
+ * path's last piece ends exactly at the first's start. Returns the number
+ * kept. */
+static size_t drawn_pieces(const km_path *p, double eps, km_path_piece *kept) {
   size_t m = 0;
   double end[2] = {p->start[0], p->start[1]};
   for (size_t i = 0; i < p->npieces; i++) {
@@ -333,39 +357,25 @@ km_status km_path_to_curve(const km_path *p, double eps, km_curve *out,
     end[1] = pc->p[pc->degree][1];
     m++;
   }
-  if (m == 0) {
-    st = km__fail(err, KM_EDEGENERATE, KM_FIELD_CONTROL_POINTS, -1, NAN,
-                  "path has zero length");
-    goto cleanup;
-  }
   /* A closed path ends where it starts; a dropped closing piece left at
    * most eps between them. */
-  if (p->closed) {
+  if (p->closed && m > 0) {
     kept[m - 1].p[kept[m - 1].degree][0] = kept[0].p[0][0];
     kept[m - 1].p[kept[m - 1].degree][1] = kept[0].p[0][1];
   }
+  return m;
+}
 
-  int deg = 1;
-  bool rational = false;
-  for (size_t i = 0; i < m; i++) {
-    if (kept[i].degree > deg) deg = kept[i].degree;
-    if (kept[i].rational) rational = true;
-  }
-  size_t n = m * (size_t)deg + 1;
-  size_t nk = n + (size_t)deg + 1;
-  knots = malloc(nk * sizeof *knots);
-  cp = malloc(2 * n * sizeof *cp);
-  if (rational) w = malloc(n * sizeof *w);
-  if (!knots || !cp || (rational && !w)) {
-    st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
-    goto cleanup;
-  }
+/* Knots (piece i over [i, i + 1], interior knots of multiplicity deg),
+ * control points and weights (w NULL without) of the m pieces elevated to
+ * degree deg. */
+static void pieces_to_bspline(const km_path_piece *kept, size_t m, int deg,
+                              double *knots, double *cp, double *w) {
   size_t k = 0;
   for (int j = 0; j <= deg; j++) knots[k++] = 0.0;
   for (size_t i = 1; i < m; i++)
     for (int j = 0; j < deg; j++) knots[k++] = (double)i;
   for (int j = 0; j <= deg; j++) knots[k++] = (double)m;
-
   for (size_t i = 0; i < m; i++) {
     double h[10][3];
     elevate_h(&kept[i], deg, h);
@@ -385,8 +395,42 @@ km_status km_path_to_curve(const km_path *p, double eps, km_curve *out,
       if (w) w[idx] = wj;
     }
   }
-  st = km_curve_create(out, deg, n, knots, cp, w, p->closed, err);
+}
 
+km_status km_path_to_curve(const km_path *p, double eps, km_curve *out,
+                           km_error *err) {
+  km_status st = KM_OK;
+  double *knots = NULL, *cp = NULL, *w = NULL;
+  km_path_piece *kept = NULL;
+  if (!(eps >= 0.0) || !isfinite(eps)) eps = 0.0;
+  if (!p->started || p->npieces == 0)
+    return km__fail(err, KM_EDEGENERATE, KM_FIELD_CONTROL_POINTS, -1, NAN,
+                    "path draws nothing");
+  kept = malloc(p->npieces * sizeof *kept);
+  if (!kept) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  size_t m = drawn_pieces(p, eps, kept);
+  if (m == 0) {
+    st = km__fail(err, KM_EDEGENERATE, KM_FIELD_CONTROL_POINTS, -1, NAN,
+                  "path has zero length");
+    goto cleanup;
+  }
+  int deg = 1;
+  bool rational = false;
+  for (size_t i = 0; i < m; i++) {
+    if (kept[i].degree > deg) deg = kept[i].degree;
+    if (kept[i].rational) rational = true;
+  }
+  size_t n = m * (size_t)deg + 1;
+  size_t nk = n + (size_t)deg + 1;
+  knots = malloc(nk * sizeof *knots);
+  cp = malloc(2 * n * sizeof *cp);
+  if (rational) w = malloc(n * sizeof *w);
+  if (!knots || !cp || (rational && !w)) {
+    st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+    goto cleanup;
+  }
+  pieces_to_bspline(kept, m, deg, knots, cp, w);
+  st = km_curve_create(out, deg, n, knots, cp, w, p->closed, err);
 cleanup:
   free(kept);
   free(knots);
