@@ -147,7 +147,8 @@ static bool parse_points(api_ctx *ctx, const cJSON *v, const char *ptr,
      * 1e-5 of the length) so the rest of the work keeps the other half */
     double len = 0.0;
     for (size_t i = 1; i < n; i++)
-      len += hypot(pts[2 * i] - pts[2 * i - 2], pts[2 * i + 1] - pts[2 * i - 1]);
+      len += hypot(pts[2 * i] - pts[2 * i - 2],
+                   pts[2 * i + 1] - pts[2 * i - 1]);
     double fit_tol = 0.5 * (tol > 0 ? tol : 1e-5 * len);
     st = km_curve_fit_points(out, pts, n, closed, fit_tol, &err);
   }

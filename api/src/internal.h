@@ -8,6 +8,12 @@
  * error names the exact field ("/from/knots/4") without any parsing of
  * messages afterwards. The first error wins: later failures in the same
  * request do not overwrite it, which keeps the report about the root cause.
+ *
+ * Where each part lives: api.c (the context, problems, dispatch),
+ * json_parse.c with json_scan.c and json_tree.c (bodies to trees),
+ * json_read.c (typed readers), curve_in.c and signature_in.c (inputs),
+ * core_problem.c (core failures), json_out.c (writers and their byte
+ * bounds), morph_*.c (the morph route), svg_*.c (SVG in and out).
  */
 #ifndef KMAPI_INTERNAL_H
 #define KMAPI_INTERNAL_H

@@ -12,7 +12,7 @@
  * [[x, y], ...], is one item holding a buffer of doubles: API_PACKED in its
  * type, the buffer in valuestring (cJSON_Delete frees it), no children.
  * Readers reach elements only through api__array_len, api__array_packed
- * and the api__elems_* walk of json_in.c, never through cJSON's own array
+ * and the api__elems_* walk of json_read.c, never through cJSON's own array
  * functions, which see a packed array as empty. The scanner is
  * json_scan.c, the builder json_tree.c; this file drives them.
  *

@@ -36,7 +36,8 @@ const char *api__type_name(const cJSON *v) {
 
 bool api__num(api_ctx *ctx, const cJSON *v, const char *ptr, double *out) {
   if (!cJSON_IsNumber(v))
-    return api__invalid(ctx, ptr, "must be a number, not %s", api__type_name(v));
+    return api__invalid(ctx, ptr, "must be a number, not %s",
+                        api__type_name(v));
   /* cJSON turns 1e999 into inf; the contract has no infinities. */
   if (!isfinite(v->valuedouble))
     return api__invalid(ctx, ptr, "must be a finite number");
@@ -142,7 +143,8 @@ static bool check_count(api_ctx *ctx, const cJSON *v, const char *ptr,
                         size_t max, size_t *n) {
   size_t size;
   if (!cJSON_IsArray(v))
-    return api__invalid(ctx, ptr, "must be an array, not %s", api__type_name(v));
+    return api__invalid(ctx, ptr, "must be an array, not %s",
+                        api__type_name(v));
   size = api__array_len(v);
   if (size == 0)
     return api__invalid(ctx, ptr, "must not be empty");

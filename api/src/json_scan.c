@@ -247,12 +247,16 @@ static bool scan_value(scan *s) {
   switch (*s->p) {
   case '{': return scan_container(s, '}', true);
   case '[': return scan_container(s, ']', false);
-  case '"': s->cost += api__heap_bytes(sizeof(cJSON)); return scan_string(s);
-  case 't': s->cost += api__heap_bytes(sizeof(cJSON)); return scan_lit(s, "true");
-  case 'f': s->cost += api__heap_bytes(sizeof(cJSON)); return scan_lit(s, "false");
-  case 'n': s->cost += api__heap_bytes(sizeof(cJSON)); return scan_lit(s, "null");
+  default: break;
+  }
+  /* any other value is one item (scan_string prices a string's text) */
+  s->cost += api__heap_bytes(sizeof(cJSON));
+  switch (*s->p) {
+  case '"': return scan_string(s);
+  case 't': return scan_lit(s, "true");
+  case 'f': return scan_lit(s, "false");
+  case 'n': return scan_lit(s, "null");
   default:
-    s->cost += api__heap_bytes(sizeof(cJSON));
     if (*s->p == '-' || isdigit(*s->p))
       return scan_number(s);
     return scan_fail(s, "value expected");

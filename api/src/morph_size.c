@@ -97,9 +97,9 @@ static size_t predict_bytes(const api_morph_plan *pl, size_t points) {
     if (pl->svgopt.layout == API_SVG_ANIMATE)
       per += per_path;
     if (pl->want_sig) {
-      /* kappa samples as svg_render.c takes them: a budget per frame
-       * shared by the spans of kappa (fewer than the control points), at
-       * least three a span, at most 4,002 */
+      /* kappa samples as svg_curvature_plot.c takes them: a budget per
+       * frame shared by the spans of kappa (fewer than the control
+       * points), at least three a span, at most 4,002 */
       size_t budget = n > 0 ? 400000 / n : 1600;
       budget = budget > 1600 ? 1600 : budget < 100 ? 100 : budget;
       size_t samples = budget + points > 3 * points ? budget + points
