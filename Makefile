@@ -24,6 +24,12 @@ PACKAGES := gcc make pkg-config libcmocka-dev libcjson-dev libmicrohttpd-dev \
             librsvg2-bin nodejs npm wrk python3 python3-yaml python3-jsonschema \
             chromium
 
+# The library headers a build needs, each as header:Debian package; a
+# build starts by checking them (check-deps) so that a machine without them
+# is told to run `make deps` rather than shown a compiler error.
+NEEDED_HEADERS ?= cjson/cJSON.h:libcjson-dev microhttpd.h:libmicrohttpd-dev \
+                  cmocka.h:libcmocka-dev
+
 CJSON_CFLAGS := -I/usr/include/cjson
 CJSON_LIBS   := -lcjson
 MHD_LIBS     := -lmicrohttpd
@@ -52,7 +58,7 @@ UNIT_BIN  := $(UNIT_SRC:%.c=$(BUILD)/%)
 APIT_BIN  := $(APIT_SRC:%.c=$(BUILD)/%)
 SUPPORT_SRC := $(wildcard tests/support/*.c)
 
-.PHONY: all deps build run test test-unit test-asan test-server test-clients check-layers \
+.PHONY: all deps check-deps check build run test test-unit test-asan test-server test-clients check-layers \
         bench bench-http fuzz fuzz-svg clean format examples \
         test-fuzz test-hardening bench-load bench-hostile
 
@@ -72,15 +78,39 @@ deps:
 
 build: $(LIBCORE) $(LIBAPI) $(CLI) $(if $(SRV_SRC),$(DAEMON))
 
-$(BUILD)/core/%.o: core/%.c
+# Each header is preprocessed alone, so the compiler's own search path
+# decides, as it will for the real sources.
+check-deps:
+	@missing=""; for hp in $(NEEDED_HEADERS); do \
+	  h=$${hp%%:*}; \
+	  echo "#include <$$h>" | $(CC) -E -x c - >/dev/null 2>&1 || \
+	    missing="$$missing $$h ($${hp#*:})"; \
+	done; \
+	if [ -n "$$missing" ]; then \
+	  echo "kmorph: missing headers:$$missing"; \
+	  echo "kmorph: run \`make deps\` to install the system packages (apt-get), then make again"; \
+	  exit 1; \
+	fi
+
+# The loop to run between edits: the libraries, the CLI and the daemon, the
+# layer check, then every unit and api test (gcc -O3), counted in
+# $(BUILD)/check-results.txt. KM_TEST=NAME runs only the tests NAME selects.
+check:
+	@$(MAKE) --no-print-directory build check-layers
+	@rm -f $(BUILD)/check-results.txt
+	@KM_RESULTS=$(BUILD)/check-results.txt $(MAKE) --no-print-directory test-unit
+	@awk '{p += $$2; f += $$3} END {printf "check: %d tests passed, %d failed\n", p, f}' \
+	  $(BUILD)/check-results.txt
+
+$(BUILD)/core/%.o: core/%.c | check-deps
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) $(CORE_INC) -MMD -MP -c $< -o $@
 
-$(BUILD)/api/%.o: api/%.c
+$(BUILD)/api/%.o: api/%.c | check-deps
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) $(API_INC) -MMD -MP -c $< -o $@
 
-$(BUILD)/server/%.o: server/%.c
+$(BUILD)/server/%.o: server/%.c | check-deps
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) $(SRV_INC) -MMD -MP -c $< -o $@
 
@@ -92,7 +122,7 @@ $(LIBAPI): $(API_OBJ)
 	@mkdir -p $(@D)
 	rm -f $@ && ar rcs $@ $^
 
-$(CLI): cli/kmorph.c $(LIBAPI) $(LIBCORE)
+$(CLI): cli/kmorph.c $(LIBAPI) $(LIBCORE) | check-deps
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) $(SRV_INC) $< -o $@ $(LIBAPI) $(LIBCORE) $(CJSON_LIBS) -lm $(LDFLAGS)
 
@@ -100,11 +130,11 @@ $(DAEMON): $(SRV_OBJ) $(LIBAPI) $(LIBCORE)
 	@mkdir -p $(@D)
 	$(CC) $(SRV_OBJ) -o $@ $(LIBAPI) $(LIBCORE) $(MHD_LIBS) $(CJSON_LIBS) -lm -lpthread $(LDFLAGS)
 
-$(BUILD)/tests/core/%: tests/core/%.c $(SUPPORT_SRC) $(LIBCORE)
+$(BUILD)/tests/core/%: tests/core/%.c $(SUPPORT_SRC) $(LIBCORE) | check-deps
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) $(CORE_INC) -Itests/support $(CJSON_CFLAGS) $< $(SUPPORT_SRC) -o $@ $(LIBCORE) -lcmocka $(CJSON_LIBS) -lm $(LDFLAGS)
 
-$(BUILD)/tests/api/%: tests/api/%.c $(SUPPORT_SRC) $(LIBAPI) $(LIBCORE)
+$(BUILD)/tests/api/%: tests/api/%.c $(SUPPORT_SRC) $(LIBAPI) $(LIBCORE) | check-deps
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) $(API_INC) -Itests/support $< $(SUPPORT_SRC) -o $@ $(LIBAPI) $(LIBCORE) -lcmocka $(CJSON_LIBS) -lm $(LDFLAGS)
 
