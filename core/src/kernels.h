@@ -1,7 +1,7 @@
 /* kernels.h - the small numeric kernels libkmorph shares; internal.
  *
  * One copy of each: the knot-span search and the cubic B-spline basis
- * (kernels.c), the dense solver, the Bernstein basis, the comparison of
+ * (kernels.c), the dense solver (inline here), the Bernstein basis, the comparison of
  * doubles for qsort and the FFT (linalg.c), Gauss-Legendre rules,
  * adaptive quadrature and angle wrapping (status.c, curve.c), the
  * spectral integral at the signature's nodes (signature_theta.c) and a
@@ -35,8 +35,40 @@ void km__cubic_basis(const double *U, size_t i, double u, double N[4]);
 /* Solve the dense n x n system A x = y in place (row-major A, x returned
  * in y) by Gaussian elimination with partial pivoting; false if a pivot
  * is below 1e-300 (singular to working precision; A and y are then
- * partly eliminated). */
-bool km__solve_dense(double *A, double *y, int n);
+ * partly eliminated). For interpolation systems and Gauss-Newton steps of
+ * at most a few dozen unknowns, and the 6 x 6 system of every theta piece
+ * of a signature: inline, so that a call of constant size is compiled
+ * for that size. */
+static inline bool km__solve_dense(double *A, double *y, int n) {
+  for (int c = 0; c < n; c++) {
+    int piv = c;
+    for (int r = c + 1; r < n; r++)
+      if (fabs(A[r * n + c]) > fabs(A[piv * n + c])) piv = r;
+    if (!(fabs(A[piv * n + c]) > 1e-300)) return false;
+    if (piv != c) {
+      for (int k = 0; k < n; k++) {
+        double tmp = A[c * n + k];
+        A[c * n + k] = A[piv * n + k];
+        A[piv * n + k] = tmp;
+      }
+      double tmp = y[c];
+      y[c] = y[piv];
+      y[piv] = tmp;
+    }
+    for (int r = c + 1; r < n; r++) {
+      double f = A[r * n + c] / A[c * n + c];
+      for (int k = c; k < n; k++) A[r * n + k] -= f * A[c * n + k];
+      y[r] -= f * y[c];
+    }
+  }
+  for (int r = n - 1; r >= 0; r--) {
+    double v = y[r];
+    for (int k = r + 1; k < n; k++) v -= A[r * n + k] * y[k];
+    y[r] = v / A[r * n + r];
+  }
+  return true;
+}
+
 /* The d+1 Bernstein basis values B_k^d(u) into row[0..d]. */
 void km__bernstein_basis(double u, int d, double *row);
 /* qsort comparison of doubles, ascending (NaN compares equal to all). */

@@ -1,41 +1,9 @@
-/* linalg.c - small helpers the numerics share: a dense solver for
- * interpolation systems and Gauss-Newton steps of at most a few dozen
- * unknowns, the Bernstein basis, a comparison for qsort, and a radix-2 FFT
+/* linalg.c - small helpers the numerics share: the Bernstein basis, a comparison for qsort, and a radix-2 FFT
  * (cyclic correlations of sampled turning functions). */
 #include <math.h>
 
 #include "internal.h"
 #include "kernels.h"
-
-bool km__solve_dense(double *A, double *y, int n) {
-  for (int c = 0; c < n; c++) {
-    int piv = c;
-    for (int r = c + 1; r < n; r++)
-      if (fabs(A[r * n + c]) > fabs(A[piv * n + c])) piv = r;
-    if (!(fabs(A[piv * n + c]) > 1e-300)) return false;
-    if (piv != c) {
-      for (int k = 0; k < n; k++) {
-        double tmp = A[c * n + k];
-        A[c * n + k] = A[piv * n + k];
-        A[piv * n + k] = tmp;
-      }
-      double tmp = y[c];
-      y[c] = y[piv];
-      y[piv] = tmp;
-    }
-    for (int r = c + 1; r < n; r++) {
-      double f = A[r * n + c] / A[c * n + c];
-      for (int k = c; k < n; k++) A[r * n + k] -= f * A[c * n + k];
-      y[r] -= f * y[c];
-    }
-  }
-  for (int r = n - 1; r >= 0; r--) {
-    double v = y[r];
-    for (int k = r + 1; k < n; k++) v -= A[r * n + k] * y[k];
-    y[r] = v / A[r * n + r];
-  }
-  return true;
-}
 
 void km__bernstein_basis(double u, int d, double *row) {
   double v = 1.0 - u;

@@ -126,44 +126,15 @@ static bool fit_theta(const double *th, const double *s, double h,
    * signature); a straight stretch (theta constant, or linear in s) has
    * exactly zero there, so its kappa is exactly zero. */
   enum { NI = KM__THETA_DEGREE - 1 };
-  double A[NI][NI], y[NI], row[KM__THETA_DEGREE + 1], d[NI];
+  double A[NI * NI], d[NI], row[KM__THETA_DEGREE + 1];
   double th0 = th[0], dth = th[KM__THETA_NODES - 1] - th[0];
   for (int j = 0; j < NI; j++) {
     double u = (s[2 * (j + 1)] - s[0]) / h;
     bernstein_row(u, row);
-    for (int k = 0; k < NI; k++) A[j][k] = row[k + 1];
-    y[j] = th[2 * (j + 1)] - (th0 + dth * u);
+    for (int k = 0; k < NI; k++) A[j * NI + k] = row[k + 1];
+    d[j] = th[2 * (j + 1)] - (th0 + dth * u);
   }
-  bool ok = true;
-  for (int c = 0; c < NI && ok; c++) {
-    int piv = c;
-    for (int r = c + 1; r < NI; r++)
-      if (fabs(A[r][c]) > fabs(A[piv][c])) piv = r;
-    if (!(fabs(A[piv][c]) > 1e-300)) {
-      ok = false;
-      break;
-    }
-    if (piv != c) {
-      for (int k = 0; k < NI; k++) {
-        double tmp = A[c][k];
-        A[c][k] = A[piv][k];
-        A[piv][k] = tmp;
-      }
-      double tmp = y[c];
-      y[c] = y[piv];
-      y[piv] = tmp;
-    }
-    for (int r = c + 1; r < NI; r++) {
-      double f = A[r][c] / A[c][c];
-      for (int k = c; k < NI; k++) A[r][k] -= f * A[c][k];
-      y[r] -= f * y[c];
-    }
-  }
-  for (int r = NI - 1; ok && r >= 0; r--) {
-    double v = y[r];
-    for (int k = r + 1; k < NI; k++) v -= A[r][k] * d[k];
-    d[r] = v / A[r][r];
-  }
+  bool ok = km__solve_dense(A, d, NI);
   coef[0] = th0;
   coef[KM__THETA_DEGREE] = th[KM__THETA_NODES - 1];
   for (int k = 1; ok && k < KM__THETA_DEGREE; k++)
