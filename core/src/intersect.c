@@ -448,6 +448,52 @@ km_status km_curve_self_intersections_until(const km_curve *c, double tol,
   return KM_OK;
 }
 
+/* The scales of the search from the control points' box: size, magnitude,
+ * tolerance, flatness, margin, budgets. False for a curve of no size. */
+static bool set_scales(ctx *x, const km_curve *c, double tol) {
+  double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
+  for (size_t i = 0; i < c->n; i++) {
+    xmin = fmin(xmin, c->cp[2 * i]);
+    xmax = fmax(xmax, c->cp[2 * i]);
+    ymin = fmin(ymin, c->cp[2 * i + 1]);
+    ymax = fmax(ymax, c->cp[2 * i + 1]);
+  }
+  x->size = hypot(xmax - xmin, ymax - ymin);
+  x->mag = fmax(fmax(fabs(xmin), fabs(xmax)), fmax(fabs(ymin), fabs(ymax)));
+  if (!(x->size > 0) || !isfinite(x->size)) return false;
+  double floor_tol = KM_MIN_RELATIVE_TOLERANCE * x->size;
+  x->tol = (tol > 0 && isfinite(tol)) ? fmax(tol, floor_tol) : 1e-9 * x->size;
+  /* Flat enough to seed Newton: within the tolerance, but no coarser than
+   * 1e-4 of the size, whatever tolerance is asked (a seed must lie near
+   * its root). A sub-curve lies inside the box of its control points, so
+   * boxes need no margin beyond the rounding of the coordinates: a loose
+   * tolerance must not make every pair of a small curve overlap. */
+  x->flat = fmax(fmin(x->tol, 1e-4 * x->size), 1e-7 * x->size);
+  x->margin = 256 * DBL_EPSILON * fmax(x->mag, x->size);
+  x->eps_t = 1e-8 * (x->t1 - x->t0);
+  x->pairs_left = PAIR_BUDGET;
+  x->seeds_left = SEED_BUDGET;
+  x->newton_left = NEWTON_BUDGET;
+  return true;
+}
+
+/* Sweep the flat sub-curves in order of xmin (order: pointers to them)
+ * and test every pair whose boxes overlap. */
+static void sweep_pairs(ctx *x, seg **order) {
+  long sweep_left = SWEEP_BUDGET;
+  for (size_t i = 0; i < x->nseg && !x->oom; i++) {
+    /* past every bound nothing more can be found */
+    if (x->pairs_left <= 0 && (x->seeds_left <= 0 || x->newton_left <= 0)) break;
+    for (size_t j = i + 1; j < x->nseg && !x->oom && sweep_left-- > 0; j++) {
+      if ((j & 15) == 0 && (x->oom = km__poll_stop(x->poll, 4))) break;
+      if (order[j]->xmin > order[i]->xmax + x->margin) break;
+      if (!boxes_overlap(order[i], order[j], x->margin)) continue;
+      if (consecutive_same_way(x, order[i], order[j])) continue;
+      pair(x, order[i], order[j], 0);
+    }
+  }
+}
+
 long km__self_intersections(const km_curve *c, double tol, km__poll *poll) {
   if (!c || !c->knots || !c->cp || c->degree < KM_MIN_DEGREE ||
       c->degree > KM_MAX_DEGREE || c->n < (size_t)c->degree + 1)
@@ -466,32 +512,11 @@ long km__self_intersections(const km_curve *c, double tol, km__poll *poll) {
   x.bz = &bz;
   x.closed = c->closed;
   km_curve_domain(c, &x.t0, &x.t1);
-  double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
-  for (size_t i = 0; i < c->n; i++) {
-    xmin = fmin(xmin, c->cp[2 * i]);
-    xmax = fmax(xmax, c->cp[2 * i]);
-    ymin = fmin(ymin, c->cp[2 * i + 1]);
-    ymax = fmax(ymax, c->cp[2 * i + 1]);
-  }
-  x.size = hypot(xmax - xmin, ymax - ymin);
-  x.mag = fmax(fmax(fabs(xmin), fabs(xmax)), fmax(fabs(ymin), fabs(ymax)));
-  if (!(x.size > 0) || !isfinite(x.size)) {
+  if (!set_scales(&x, c, tol)) {
     result = 0;
     goto cleanup;
   }
-  double floor_tol = KM_MIN_RELATIVE_TOLERANCE * x.size;
-  x.tol = (tol > 0 && isfinite(tol)) ? fmax(tol, floor_tol) : 1e-9 * x.size;
-  /* Flat enough to seed Newton: within the tolerance, but no coarser than
-   * 1e-4 of the size, whatever tolerance is asked (a seed must lie near
-   * its root). A sub-curve lies inside the box of its control points, so
-   * boxes need no margin beyond the rounding of the coordinates: a loose
-   * tolerance must not make every pair of a small curve overlap. */
-  x.flat = fmax(fmin(x.tol, 1e-4 * x.size), 1e-7 * x.size);
-  x.margin = 256 * DBL_EPSILON * fmax(x.mag, x.size);
-  x.eps_t = 1e-8 * (x.t1 - x.t0);
-  x.pairs_left = PAIR_BUDGET;
-  x.seeds_left = SEED_BUDGET;
-  x.newton_left = NEWTON_BUDGET;
+  /* every Bezier piece split until flat */
   size_t pieces = (bz.n - 1) / (size_t)p;
   for (size_t k = 0; k < pieces && !x.oom; k++) {
     seg s;
@@ -508,18 +533,7 @@ long km__self_intersections(const km_curve *c, double tol, km__poll *poll) {
   if (!order) goto cleanup;
   for (size_t i = 0; i < x.nseg; i++) order[i] = &x.segs[i];
   qsort(order, x.nseg, sizeof *order, by_xmin);
-  long sweep_left = SWEEP_BUDGET;
-  for (size_t i = 0; i < x.nseg && !x.oom; i++) {
-    /* past every bound nothing more can be found */
-    if (x.pairs_left <= 0 && (x.seeds_left <= 0 || x.newton_left <= 0)) break;
-    for (size_t j = i + 1; j < x.nseg && !x.oom && sweep_left-- > 0; j++) {
-      if ((j & 15) == 0 && (x.oom = km__poll_stop(poll, 4))) break;
-      if (order[j]->xmin > order[i]->xmax + x.margin) break;
-      if (!boxes_overlap(order[i], order[j], x.margin)) continue;
-      if (consecutive_same_way(&x, order[i], order[j])) continue;
-      pair(&x, order[i], order[j], 0);
-    }
-  }
+  sweep_pairs(&x, order);
   if (x.oom) goto cleanup;
   result = (long)x.nhit;
 cleanup:

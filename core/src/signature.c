@@ -31,10 +31,10 @@ km_status km_signature_copy(km_signature *out, const km_signature *sig,
                              sig->closed, err);
 }
 
-km_status km_signature_create(km_signature *out, double length,
-                              const double start[2], double angle,
-                              const km_fn *kappa, const km_corner *corners,
-                              size_t ncorners, bool closed, km_error *err) {
+/* ---- the checks of km_signature_create, in the order their errors are
+ * reported: length, start, angle, kappa's domain, corners, turning. */
+static km_status check_placement(double length, const double start[2],
+                                 double angle, km_error *err) {
   if (!isfinite(length))
     return km__fail(err, KM_ENONFINITE, KM_FIELD_LENGTH, -1, NAN,
                     "length is not finite");
@@ -54,13 +54,11 @@ km_status km_signature_create(km_signature *out, double length,
   if (!isfinite(angle) || fabs(angle) > 1e6)
     return km__fail(err, KM_ERANGE, KM_FIELD_ANGLE, -1, NAN,
                     "start angle must be finite and at most 1e6 radians");
-  double a, b;
-  km_fn_domain(kappa, &a, &b);
-  if (fabs(a) > 1e-9 * length || fabs(b - length) > 1e-9 * length)
-    return km__fail(err, KM_EKNOTS, KM_FIELD_KAPPA_KNOTS, -1, NAN,
-                    "kappa must be defined on [0, length] = [0, %g], not "
-                    "[%g, %g]",
-                    length, a, b);
+  return KM_OK;
+}
+
+static km_status check_corners(const km_corner *corners, size_t ncorners,
+                               double length, km_error *err) {
   for (size_t i = 0; i < ncorners; i++) {
     if (!isfinite(corners[i].s) || !isfinite(corners[i].turn))
       return km__fail(err, KM_ENONFINITE, KM_FIELD_CORNERS, (long)i, NAN,
@@ -76,7 +74,13 @@ km_status km_signature_create(km_signature *out, double length,
       return km__fail(err, KM_EINVAL, KM_FIELD_CORNERS, (long)i, NAN,
                       "corners must be sorted by s (corner %zu)", i);
   }
-  /* a bound on the integral of |kappa| plus |turn| at the corners */
+  return KM_OK;
+}
+
+/* A bound on the integral of |kappa| plus |turn| at the corners, held to
+ * the turns a signature may trace. */
+static km_status check_turning(const km_fn *kappa, const km_corner *corners,
+                               size_t ncorners, km_error *err) {
   double abs_turning = 0.0;
   int p = kappa->degree;
   for (size_t i = 0; i < kappa->n; i++)
@@ -89,10 +93,29 @@ km_status km_signature_create(km_signature *out, double length,
                     "the curve would turn up to %g times (|kappa| "
                     "integrates to %g rad); at most %g turns are traced",
                     abs_turning / (2 * KM_PI), abs_turning, max_turns);
+  return KM_OK;
+}
+
+km_status km_signature_create(km_signature *out, double length,
+                              const double start[2], double angle,
+                              const km_fn *kappa, const km_corner *corners,
+                              size_t ncorners, bool closed, km_error *err) {
+  km_status st = check_placement(length, start, angle, err);
+  if (st) return st;
+  double a, b;
+  km_fn_domain(kappa, &a, &b);
+  if (fabs(a) > 1e-9 * length || fabs(b - length) > 1e-9 * length)
+    return km__fail(err, KM_EKNOTS, KM_FIELD_KAPPA_KNOTS, -1, NAN,
+                    "kappa must be defined on [0, length] = [0, %g], not "
+                    "[%g, %g]",
+                    length, a, b);
+  st = check_corners(corners, ncorners, length, err);
+  if (!st) st = check_turning(kappa, corners, ncorners, err);
+  if (st) return st;
   km_signature r;
   km_signature_init(&r);
-  km_status st = km_fn_copy(&r.kappa, kappa, err);
-  if (st) return st;
+  st = km_fn_copy(&r.kappa, kappa, err);
+  if (st) goto cleanup;
   /* snap the domain to [0, length] exactly */
   size_t nk = r.kappa.n + (size_t)r.kappa.degree + 1;
   for (size_t i = 0; i < nk; i++) {
@@ -103,8 +126,8 @@ km_status km_signature_create(km_signature *out, double length,
   if (ncorners) {
     r.corners = malloc(ncorners * sizeof *r.corners);
     if (!r.corners) {
-      km_fn_free(&r.kappa);
-      return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+      st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+      goto cleanup;
     }
     memcpy(r.corners, corners, ncorners * sizeof *r.corners);
     for (size_t i = 0; i < ncorners; i++)
@@ -120,7 +143,10 @@ km_status km_signature_create(km_signature *out, double length,
   for (size_t i = 0; i < ncorners; i++) turning += corners[i].turn;
   r.turning = turning;
   *out = r;
-  return KM_OK;
+  km_signature_init(&r);
+cleanup:
+  km_signature_free(&r);
+  return st;
 }
 
 double km_signature_theta(const km_signature *sig, double s) {
