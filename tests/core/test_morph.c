@@ -119,18 +119,8 @@ static void random_open_curve(km_curve *c, uint64_t *seed, size_t n, double x,
 
 static void fixture_signature(const char *name, km_signature *sig) {
   tf_analytic a;
-  km_error err;
   assert_int_equal(tf_load_analytic(name, &a), 0);
-  km_fn kappa;
-  km_fn_init(&kappa);
-  assert_status(km_fn_create(&kappa, a.kappa_degree, a.kappa_n, a.kappa_knots,
-                             a.kappa_coef, &err),
-                KM_OK);
-  km_signature_init(sig);
-  assert_status(km_signature_create(sig, a.length, a.start, a.angle, &kappa,
-                                    NULL, 0, a.closed, &err),
-                KM_OK);
-  km_fn_free(&kappa);
+  signature_of_analytic(&a, sig);
   tf_analytic_free(&a);
 }
 

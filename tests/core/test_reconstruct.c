@@ -126,21 +126,6 @@ static double check_reconstruction(const km_signature *sig, const oracle *o,
   return m;
 }
 
-/* A signature from an analytic.json case. */
-static void fixture_signature(const tf_analytic *a, km_signature *sig) {
-  km_fn kappa;
-  km_error err;
-  km_fn_init(&kappa);
-  assert_status(km_fn_create(&kappa, a->kappa_degree, a->kappa_n,
-                             a->kappa_knots, a->kappa_coef, &err),
-                KM_OK);
-  km_signature_init(sig);
-  assert_status(km_signature_create(sig, a->length, a->start, a->angle,
-                                    &kappa, NULL, 0, a->closed, &err),
-                KM_OK);
-  km_fn_free(&kappa);
-}
-
 static double theta_circle(double s, const void *ctx) {
   (void)ctx;
   return s;
@@ -151,7 +136,7 @@ static void unit_circle_is_reconstructed_within_each_tolerance(void **state) {
   tf_analytic a;
   assert_int_equal(tf_load_analytic("unit_circle", &a), 0);
   km_signature sig;
-  fixture_signature(&a, &sig);
+  signature_of_analytic(&a, &sig);
   static oracle o;
   oracle_init(&o, theta_circle, NULL, 2 * M_PI, 0, 0);
   /* the oracle itself against the closed form and the fixture */
@@ -207,7 +192,7 @@ static void cornu_spirals_are_reconstructed_within_tolerance(void **state) {
     tf_analytic a;
     assert_int_equal(tf_load_analytic(cases[ci].name, &a), 0);
     km_signature sig;
-    fixture_signature(&a, &sig);
+    signature_of_analytic(&a, &sig);
     oracle_init(&o, theta_cornu, &cases[ci].c, a.length, 0, 0);
     /* the oracle against the fixture (independent computations) */
     for (size_t i = 0; i < a.nsamples; i++) {

@@ -1,13 +1,16 @@
-/* curvecases.h - making curves in the tests: make_curve, and curves that
- * more than one test file needs, each with the geometry that makes its
- * expected values exact.
+/* curvecases.h - making curves and signatures in the tests: make_curve,
+ * the signature of an analytic fixture, and curves that more than one test
+ * file needs, each with the geometry that makes its expected values exact.
  */
 #ifndef TESTS_CURVECASES_H
 #define TESTS_CURVECASES_H
 
 #include <stdbool.h>
 
+#include "fixtures.h"
 #include "km/curve.h"
+#include "km/fn.h"
+#include "km/signature.h"
 #include "testutil.h"
 
 /* km_curve_create or fail the test: c is initialised first, so the caller
@@ -18,6 +21,24 @@ static inline void make_curve(km_curve *c, int p, size_t n,
   km_error err;
   km_curve_init(c);
   assert_status(km_curve_create(c, p, n, knots, cp, w, closed, &err), KM_OK);
+}
+
+/* The signature an analytic.json case states (its kappa, length, start
+ * and closedness), or fail the test; sig is initialised first, so the
+ * caller frees it with km_signature_free. */
+static inline void signature_of_analytic(const tf_analytic *a,
+                                         km_signature *sig) {
+  km_fn kappa;
+  km_error err;
+  km_fn_init(&kappa);
+  km_signature_init(sig);
+  assert_status(km_fn_create(&kappa, a->kappa_degree, a->kappa_n,
+                             a->kappa_knots, a->kappa_coef, &err),
+                KM_OK);
+  assert_status(km_signature_create(sig, a->length, a->start, a->angle,
+                                    &kappa, NULL, 0, a->closed, &err),
+                KM_OK);
+  km_fn_free(&kappa);
 }
 
 /* A rational Bezier of degree 9 on the segment from (1e6, 1e6) to
