@@ -14,14 +14,7 @@ size_t km__knot_span(const double *U, size_t n, int p, double u) {
     while (lo < n - 1 && U[lo + 1] == U[p]) lo++;
     return lo;
   }
-  while (hi - lo > 1) { /* U[lo] <= u < U[hi] */
-    size_t mid = (lo + hi) / 2;
-    if (u < U[mid])
-      hi = mid;
-    else
-      lo = mid;
-  }
-  return lo;
+  return km__bracket(U, lo, hi, u); /* U[lo] <= u < U[hi] */
 }
 
 void km__cubic_basis(const double *U, size_t i, double u, double N[4]) {

@@ -17,6 +17,21 @@
 
 #define KM_PI 3.14159265358979323846
 
+/* The binary search under every span and piece search: the largest i in
+ * [lo, hi) with x[i] <= v, given x[lo] <= v < x[hi] for sorted x (a NaN v
+ * gives hi - 1). O(log(hi - lo)). */
+static inline size_t km__bracket(const double *x, size_t lo, size_t hi,
+                                 double v) {
+  while (hi - lo > 1) {
+    size_t mid = (lo + hi) / 2;
+    if (v < x[mid])
+      hi = mid;
+    else
+      lo = mid;
+  }
+  return lo;
+}
+
 /* Span index i in [p, n - 1] with U[i] <= u < U[i+1], for the knot vector
  * U[0 .. n + p] of n control points of degree p (non-decreasing knots,
  * U[p] < U[n]). u at or past the domain's end U[n] gives the last

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "internal.h"
+#include "kernels.h"
 #include "km/limits.h"
 
 void km__pp_init(km_pp *p) { memset(p, 0, sizeof *p); }
@@ -150,15 +151,7 @@ double km__bern_abs_bound(const double *c, int d) {
 size_t km__pp_find(const km_pp *p, double x) {
   if (x <= p->x[0]) return 0;
   if (x >= p->x[p->m]) return p->m - 1;
-  size_t lo = 0, hi = p->m; /* x[lo] <= x < x[hi] */
-  while (hi - lo > 1) {
-    size_t mid = (lo + hi) / 2;
-    if (x < p->x[mid])
-      hi = mid;
-    else
-      lo = mid;
-  }
-  return lo;
+  return km__bracket(p->x, 0, p->m, x); /* x[0] < x < x[m] */
 }
 
 double km__pp_eval(const km_pp *p, double x) {
