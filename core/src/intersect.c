@@ -20,7 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bezier_util.h"
+#include "hcurve.h"
 #include "internal.h"
 #include "km/curve.h"
 #include "km/limits.h"

@@ -1,6 +1,6 @@
-/* bezier_util.h - homogeneous B-spline workspaces shared by the knot-level
- * curve operations, the interpolator and the self-intersection counter;
- * internal to libkmorph.
+/* hcurve.h - homogeneous B-spline workspaces shared by the knot-level
+ * curve operations (hcurve.c, curve_ops.c) and the self-intersection
+ * counter (intersect.c); internal to libkmorph.
  *
  * A rational curve is exact under knot insertion, knot removal and degree
  * elevation only when those act on the homogeneous points (w x, w y, w), so
@@ -8,8 +8,8 @@
  * control points have `dim` coordinates, 2 for polynomial curves and 3 for
  * rational ones. One heap block holds knots then points.
  */
-#ifndef KM_BEZIER_UTIL_H
-#define KM_BEZIER_UTIL_H
+#ifndef KM_HCURVE_H
+#define KM_HCURVE_H
 
 #include <stdbool.h>
 #include <stddef.h>
