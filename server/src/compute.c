@@ -122,7 +122,12 @@ static api_morph_plan *plan_job(srv_req *r, api_request *req, double limit)
   api_morph_plan *plan = NULL;
   api_response err;
   api_response_init(&err);
-  int rc = api_morph_prepare(&s->api, req, s->cfg.max_job_frames, &plan, &err);
+  /* A job's answer is kept, not sent at once: it is held to the memory
+   * kept for job results (checked again with the others' reservations
+   * when the job is admitted), not to the size of a synchronous answer. */
+  api_config cfg = s->api;
+  cfg.max_output_bytes = s->cfg.result_memory;
+  int rc = api_morph_prepare(&cfg, req, s->cfg.max_job_frames, &plan, &err);
   if (rc == 0 && plan != NULL) {
     api_response_free(&err);
     return plan;
