@@ -8,11 +8,11 @@
  */
 #include <float.h>
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
 #include "kernels.h"
+#include "km/alloc.h"
 #include "km/limits.h"
 
 void km_curve_init(km_curve *c) {
@@ -21,7 +21,7 @@ void km_curve_init(km_curve *c) {
 
 void km_curve_free(km_curve *c) {
   if (!c) return;
-  free(c->knots);
+  km__free(c->knots);
   memset(c, 0, sizeof *c);
 }
 
@@ -29,7 +29,7 @@ km_status km__curve_alloc(km_curve *c, int degree, size_t n, bool rational) {
   size_t nk = n + (size_t)degree + 1;
   size_t total = nk + 2 * n + (rational ? n : 0);
   if (n == 0 || total > ((size_t)-1) / sizeof(double)) return KM_ENOMEM;
-  double *block = malloc(total * sizeof(double));
+  double *block = km__malloc(total * sizeof(double));
   if (!block) return KM_ENOMEM;
   c->degree = degree;
   c->n = n;

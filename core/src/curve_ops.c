@@ -6,12 +6,12 @@
  * (hcurve.h, hcurve.c), which makes it exact for rational curves too.
  */
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "hcurve.h"
 #include "internal.h"
 #include "kernels.h"
+#include "km/alloc.h"
 #include "km/curve.h"
 #include "km/limits.h"
 
@@ -41,7 +41,7 @@ static km_status insert_times(km_curve *out, const km_curve *c, double t,
   double *x = NULL;
   km_status st = km__h_from_curve(&h, c, 2);
   if (st) goto cleanup;
-  x = malloc((r ? r : 1) * sizeof(double));
+  x = km__malloc((r ? r : 1) * sizeof(double));
   if (!x) {
     st = KM_ENOMEM;
     goto cleanup;
@@ -51,7 +51,7 @@ static km_status insert_times(km_curve *out, const km_curve *c, double t,
   if (st) goto cleanup;
   st = km__h_to_curve(out, &q, c->closed);
 cleanup:
-  free(x);
+  km__free(x);
   km__h_free(&h);
   km__h_free(&q);
   return st;
@@ -365,7 +365,7 @@ km_status km_curve_make_compatible(const km_curve *a, const km_curve *b,
    * knot: moving one by 1e-13 of the domain changes the curve by less than
    * rounding elsewhere does, while keeping both would add a sliver span */
   snap_knots(&eb, &ea, 1e-13);
-  x = malloc((ea.n + eb.n + 2) * sizeof(double));
+  x = km__malloc((ea.n + eb.n + 2) * sizeof(double));
   if (!x) {
     st = KM_ENOMEM;
     goto cleanup;
@@ -392,7 +392,7 @@ km_status km_curve_make_compatible(const km_curve *a, const km_curve *b,
   km_curve_init(&cb);
 cleanup:
   if (st) km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
-  free(x);
+  km__free(x);
   km__h_free(&ha);
   km__h_free(&hb);
   km__h_free(&ea);

@@ -13,11 +13,11 @@
  * points, the interpolant is returned instead (it is exact).
  */
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
 #include "kernels.h"
+#include "km/alloc.h"
 #include "km/limits.h"
 
 #define FIT_MAX_CP 400 /* dense normal equations beyond this cost too much */
@@ -41,7 +41,7 @@ typedef struct fit_work {
 static km_status prepare(fit_work *fw, const double *pts, size_t n,
                          bool closed, km_error *err) {
   if (closed) {
-    fw->ext = malloc(2 * (n + 1) * sizeof(double));
+    fw->ext = km__malloc(2 * (n + 1) * sizeof(double));
     if (!fw->ext) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
     memcpy(fw->ext, pts, 2 * n * sizeof(double));
     fw->ext[2 * n] = pts[0];
@@ -52,7 +52,7 @@ static km_status prepare(fit_work *fw, const double *pts, size_t n,
   fw->pts = pts;
   fw->n = n;
   fw->seam = closed;
-  double *u = fw->u = malloc(n * sizeof(double));
+  double *u = fw->u = km__malloc(n * sizeof(double));
   if (!u) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   u[0] = 0.0;
   for (size_t i = 1; i < n; i++)
@@ -60,11 +60,11 @@ static km_status prepare(fit_work *fw, const double *pts, size_t n,
   fw->total = u[n - 1];
   if (!(fw->total > 0)) return KM_OK;
   for (size_t i = 0; i < n; i++) u[i] /= fw->total;
-  fw->U = malloc((FIT_MAX_CP + 8) * sizeof(double));
-  fw->newk = malloc((FIT_MAX_CP + 8) * sizeof(double));
-  fw->cp = malloc(2 * (FIT_MAX_CP + 4) * sizeof(double));
-  fw->A = malloc((size_t)FIT_MAX_CP * FIT_MAX_CP * sizeof(double));
-  fw->rhs = malloc(2 * (size_t)FIT_MAX_CP * sizeof(double));
+  fw->U = km__malloc((FIT_MAX_CP + 8) * sizeof(double));
+  fw->newk = km__malloc((FIT_MAX_CP + 8) * sizeof(double));
+  fw->cp = km__malloc(2 * (FIT_MAX_CP + 4) * sizeof(double));
+  fw->A = km__malloc((size_t)FIT_MAX_CP * FIT_MAX_CP * sizeof(double));
+  fw->rhs = km__malloc(2 * (size_t)FIT_MAX_CP * sizeof(double));
   if (!fw->U || !fw->newk || !fw->cp || !fw->A || !fw->rhs)
     return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   return KM_OK;
@@ -147,12 +147,12 @@ static km_status solve_points(fit_work *fw, size_t ncp, size_t nu, bool *ok,
   double *cp = fw->cp, *rhs = fw->rhs;
   normal_equations(fw, ncp, nu);
   /* two right-hand sides: solve twice on copies */
-  double *A2 = malloc(nu * nu * sizeof(double));
+  double *A2 = km__malloc(nu * nu * sizeof(double));
   if (!A2) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   memcpy(A2, fw->A, nu * nu * sizeof(double));
   *ok = km__solve_dense(fw->A, rhs, (int)nu) &&
         km__solve_dense(A2, rhs + nu, (int)nu);
-  free(A2);
+  km__free(A2);
   if (!*ok) return KM_OK;
   cp[0] = pts[0];
   cp[1] = pts[1];
@@ -262,12 +262,12 @@ km_status km_curve_fit_points(km_curve *out, const double *pts, size_t n,
   km_status st = prepare(&fw, pts, n, closed, err);
   if (!st && fw.total > 0) st = fit_rounds(&fw, tol, closed, out, &fitted, err);
   if (!st && !fitted) st = km_curve_interpolate(out, pts, n, closed, err);
-  free(fw.ext);
-  free(fw.u);
-  free(fw.U);
-  free(fw.newk);
-  free(fw.cp);
-  free(fw.A);
-  free(fw.rhs);
+  km__free(fw.ext);
+  km__free(fw.u);
+  km__free(fw.U);
+  km__free(fw.newk);
+  km__free(fw.cp);
+  km__free(fw.A);
+  km__free(fw.rhs);
   return st;
 }

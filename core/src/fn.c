@@ -3,11 +3,11 @@
  * different knots over a normalised domain.
  */
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
 #include "kernels.h"
+#include "km/alloc.h"
 #include "km/limits.h"
 
 #define FN_MAX_DEGREE KM_MAX_FN_DEGREE
@@ -18,14 +18,14 @@ void km_fn_init(km_fn *f) {
 
 void km_fn_free(km_fn *f) {
   if (!f) return;
-  free(f->knots);
+  km__free(f->knots);
   memset(f, 0, sizeof *f);
 }
 
 km_status km__fn_alloc(km_fn *f, int degree, size_t n) {
   size_t nk = n + (size_t)degree + 1;
   if (n == 0) return KM_ENOMEM;
-  double *block = malloc((nk + n) * sizeof(double));
+  double *block = km__malloc((nk + n) * sizeof(double));
   if (!block) return KM_ENOMEM;
   f->degree = degree;
   f->n = n;
@@ -301,7 +301,7 @@ static void piece_on(const km_pp *p, double r0, double r1, int e,
 km_status km__pp_blend(km_pp *out, const km_pp *a, double wa, const km_pp *b,
                        double wb, double u0, double u1) {
   size_t nr = a->m + b->m + 2;
-  double *r = malloc(nr * sizeof(double));
+  double *r = km__malloc(nr * sizeof(double));
   if (!r) return KM_ENOMEM;
   size_t k = 0, ia = 0, ib = 0;
   double La = a->x[a->m] - a->x[0], Lb = b->x[b->m] - b->x[0];
@@ -330,7 +330,7 @@ km_status km__pp_blend(km_pp *out, const km_pp *a, double wa, const km_pp *b,
   int e = a->degree > b->degree ? a->degree : b->degree;
   km_pp o;
   if (km__pp_alloc(&o, e, m - 1)) {
-    free(r);
+    km__free(r);
     return KM_ENOMEM;
   }
   double ca[FN_MAX_DEGREE + 2], cb[FN_MAX_DEGREE + 2];
@@ -343,7 +343,7 @@ km_status km__pp_blend(km_pp *out, const km_pp *a, double wa, const km_pp *b,
   }
   o.x[0] = u0;
   o.x[m - 1] = u1;
-  free(r);
+  km__free(r);
   *out = o;
   return KM_OK;
 }

@@ -11,12 +11,12 @@
  * one-sided recurrence amplifies rounding.
  */
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "hcurve.h"
 #include "internal.h"
 #include "kernels.h"
+#include "km/alloc.h"
 #include "km/curve.h"
 #include "km/limits.h"
 
@@ -25,14 +25,14 @@ void km__h_init(km__hcurve *h) { memset(h, 0, sizeof *h); }
 
 void km__h_free(km__hcurve *h) {
   if (!h) return;
-  free(h->knots);
+  km__free(h->knots);
   memset(h, 0, sizeof *h);
 }
 
 km_status km__h_alloc(km__hcurve *h, int degree, int dim, size_t n) {
   size_t nk = n + (size_t)degree + 1;
   if (n == 0 || n > ((size_t)-1) / sizeof(double) / 8) return KM_ENOMEM;
-  double *block = malloc((nk + n * (size_t)dim) * sizeof(double));
+  double *block = km__malloc((nk + n * (size_t)dim) * sizeof(double));
   if (!block) return KM_ENOMEM;
   h->degree = degree;
   h->dim = dim;
@@ -175,7 +175,7 @@ km_status km__h_to_bezier(km__hcurve *out, const km__hcurve *h) {
   }
   double *x = NULL;
   if (cnt) {
-    x = malloc(cnt * sizeof(double));
+    x = km__malloc(cnt * sizeof(double));
     if (!x) return KM_ENOMEM;
   }
   size_t c = 0;
@@ -187,7 +187,7 @@ km_status km__h_to_bezier(km__hcurve *out, const km__hcurve *h) {
     i = j + 1;
   }
   km_status st = km__h_refine(out, h, x, cnt);
-  free(x);
+  km__free(x);
   return st;
 }
 
@@ -254,7 +254,7 @@ km_status km__h_elevate(km__hcurve *out, const km__hcurve *h, int times) {
   for (size_t i = (size_t)p + 1; i < n; i++)
     if (U[i] != U[i - 1]) nd++;
   if (nd) {
-    mult = malloc(nd * sizeof *mult);
+    mult = km__malloc(nd * sizeof *mult);
     if (!mult) {
       st = KM_ENOMEM;
       goto cleanup;
@@ -306,7 +306,7 @@ km_status km__h_elevate(km__hcurve *out, const km__hcurve *h, int times) {
 cleanup:
   km__h_free(&bz);
   km__h_free(&e);
-  free(mult);
+  km__free(mult);
   return st;
 }
 

@@ -14,11 +14,11 @@
  * taking per point the side whose ratio is <= 1.
  */
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
 #include "kernels.h"
+#include "km/alloc.h"
 #include "km/curve.h"
 #include "km/limits.h"
 
@@ -32,7 +32,7 @@ static km_status solve_open(const double *Q, const double *u, size_t N,
   }
   for (size_t j = 4; j < N; j++) T[j] = u[j - 2];
   /* band: row k holds columns k-3..k+3 at offsets 0..6 */
-  double *A = calloc(N * 7, sizeof(double));
+  double *A = km__calloc(N * 7, sizeof(double));
   if (!A) return KM_ENOMEM;
   memcpy(cp, Q, 2 * N * sizeof(double));
   for (size_t k = 0; k < N; k++) {
@@ -74,7 +74,7 @@ static km_status solve_open(const double *Q, const double *u, size_t N,
     cp[2 * i + 1] = sy / A[i * 7 + 3];
   }
 cleanup:
-  free(A);
+  km__free(A);
   return st;
 }
 
@@ -136,7 +136,7 @@ static void cyclic_solve(const double *sub, const double *dia,
 static km_status solve_closed(const double *Q, const double *h,
                               const double *u, size_t N, double *T,
                               double *cp) {
-  double *buf = malloc(N * 10 * sizeof(double));
+  double *buf = km__malloc(N * 10 * sizeof(double));
   if (!buf) return KM_ENOMEM;
   double *sub = buf, *dia = buf + N, *sup = buf + 2 * N, *D = buf + 3 * N;
   double *work = buf + 5 * N;
@@ -187,7 +187,7 @@ static km_status solve_closed(const double *Q, const double *h,
       cp[2 * (i + 1) + (size_t)c] = v;
     }
   }
-  free(buf);
+  km__free(buf);
   return KM_OK;
 }
 
@@ -307,9 +307,9 @@ km_status km_curve_interpolate(km_curve *out, const double *pts, size_t n,
                     "too many points");
   km_status st = check_points(pts, n, err);
   if (st) return st;
-  Q = malloc((2 * n + 2) * sizeof(double));
-  u = malloc((n + 2) * sizeof(double));
-  h = malloc((n + 2) * sizeof(double));
+  Q = km__malloc((2 * n + 2) * sizeof(double));
+  u = km__malloc((n + 2) * sizeof(double));
+  h = km__malloc((n + 2) * sizeof(double));
   if (!Q || !u || !h) {
     st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
     goto cleanup;
@@ -351,8 +351,8 @@ km_status km_curve_interpolate(km_curve *out, const double *pts, size_t n,
   km_curve_init(&c);
 cleanup:
   km_curve_free(&c);
-  free(Q);
-  free(u);
-  free(h);
+  km__free(Q);
+  km__free(u);
+  km__free(h);
   return st;
 }

@@ -22,6 +22,7 @@
 
 #include "hcurve.h"
 #include "internal.h"
+#include "km/alloc.h"
 #include "km/curve.h"
 #include "km/limits.h"
 #include "km/morph.h"
@@ -151,7 +152,7 @@ static bool monotone(const seg *s, int p, double eps) {
 static void push_seg(ctx *x, const seg *s) {
   if (x->nseg == x->capseg) {
     size_t cap = x->capseg ? 2 * x->capseg : 64;
-    seg *n = realloc(x->segs, cap * sizeof *n);
+    seg *n = km__realloc(x->segs, cap * sizeof *n);
     if (!n) {
       x->oom = true;
       return;
@@ -234,7 +235,7 @@ static void add_hit(ctx *x, double ta, double tb) {
       return;
   if (x->nhit == x->caphit) {
     size_t cap = x->caphit ? 2 * x->caphit : 16;
-    double *n = realloc(x->hits, 2 * cap * sizeof(double));
+    double *n = km__realloc(x->hits, 2 * cap * sizeof(double));
     if (!n) {
       x->oom = true;
       return;
@@ -529,7 +530,7 @@ long km__self_intersections(const km_curve *c, double tol, km__poll *poll) {
   }
   if (x.oom) goto cleanup;
   /* the sweep orders pointers: a sub-curve is hundreds of bytes */
-  order = malloc((x.nseg + 1) * sizeof *order);
+  order = km__malloc((x.nseg + 1) * sizeof *order);
   if (!order) goto cleanup;
   for (size_t i = 0; i < x.nseg; i++) order[i] = &x.segs[i];
   qsort(order, x.nseg, sizeof *order, by_xmin);
@@ -537,9 +538,9 @@ long km__self_intersections(const km_curve *c, double tol, km__poll *poll) {
   if (x.oom) goto cleanup;
   result = (long)x.nhit;
 cleanup:
-  free(order);
-  free(x.segs);
-  free(x.hits);
+  km__free(order);
+  km__free(x.segs);
+  km__free(x.hits);
   km__h_free(&h);
   km__h_free(&bz);
   return result;

@@ -14,10 +14,10 @@
 #include <limits.h>
 #include <math.h>
 #include <stdint.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
+#include "km/alloc.h"
 #include "km/limits.h"
 #include "km/morph.h"
 #include "km/reconstruct.h"
@@ -46,11 +46,11 @@ void km_morph_free(km_morph *m) {
     km__input_free(&m->in[i]);
     km_curve_free(&m->lin[i]);
   }
-  free(m->ra);
-  free(m->rb);
+  km__free(m->ra);
+  km__free(m->rb);
   km__frame_plan_free(m->plan);
-  free(m->place_ab);
-  free(m);
+  km__free(m->place_ab);
+  km__free(m);
 }
 
 /* Whether the lsq closure goes by the frames' corners: so if it can at
@@ -111,7 +111,7 @@ static km_status plan_frames(km_morph *m, km_error *err) {
 /* An empty morph (every part initialised, km_morph_free-able) with the
  * caller's poll, or NULL without memory. */
 static km_morph *morph_new(km__poll *poll) {
-  km_morph *m = calloc(1, sizeof *m);
+  km_morph *m = km__calloc(1, sizeof *m);
   if (!m) return NULL;
   for (int i = 0; i < 2; i++) {
     km_curve_init(&m->in[i].curve);
@@ -135,8 +135,8 @@ static km_status morph_shifted(const km_morph *base, double dshift,
   m->tol = base->tol;
   m->closed = base->closed;
   m->kmax = base->kmax;
-  m->ra = malloc(2 * sizeof(double));
-  m->rb = malloc(2 * sizeof(double));
+  m->ra = km__malloc(2 * sizeof(double));
+  m->rb = km__malloc(2 * sizeof(double));
   km_status st = m->ra && m->rb ? KM_OK
                                 : km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   if (!st) {
@@ -226,8 +226,8 @@ static km_status set_correspondence(km_morph *m, const km_morph_options *opt,
     nm = km__auto_matches(&m->in[0], &m->in[1], auto_pairs, 64);
     pairs = auto_pairs;
   }
-  m->ra = malloc((nm + 2) * sizeof(double));
-  m->rb = malloc((nm + 2) * sizeof(double));
+  m->ra = km__malloc((nm + 2) * sizeof(double));
+  m->rb = km__malloc((nm + 2) * sizeof(double));
   if (!m->ra || !m->rb) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   m->ra[0] = m->rb[0] = 0.0;
   for (size_t i = 0; i < nm; i++) {
@@ -381,7 +381,7 @@ static km_status planned_frame(const km_morph *m, double t, km_closure how,
   double phia = a->sig.angle, phib = phia + km__wrap_angle(b->sig.angle - phia);
   double rot, T[2];
   size_t nb = km__frame_plan_pieces(m->plan) + 1;
-  double *buf = malloc(2 * nb * sizeof(double));
+  double *buf = km__malloc(2 * nb * sizeof(double));
   if (!buf) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   double (*P)[2] = (double (*)[2])buf;
   km_curve f;
@@ -399,7 +399,7 @@ static km_status planned_frame(const km_morph *m, double t, km_closure how,
   }
 done:
   km_curve_free(&f);
-  free(buf);
+  km__free(buf);
   return st;
 }
 

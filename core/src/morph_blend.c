@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include "internal.h"
+#include "km/alloc.h"
 #include "morph_blend.h"
 
 typedef struct corner_list {
@@ -34,7 +35,7 @@ typedef struct corner_list {
 static km_status corner_push(corner_list *cl, double s, double turn) {
   if (cl->n == cl->cap) {
     size_t cap = cl->cap ? 2 * cl->cap : 16;
-    km_corner *c = realloc(cl->c, cap * sizeof *c);
+    km_corner *c = km__realloc(cl->c, cap * sizeof *c);
     if (!c) return KM_ENOMEM;
     cl->c = c;
     cl->cap = cap;
@@ -195,8 +196,8 @@ typedef struct smooth_map {
 } smooth_map;
 
 static void smooth_map_free(smooth_map *sm) {
-  free(sm->buf);
-  free(sm->qm);
+  km__free(sm->buf);
+  km__free(sm->qm);
 }
 
 /* KM_EINVAL when alpha and beta cannot be kept positive, KM_ENOMEM. */
@@ -204,7 +205,7 @@ static km_status smooth_map_make(const km_morph *m, double t, smooth_map *sm) {
   double La = m->in[0].sig.length, Lb = m->in[1].sig.length;
   size_t K = sm->K = m->nk - 1;
   sm->nq = 2 * K;
-  double *buf = sm->buf = malloc((6 * K + 1) * sizeof(double));
+  double *buf = sm->buf = km__malloc((6 * K + 1) * sizeof(double));
   if (!buf) return KM_ENOMEM;
   double *rho = sm->rho = buf, *len = sm->len = buf + K, *S = sm->S = buf + 2 * K;
   sm->nl = buf + 3 * K + 1;
@@ -219,7 +220,7 @@ static km_status smooth_map_make(const km_morph *m, double t, smooth_map *sm) {
   }
   km_status st = smooth_nodes(rho, len, K, m->closed, t, sm->nl, sm->nr, sm->mid);
   if (st) return st;
-  quad_map *qm = sm->qm = malloc(2 * K * sizeof *qm);
+  quad_map *qm = sm->qm = km__malloc(2 * K * sizeof *qm);
   if (!qm) return KM_ENOMEM;
   double sa_at = 0.0;
   for (size_t k = 0; k < K; k++) {
@@ -242,7 +243,7 @@ static km_status smooth_breaks(const km_morph *m, double t,
   const quad_map *qm = sm->qm;
   size_t K = sm->K, nq = sm->nq, nb = 0;
   size_t cap = 2 * K + 1 + a->kappa.m + b->kappa.m + 2;
-  double *br = malloc(cap * sizeof(double));
+  double *br = km__malloc(cap * sizeof(double));
   if (!br) return KM_ENOMEM;
   for (size_t q = 0; q < nq; q++) br[nb++] = qm[q].x0;
   br[nb++] = sm->S[K];
@@ -381,7 +382,7 @@ static km_status blend_smooth(const km_morph *m, double t, km_pp *out,
     km__pp_init(&o);
   }
   km__pp_free(&o);
-  free(br);
+  km__free(br);
   smooth_map_free(&sm);
   return st;
 }
@@ -551,7 +552,7 @@ km_status km__blend_signature(const km_morph *m, double t, km_signature *out,
                               km_error *err) {
   const km__input *a = &m->in[0], *b = &m->in[1];
   double Lt = (1 - t) * a->sig.length + t * b->sig.length;
-  km_pp *segs = calloc(m->nk - 1, sizeof *segs);
+  km_pp *segs = km__calloc(m->nk - 1, sizeof *segs);
   corner_list cl = {NULL, 0, 0};
   km_pp whole;
   km__pp_init(&whole);
@@ -580,10 +581,10 @@ km_status km__blend_signature(const km_morph *m, double t, km_signature *out,
 done:
   if (segs)
     for (size_t k = 0; k + 1 < m->nk; k++) km__pp_free(&segs[k]);
-  free(segs);
+  km__free(segs);
   km_fn_free(&kf);
   km__pp_free(&whole);
-  free(cl.c);
+  km__free(cl.c);
   if (st == KM_ENOMEM) km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
   return st;
 }

@@ -17,10 +17,10 @@
  * frames (morph_plan_frame.c) close with the same basis and metric.
  */
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
+#include "km/alloc.h"
 #include "km/limits.h"
 #include "morph_closure.h"
 #include "morph_internal.h"
@@ -109,7 +109,7 @@ void km__closure_metric_solve(const double *Lc, double *y) {
 bool km__close_by_corners(const double *S, const double *tau, size_t nc,
                           double *delta) {
   if (nc < 3) return false;
-  double *W = malloc((4 * nc + 1) * sizeof(double));
+  double *W = km__malloc((4 * nc + 1) * sizeof(double));
   if (!W) return false;
   double *D = W + nc, *J = W + 2 * nc + 1; /* J: 2 nc (suffix sums) */
   double wsum = 0.0;
@@ -157,7 +157,7 @@ bool km__close_by_corners(const double *S, const double *tau, size_t nc,
    * would be closed by corners it hardly has */
   for (size_t k = 0; ok && k < nc; k++)
     if (fabs(delta[k]) > 0.5 * fabs(tau[k])) ok = false;
-  free(W);
+  km__free(W);
   return ok;
 }
 
@@ -187,7 +187,7 @@ static km_status closure_nodes(const km_pp *kp, const km_pp *tp, double h,
       int chunks = (int)ceil(kb * (hi - lo) / 0.5);
       if (chunks < 1) chunks = 1;
       if (km__poll_stop(poll, 8L * chunks)) {
-        free(q);
+        km__free(q);
         return KM_ECANCELLED;
       }
       for (int c = 0; c < chunks; c++) {
@@ -196,12 +196,12 @@ static km_status closure_nodes(const km_pp *kp, const km_pp *tp, double h,
         if (n + 8 > cap) {
           cap = cap ? 2 * cap : 1024;
           if (cap > 64 * (size_t)KM_MAX_PIECES) {
-            free(q);
+            km__free(q);
             return KM_ELIMIT;
           }
-          qnode *nq = realloc(q, cap * sizeof *nq);
+          qnode *nq = km__realloc(q, cap * sizeof *nq);
           if (!nq) {
-            free(q);
+            km__free(q);
             return KM_ENOMEM;
           }
           q = nq;
@@ -237,7 +237,7 @@ static km_status stretch_sums(const km_signature *sig, const qnode *q,
   size_t nc = 0, m = 0, ci = 0;
   for (size_t k = 0; k < sig->ncorners; k++)
     if (sig->corners[k].s > 0 && sig->corners[k].s < L) nc++;
-  double *S = sc->S = malloc((4 * nc + 2) * sizeof(double));
+  double *S = sc->S = km__malloc((4 * nc + 2) * sizeof(double));
   if (!S) return KM_ENOMEM;
   sc->nc = nc;
   sc->tau = S + 2 * (nc + 1);
@@ -267,7 +267,7 @@ static km_status stretch_sums(const km_signature *sig, const qnode *q,
 static km_status turn_corners(const km_signature *sig, const double *delta,
                               km_signature *out, km_error *err) {
   double L = sig->length;
-  km_corner *cs = malloc((sig->ncorners + 1) * sizeof *cs);
+  km_corner *cs = km__malloc((sig->ncorners + 1) * sizeof *cs);
   if (!cs) return KM_ENOMEM;
   for (size_t k = 0, m = 0; k < sig->ncorners; k++) {
     cs[k] = sig->corners[k];
@@ -276,7 +276,7 @@ static km_status turn_corners(const km_signature *sig, const double *delta,
   km_status st = km_signature_create(out, L, sig->start, sig->angle,
                                      &sig->kappa, cs, sig->ncorners,
                                      sig->closed, err);
-  free(cs);
+  km__free(cs);
   return st;
 }
 
@@ -430,8 +430,8 @@ km_status km__close_lsq(const km_signature *sig, bool by_corners,
     if (!st) st = add_correction(sig, c, out, err);
   }
 done:
-  free(q);
-  free(sc.S);
+  km__free(q);
+  km__free(sc.S);
   km__pp_free(&kp);
   km__pp_free(&tp);
   if (st == KM_ECANCELLED) return km__stopped(err);

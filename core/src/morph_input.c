@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "internal.h"
+#include "km/alloc.h"
 #include "km/reconstruct.h"
 #include "morph_internal.h"
 
@@ -147,7 +148,7 @@ static km_status rotate_signature(const km__input *in, double s0,
   km__pp_init(&k1);
   km__pp_init(&k2);
   km__pp_init(&kr);
-  km_corner *cs = malloc((sig->ncorners + 1) * sizeof *cs);
+  km_corner *cs = km__malloc((sig->ncorners + 1) * sizeof *cs);
   km_fn kf;
   km_fn_init(&kf);
   km_status st = cs ? km_signature_point(sig, s0, start, NULL) : KM_ENOMEM;
@@ -180,7 +181,7 @@ static km_status rotate_signature(const km__input *in, double s0,
 done:
   if (st == KM_ENOMEM) km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
   km_fn_free(&kf);
-  free(cs);
+  km__free(cs);
   km__pp_free(&k1);
   km__pp_free(&k2);
   km__pp_free(&kr);
@@ -281,7 +282,8 @@ static km_status reverse_signature(const km_signature *sig, km_signature *out,
   double L = sig->length;
   const km_fn *f = &sig->kappa;
   size_t n = f->n, nk = n + (size_t)f->degree + 1, nc = sig->ncorners;
-  double *buf = malloc((nk + n) * sizeof(double) + (nc + 1) * sizeof(km_corner));
+  double *buf =
+      km__malloc((nk + n) * sizeof(double) + (nc + 1) * sizeof(km_corner));
   if (!buf) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   double *knots = buf, *coef = buf + nk;
   km_corner *cr = (km_corner *)(coef + n);
@@ -315,7 +317,7 @@ static km_status reverse_signature(const km_signature *sig, km_signature *out,
     st = km_signature_create(out, L, start, km__wrap_angle(end_angle + KM_PI), &kr,
                              cr, m, sig->closed, err);
   km_fn_free(&kr);
-  free(buf);
+  km__free(buf);
   return st;
 }
 
@@ -458,7 +460,7 @@ static size_t deepest_minima(const double *cost, double *cand) {
  * sum_j pa_j . pb_(j+k), which the FFT gives for all k at once. */
 size_t km__best_shifts(const km__input *a, const km__input *b, double *cand) {
   enum { N = ALIGN_N };
-  double *buf = malloc(14 * (size_t)N * sizeof(double));
+  double *buf = km__malloc(14 * (size_t)N * sizeof(double));
   if (!buf) {
     cand[0] = 0.0;
     return 1;
@@ -470,7 +472,7 @@ size_t km__best_shifts(const km__input *a, const km__input *b, double *cand) {
   shift_samples(a, b, &w);
   shift_costs(&w, b->sig.turning);
   size_t n = deepest_minima(w.cost, cand);
-  free(buf);
+  km__free(buf);
   return n;
 }
 

@@ -9,9 +9,9 @@
  * between the inputs'.
  */
 #include <math.h>
-#include <stdlib.h>
 
 #include "internal.h"
+#include "km/alloc.h"
 #include "morph_blend.h"
 #include "morph_place.h"
 
@@ -25,7 +25,7 @@
 km_status km__place_plan_targets(km_morph *m, km_error *err) {
   size_t nb = km__frame_plan_pieces(m->plan) + 1;
   const double *x = km__frame_plan_breaks(m->plan);
-  m->place_ab = malloc(nb * sizeof *m->place_ab);
+  m->place_ab = km__malloc(nb * sizeof *m->place_ab);
   if (!m->place_ab) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   double W = 0.0, qa[2] = {0, 0}, qb[2] = {0, 0};
   for (size_t k = 0; k < nb; k++) {
@@ -80,7 +80,7 @@ static void place_samples(const km_morph *m, double t, const double (*F)[2],
   if (t == 0.0 || t == 1.0 || m->opt.anchor == KM_ANCHOR_START || n == 0)
     return;
   double fc[2] = {0, 0}, qc[2] = {0, 0}, W = 0.0;
-  double (*Q)[2] = malloc(n * sizeof *Q);
+  double (*Q)[2] = km__malloc(n * sizeof *Q);
   if (!Q) return;
   for (size_t j = 0; j < n; j++) {
     double ra, rb, pa[2], pb[2];
@@ -107,7 +107,7 @@ static void place_samples(const km_morph *m, double t, const double (*F)[2],
   } else {
     procrustes(F, (const double (*)[2])Q, w, n, fc, qc, rot, T);
   }
-  free(Q);
+  km__free(Q);
 }
 
 /* Placement of a frame curve whose parameter is arc length: samples at the
@@ -115,8 +115,8 @@ static void place_samples(const km_morph *m, double t, const double (*F)[2],
 void km__place_frame(const km_morph *m, double t, const km_curve *f,
                      double Lt, double *rot, double T[2]) {
   static const size_t N = FIT_N;
-  double (*F)[2] = malloc(N * sizeof *F);
-  double *s = malloc(2 * N * sizeof(double));
+  double (*F)[2] = km__malloc(N * sizeof *F);
+  double *s = km__malloc(2 * N * sizeof(double));
   double *w = s ? s + N : NULL;
   size_t n = F && s ? N : 0; /* without memory: by the start */
   for (size_t j = 0; j < n; j++) {
@@ -128,8 +128,8 @@ void km__place_frame(const km_morph *m, double t, const km_curve *f,
     F[j][1] = d[0][1];
   }
   place_samples(m, t, (const double (*)[2])F, s, w, n, rot, T);
-  free(F);
-  free(s);
+  km__free(F);
+  km__free(s);
 }
 
 /* place_samples for a planned frame given by its points F at the plan's

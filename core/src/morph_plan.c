@@ -28,6 +28,7 @@
 #include <string.h>
 
 #include "internal.h"
+#include "km/alloc.h"
 #include "km/limits.h"
 #include "morph_plan.h"
 #include "morph_plan_internal.h"
@@ -196,7 +197,7 @@ static km_status vec_push(vec *v, const void *item) {
   if (v->n == v->cap) {
     size_t cap = v->cap ? 2 * v->cap : 256;
     if (cap > 64 * (size_t)KM_MAX_PIECES) return KM_ELIMIT;
-    void *q = realloc(v->p, cap * v->size);
+    void *q = km__realloc(v->p, cap * v->size);
     if (!q) return KM_ENOMEM;
     v->p = q;
     v->cap = cap;
@@ -251,17 +252,17 @@ static km_status plan_interval(vec *atoms, const side sd[2], double r0,
 
 void km__frame_plan_free(km__frame_plan *p) {
   if (!p) return;
-  free(p->x);
-  free(p->corner);
-  free(p->ta_l);
-  free(p->ta_r);
-  free(p->tb_l);
-  free(p->tb_r);
-  free(p->first);
-  free(p->at_break);
-  free(p->node);
-  free(p->corner_at);
-  free(p);
+  km__free(p->x);
+  km__free(p->corner);
+  km__free(p->ta_l);
+  km__free(p->ta_r);
+  km__free(p->tb_l);
+  km__free(p->tb_r);
+  km__free(p->first);
+  km__free(p->at_break);
+  km__free(p->node);
+  km__free(p->corner_at);
+  km__free(p);
 }
 
 /* ---- the phases of planning --------------------------------------------
@@ -284,12 +285,12 @@ static void builder_free(builder *b) {
     km__pp_free(&b->mt[w]);
     km__pp_free(&b->mk[w]);
   }
-  free(b->g);
-  free(b->br);
-  free(b->Dall);
-  free(b->atoms.p);
-  free(b->nodes.p);
-  free(b->start);
+  km__free(b->g);
+  km__free(b->br);
+  km__free(b->Dall);
+  km__free(b->atoms.p);
+  km__free(b->nodes.p);
+  km__free(b->start);
 }
 
 /* The inputs' pieces merged where one polynomial carries them within
@@ -319,7 +320,7 @@ static km_status merge_inputs(builder *b, const km_pp theta[2],
 static km_status merged_breaks(builder *b, const double length[2],
                                km__poll *poll) {
   size_t nbr = b->mt[0].m + b->mt[1].m + 2, q = 0, m = 0;
-  double *br = b->br = malloc(nbr * sizeof(double));
+  double *br = b->br = km__malloc(nbr * sizeof(double));
   if (!br) return KM_ENOMEM;
   for (int w = 0; w < 2; w++)
     for (size_t i = 0; i <= b->mt[w].m; i++) br[q++] = b->mt[w].x[i] / length[w];
@@ -335,7 +336,7 @@ static km_status merged_breaks(builder *b, const double length[2],
     br[m - 1] = 1.0;
   b->m = m;
   if (m < 2) return KM_EDEGENERATE;
-  b->Dall = malloc((m - 1) * (NDER + 1) * sizeof(double));
+  b->Dall = km__malloc((m - 1) * (NDER + 1) * sizeof(double));
   if (!b->Dall) return KM_ENOMEM;
   for (size_t i = 0; i + 1 < m; i++) {
     both_bounds(b->sd, br[i], br[i + 1], NDER, b->Dall + i * (NDER + 1));
@@ -383,7 +384,7 @@ static km_status group_atoms(builder *b, double tolp, size_t max_pieces,
                              size_t *np_out) {
   const atom *A = b->atoms.p;
   size_t na = b->atoms.n, np = 0, k = 0;
-  size_t *start = b->start = malloc((na + 1) * sizeof(size_t));
+  size_t *start = b->start = km__malloc((na + 1) * sizeof(size_t));
   if (!start) return KM_ENOMEM;
   while (k < na) {
     start[np++] = k;
@@ -411,15 +412,15 @@ static km_status group_atoms(builder *b, double tolp, size_t max_pieces,
 /* The plan's per-break arrays for np pieces. */
 static km_status alloc_breaks(km__frame_plan *p, size_t np) {
   p->np = np;
-  p->x = malloc((np + 1) * sizeof(double));
-  p->corner = calloc(np + 1, 1);
-  p->ta_l = malloc((np + 1) * sizeof(double));
-  p->ta_r = malloc((np + 1) * sizeof(double));
-  p->tb_l = malloc((np + 1) * sizeof(double));
-  p->tb_r = malloc((np + 1) * sizeof(double));
-  p->first = malloc((np + 1) * sizeof(size_t));
-  p->at_break = malloc((np + 1) * sizeof(gnode));
-  p->corner_at = malloc((np + 1) * sizeof(size_t));
+  p->x = km__malloc((np + 1) * sizeof(double));
+  p->corner = km__calloc(np + 1, 1);
+  p->ta_l = km__malloc((np + 1) * sizeof(double));
+  p->ta_r = km__malloc((np + 1) * sizeof(double));
+  p->tb_l = km__malloc((np + 1) * sizeof(double));
+  p->tb_r = km__malloc((np + 1) * sizeof(double));
+  p->first = km__malloc((np + 1) * sizeof(size_t));
+  p->at_break = km__malloc((np + 1) * sizeof(gnode));
+  p->corner_at = km__malloc((np + 1) * sizeof(size_t));
   bool ok = p->x && p->corner && p->ta_l && p->ta_r && p->tb_l && p->tb_r &&
             p->first && p->at_break && p->corner_at;
   return ok ? KM_OK : KM_ENOMEM;
@@ -534,9 +535,10 @@ static void break_tables(const builder *b, km__frame_plan *p) {
  * one). Without memory for the trial the smooth closure is chosen. */
 static void choose_corner_closure(km__frame_plan *p, km__poll *poll) {
   size_t nc = p->ncorners, np = p->np;
-  double *buf = nc >= 3 ? malloc((km__plan_frame_scratch(p) + 4 * nc + 2 + np) *
-                                 sizeof(double))
-                        : NULL;
+  double *buf =
+      nc >= 3 ? km__malloc((km__plan_frame_scratch(p) + 4 * nc + 2 + np) *
+                           sizeof(double))
+              : NULL;
   if (!buf) return;
   double *tau = buf + km__plan_frame_scratch(p), *delta = tau + nc, *S = delta + nc;
   double *dp = S + 2 * (nc + 1), c0[NF] = {0};
@@ -545,7 +547,7 @@ static void choose_corner_closure(km__frame_plan *p, km__poll *poll) {
     p->by_corners = km__plan_close_frame(p, k / 4.0, 0.0, false, false, c0, buf,
                                          buf + 2 * np, poll) == KM_OK &&
                     km__plan_corner_closure(p, k / 4.0, buf, tau, delta, S, dp);
-  free(buf);
+  km__free(buf);
 }
 
 /* The corrections frames start from, at t = k / WARM_POINTS: the
@@ -555,7 +557,7 @@ static void choose_corner_closure(km__frame_plan *p, km__poll *poll) {
  * correction itself). One that does not converge is zero. */
 static km_status warm_corrections(km__frame_plan *p, km__poll *poll) {
   size_t np = p->np;
-  double *sum = malloc(km__plan_frame_scratch(p) * sizeof(double));
+  double *sum = km__malloc(km__plan_frame_scratch(p) * sizeof(double));
   if (!sum) return KM_ENOMEM;
   double c_half[NF] = {0};
   km_status st = km__plan_close_frame(p, 0.5, 0.0, true, true, c_half, sum,
@@ -574,7 +576,7 @@ static km_status warm_corrections(km__frame_plan *p, km__poll *poll) {
       st = KM_OK;
     }
   }
-  free(sum);
+  km__free(sum);
   return st;
 }
 
@@ -597,8 +599,8 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
   double tolp = 0.5 * tol / b.Lmax;
   size_t np = 0;
   km_status st = KM_OK;
-  b.g = malloc(sizeof *b.g);
-  km__frame_plan *p = calloc(1, sizeof *p);
+  b.g = km__malloc(sizeof *b.g);
+  km__frame_plan *p = km__calloc(1, sizeof *p);
   if (!p || !b.g) {
     st = KM_ENOMEM;
     goto done;

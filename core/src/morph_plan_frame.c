@@ -11,10 +11,10 @@
  * plan says so, a turn of the frame's corners.
  */
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
+#include "km/alloc.h"
 #include "morph_plan_internal.h"
 
 /* Gap (over the frame's length) at which the lsq closure stops: a tenth of
@@ -422,7 +422,7 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t,
   /* sums of the pieces, scratch of the nodes, and per corner its turn,
    * its change and the stretch sums; per piece the turn added before it */
   size_t nc = p->ncorners, scratch = km__plan_frame_scratch(p) + 4 * nc + 2;
-  double *sum = malloc((scratch + p->np) * sizeof(double));
+  double *sum = km__malloc((scratch + p->np) * sizeof(double));
   if (!sum) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   const char *msg = "closing the frame did not converge";
   km_curve f;
@@ -447,7 +447,7 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t,
   *out = f;
   km_curve_init(&f);
 done:
-  free(sum);
+  km__free(sum);
   km_curve_free(&f);
   if (st == KM_ECANCELLED) return km__stopped(err);
   if (st) return km__fail(err, st, KM_FIELD_NONE, -1, NAN, msg);

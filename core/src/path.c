@@ -12,10 +12,10 @@
 #include "km/path.h"
 
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
+#include "km/alloc.h"
 #include "km/limits.h"
 
 void km_path_init(km_path *p) {
@@ -25,7 +25,7 @@ void km_path_init(km_path *p) {
 
 void km_path_free(km_path *p) {
   if (!p) return;
-  free(p->pieces);
+  km__free(p->pieces);
   km_path_init(p);
 }
 
@@ -74,7 +74,7 @@ static km_status push(km_path *p, const km_path_piece *pc, km_error *err) {
       return km__fail(err, KM_ELIMIT, KM_FIELD_NONE, -1, NAN,
                       "path has more than %zu pieces",
                       (size_t)KM_MAX_PIECES);
-    km_path_piece *np = realloc(p->pieces, cap * sizeof *np);
+    km_path_piece *np = km__realloc(p->pieces, cap * sizeof *np);
     if (!np) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
     p->pieces = np;
     p->cap = cap;
@@ -406,7 +406,7 @@ km_status km_path_to_curve(const km_path *p, double eps, km_curve *out,
   if (!p->started || p->npieces == 0)
     return km__fail(err, KM_EDEGENERATE, KM_FIELD_CONTROL_POINTS, -1, NAN,
                     "path draws nothing");
-  kept = malloc(p->npieces * sizeof *kept);
+  kept = km__malloc(p->npieces * sizeof *kept);
   if (!kept) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   size_t m = drawn_pieces(p, eps, kept);
   if (m == 0) {
@@ -422,9 +422,9 @@ km_status km_path_to_curve(const km_path *p, double eps, km_curve *out,
   }
   size_t n = m * (size_t)deg + 1;
   size_t nk = n + (size_t)deg + 1;
-  knots = malloc(nk * sizeof *knots);
-  cp = malloc(2 * n * sizeof *cp);
-  if (rational) w = malloc(n * sizeof *w);
+  knots = km__malloc(nk * sizeof *knots);
+  cp = km__malloc(2 * n * sizeof *cp);
+  if (rational) w = km__malloc(n * sizeof *w);
   if (!knots || !cp || (rational && !w)) {
     st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
     goto cleanup;
@@ -432,9 +432,9 @@ km_status km_path_to_curve(const km_path *p, double eps, km_curve *out,
   pieces_to_bspline(kept, m, deg, knots, cp, w);
   st = km_curve_create(out, deg, n, knots, cp, w, p->closed, err);
 cleanup:
-  free(kept);
-  free(knots);
-  free(cp);
-  free(w);
+  km__free(kept);
+  km__free(knots);
+  km__free(cp);
+  km__free(w);
   return st;
 }

@@ -8,24 +8,24 @@
  * bounds the values.
  */
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
 #include "kernels.h"
+#include "km/alloc.h"
 #include "km/limits.h"
 
 void km__pp_init(km_pp *p) { memset(p, 0, sizeof *p); }
 
 void km__pp_free(km_pp *p) {
   if (!p) return;
-  free(p->x);
+  km__free(p->x);
   memset(p, 0, sizeof *p);
 }
 
 km_status km__pp_alloc(km_pp *p, int degree, size_t m) {
   size_t total = (m + 1) + m * (size_t)(degree + 1);
-  double *block = malloc(total * sizeof(double));
+  double *block = km__malloc(total * sizeof(double));
   if (!block) return KM_ENOMEM;
   p->degree = degree;
   p->m = m;
@@ -319,9 +319,9 @@ static bool merge_try(const km_pp *p, const merge_fit *mf, size_t i0,
 km_status km__pp_merge(const km_pp *p, int degree, double delta, km_pp *out) {
   int d = degree > p->degree ? degree : p->degree;
   size_t m = p->m, dp = (size_t)p->degree;
-  merge_fit *mf = malloc(sizeof *mf);
-  double *x = malloc((m + 1) * sizeof(double));
-  double *c = malloc(m * (size_t)(d + 1) * sizeof(double));
+  merge_fit *mf = km__malloc(sizeof *mf);
+  double *x = km__malloc((m + 1) * sizeof(double));
+  double *c = km__malloc(m * (size_t)(d + 1) * sizeof(double));
   km_status st = mf && x && c ? KM_OK : KM_ENOMEM;
   if (!st && !merge_fit_make(mf, d)) st = KM_ENOCONVERGE;
   size_t np = 0, i = 0;
@@ -368,9 +368,9 @@ km_status km__pp_merge(const km_pp *p, int degree, double delta, km_pp *out) {
     i = good;
   }
   if (st) {
-    free(mf);
-    free(x);
-    free(c);
+    km__free(mf);
+    km__free(x);
+    km__free(c);
     return st;
   }
   x[np] = p->x[m];
@@ -381,9 +381,9 @@ km_status km__pp_merge(const km_pp *p, int degree, double delta, km_pp *out) {
     memcpy(r.c, c, np * (size_t)(d + 1) * sizeof(double));
     *out = r;
   }
-  free(mf);
-  free(x);
-  free(c);
+  km__free(mf);
+  km__free(x);
+  km__free(c);
   return st;
 }
 

@@ -20,10 +20,10 @@
  * never below the true error.
  */
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
+#include "km/alloc.h"
 #include "km/limits.h"
 #include "km/reconstruct.h"
 
@@ -51,7 +51,7 @@ km_status km__build_theta(const km_signature *sig, km_pp *kappa, km_pp *theta) {
   if (st) return st;
   double L = sig->length;
   size_t nb = k0.m + 1 + sig->ncorners;
-  double *br = malloc(nb * sizeof(double));
+  double *br = km__malloc(nb * sizeof(double));
   if (!br) {
     km__pp_free(&k0);
     return KM_ENOMEM;
@@ -100,7 +100,7 @@ km_status km__build_theta(const km_signature *sig, km_pp *kappa, km_pp *theta) {
   }
   tp->kappa.x[m - 1] = tp->theta.x[m - 1] = L;
 done:
-  free(br);
+  km__free(br);
   km__pp_free(&k0);
   if (st) {
     theta_pieces_free(tp);
@@ -194,7 +194,7 @@ static km_status plan_push(plan *pl, out_piece op) {
   if (pl->n == pl->cap) {
     size_t cap = pl->cap ? 2 * pl->cap : 64;
     if (cap > KM_MAX_PIECES) return KM_ELIMIT;
-    out_piece *q = realloc(pl->p, cap * sizeof *q);
+    out_piece *q = km__realloc(pl->p, cap * sizeof *q);
     if (!q) return KM_ENOMEM;
     pl->p = q;
     pl->cap = cap;
@@ -536,8 +536,8 @@ km_status km__reconstruct(const km_signature *sig, int degree, double tol,
   st = plan_pieces(&pl, &tp, degree, tol, sig, err);
   if (st) goto cleanup;
   size_t np = pl.n;
-  pos = malloc((np + 1) * 2 * sizeof(double));
-  cont = malloc((np + 1) * sizeof(int));
+  pos = km__malloc((np + 1) * 2 * sizeof(double));
+  cont = km__malloc((np + 1) * sizeof(int));
   if (!pos || !cont) {
     st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
     goto cleanup;
@@ -585,9 +585,9 @@ km_status km__reconstruct(const km_signature *sig, int degree, double tol,
   if (error_bound) *error_bound = bound;
 cleanup:
   km_curve_free(&c);
-  free(cont);
-  free(pos);
-  free(pl.p);
+  km__free(cont);
+  km__free(pos);
+  km__free(pl.p);
   theta_pieces_free(&tp);
   return st;
 }

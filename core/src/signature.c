@@ -4,10 +4,10 @@
  * signature_theta.c.
  */
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
+#include "km/alloc.h"
 #include "km/limits.h"
 #include "km/signature.h"
 
@@ -20,7 +20,7 @@ void km_signature_init(km_signature *sig) {
 void km_signature_free(km_signature *sig) {
   if (!sig) return;
   km_fn_free(&sig->kappa);
-  free(sig->corners);
+  km__free(sig->corners);
   km_signature_init(sig);
 }
 
@@ -124,7 +124,7 @@ km_status km_signature_create(km_signature *out, double length,
     if (r.kappa.knots[i] > length || i >= r.kappa.n) r.kappa.knots[i] = length;
   }
   if (ncorners) {
-    r.corners = malloc(ncorners * sizeof *r.corners);
+    r.corners = km__malloc(ncorners * sizeof *r.corners);
     if (!r.corners) {
       st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
       goto cleanup;

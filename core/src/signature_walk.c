@@ -29,10 +29,10 @@
  */
 #include <float.h>
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
+#include "km/alloc.h"
 #include "km/limits.h"
 #include "km/signature.h"
 #include "signature_builder.h"
@@ -47,10 +47,11 @@ km_status km__sig_push_piece(km__sig_builder *b, double s0, double s1,
       return km__fail(b->err, KM_ELIMIT, KM_FIELD_NONE, -1, NAN,
                       "signature would need more than %d pieces",
                       KM_MAX_PIECES);
-    double *s = realloc(b->s, (cap + 1) * sizeof(double));
+    double *s = km__realloc(b->s, (cap + 1) * sizeof(double));
     if (!s) return km__fail(b->err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
     b->s = s;
-    double *th = realloc(b->th, cap * (KM__THETA_DEGREE + 1) * sizeof(double));
+    double *th =
+        km__realloc(b->th, cap * (KM__THETA_DEGREE + 1) * sizeof(double));
     if (!th) return km__fail(b->err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
     b->th = th;
     b->cap = cap;
@@ -77,7 +78,7 @@ static km_status push_corner(km__sig_builder *b, double s, double turn, double t
   }
   if (b->ncorners == b->ccap) {
     size_t cap = b->ccap ? 2 * b->ccap : 16;
-    km_corner *c = realloc(b->corners, cap * sizeof *c);
+    km_corner *c = km__realloc(b->corners, cap * sizeof *c);
     if (!c) return km__fail(b->err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
     b->corners = c;
     b->ccap = cap;
@@ -533,14 +534,14 @@ km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
   memset(&w, 0, sizeof w);
   w.c = c;
   km_status st = KM_OK;
-  w.span_len = malloc(c->n * sizeof(double));
+  w.span_len = km__malloc(c->n * sizeof(double));
   if (!w.span_len) {
     st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
     goto cleanup;
   }
   /* the spans in Bezier form, made once for both passes (a few hundred
    * bytes each: kept for curves of up to SPAN_CACHE control points) */
-  w.spans = c->n <= SPAN_CACHE ? malloc(c->n * sizeof *w.spans) : NULL;
+  w.spans = c->n <= SPAN_CACHE ? km__malloc(c->n * sizeof *w.spans) : NULL;
   st = estimate_lengths(&b, &w);
   if (st) goto cleanup;
   st = set_tolerance(&b, &w, tol, rel_tol);
@@ -559,10 +560,10 @@ km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
   if (st) goto cleanup;
   st = make_signature(&b, &w, out);
 cleanup:
-  free(w.span_len);
-  free(w.spans);
-  free(b.s);
-  free(b.th);
-  free(b.corners);
+  km__free(w.span_len);
+  km__free(w.spans);
+  km__free(b.s);
+  km__free(b.th);
+  km__free(b.corners);
   return st;
 }

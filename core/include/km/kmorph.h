@@ -34,8 +34,8 @@
  * nothing is leaked on failure. Objects a call returns are the caller's,
  * freed by their km_x_free (which accepts NULL and empty objects); an
  * out-parameter of object type is taken as empty: whatever it held is not
- * freed, so pass an init'ed or freed object. Memory comes from malloc and
- * goes back to free.
+ * freed, so pass an init'ed or freed object. Memory comes from the hook of
+ * km/alloc.h (libc's malloc and free unless the program replaces it).
  *
  * VALIDITY. Fallible functions check what they are given and return a
  * status; the ones that return a value (a length, a count, a point) or
