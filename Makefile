@@ -138,7 +138,39 @@ $(BUILD)/tests/api/%: tests/api/%.c $(SUPPORT_SRC) $(LIBAPI) $(LIBCORE) | check-
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) $(API_INC) -Itests/support $< $(SUPPORT_SRC) -o $@ $(LIBAPI) $(LIBCORE) -lcmocka $(CJSON_LIBS) -lm $(LDFLAGS)
 
+# The out-of-memory tests (tests/core/test_oom.c, tests/api/test_api_oom.c)
+# define the allocation hook themselves, so they link libraries built with
+# KM_ALLOC_HOOKED, where it is called out of line (km/alloc.h); the normal
+# build inlines it to libc.
+HOOK_CORE_OBJ := $(CORE_SRC:%.c=$(BUILD)/hooked/%.o)
+HOOK_API_OBJ  := $(API_SRC:%.c=$(BUILD)/hooked/%.o)
+HOOK_LIBCORE  := $(BUILD)/hooked/libkmorph.a
+HOOK_LIBAPI   := $(BUILD)/hooked/libkmapi.a
+
+$(BUILD)/hooked/core/%.o: core/%.c | check-deps
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) -DKM_ALLOC_HOOKED $(CORE_INC) -MMD -MP -c $< -o $@
+
+$(BUILD)/hooked/api/%.o: api/%.c | check-deps
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) -DKM_ALLOC_HOOKED $(API_INC) -MMD -MP -c $< -o $@
+
+$(HOOK_LIBCORE): $(HOOK_CORE_OBJ)
+	rm -f $@ && ar rcs $@ $^
+
+$(HOOK_LIBAPI): $(HOOK_API_OBJ)
+	rm -f $@ && ar rcs $@ $^
+
+$(BUILD)/tests/core/test_oom: tests/core/test_oom.c $(SUPPORT_SRC) $(HOOK_LIBCORE) | check-deps
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) -DKM_ALLOC_HOOKED $(CORE_INC) -Itests/support $(CJSON_CFLAGS) $< $(SUPPORT_SRC) -o $@ $(HOOK_LIBCORE) -lcmocka $(CJSON_LIBS) -lm $(LDFLAGS)
+
+$(BUILD)/tests/api/test_api_oom: tests/api/test_api_oom.c $(SUPPORT_SRC) $(HOOK_LIBAPI) $(HOOK_LIBCORE) | check-deps
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) -DKM_ALLOC_HOOKED $(API_INC) -Itests/support $< $(SUPPORT_SRC) -o $@ $(HOOK_LIBAPI) $(HOOK_LIBCORE) -lcmocka $(CJSON_LIBS) -lm $(LDFLAGS)
+
 -include $(CORE_OBJ:.o=.d) $(API_OBJ:.o=.d) $(SRV_OBJ:.o=.d)
+-include $(HOOK_CORE_OBJ:.o=.d) $(HOOK_API_OBJ:.o=.d)
 
 # core/ must build with libm alone and must not include anything above it.
 check-layers:
@@ -148,6 +180,10 @@ check-layers:
 	  echo "api headers leak core or transport"; exit 1; fi
 	@if grep -rnE '#include *[<"](km/|cJSON)' server/; then \
 	  echo "server/ reaches past the api layer"; exit 1; fi
+	@if grep -nE '(^|[^A-Za-z0-9_])(malloc|calloc|realloc|free|strdup|strndup)\(' \
+	    $(filter-out core/src/alloc.c,$(CORE_SRC)) $(API_SRC) core/src/*.h api/src/*.h | \
+	    grep -vE '^[^:]*:[0-9]+: *(/\*|\*)'; then \
+	  echo "core/ and api/ allocate through km/alloc.h only"; exit 1; fi
 	@echo "layers: ok"
 
 test-unit: $(UNIT_BIN) $(APIT_BIN) $(CLI)

@@ -4,10 +4,30 @@
  */
 #include <stdarg.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
+#include "km/alloc.h"
+
+/* ------------------------------------------------------------ allocation */
+
+#if defined(KM_ALLOC_HOOKED)
+#include <pthread.h>
+
+/* cJSON keeps its allocator in one process-wide table (cJSON_InitHooks):
+ * pointed at the km/alloc.h hook, the request and response trees fail and
+ * are counted like every other allocation of the api. The table is
+ * written once, before the first tree, under pthread_once, so threads that
+ * enter the api together never race on it. */
+static pthread_once_t cjson_hooks_once = PTHREAD_ONCE_INIT;
+
+static void install_cjson_hooks(void) {
+  cJSON_Hooks hooks = {km__malloc, km__free};
+  cJSON_InitHooks(&hooks);
+}
+
+void api__init(void) { pthread_once(&cjson_hooks_once, install_cjson_hooks); }
+#endif
 
 void api_config_default(api_config *cfg) {
   cfg->max_body_bytes = 8u * 1024u * 1024u;
@@ -29,7 +49,7 @@ void api_response_init(api_response *r) {
 void api_response_free(api_response *r) {
   if (r == NULL)
     return;
-  free(r->body);
+  km__free(r->body);
   api_response_init(r);
 }
 
@@ -89,7 +109,7 @@ static void problem_fallback(api_response *out, api_status status) {
   out->body = NULL;
   out->length = 0;
   if (n > 0 && (size_t)n < sizeof buf) {
-    out->body = malloc((size_t)n + 1);
+    out->body = km__malloc((size_t)n + 1);
     if (out->body != NULL) {
       memcpy(out->body, buf, (size_t)n + 1);
       out->length = (size_t)n;
@@ -100,8 +120,11 @@ static void problem_fallback(api_response *out, api_status status) {
 void api_problem(api_response *out, api_status status, const char *type,
                  const char *title, const char *detail, const char *pointer,
                  const char *message, const char *request_id) {
-  cJSON *root = cJSON_CreateObject();
-  bool ok = root != NULL;
+  cJSON *root;
+  bool ok;
+  api__init();
+  root = cJSON_CreateObject();
+  ok = root != NULL;
   if (type == NULL)
     type = default_type(status);
   if (title == NULL)
@@ -238,6 +261,7 @@ api_status api_handle(const api_config *cfg, const api_request *req,
                       api_response *out) {
   api_config defaults;
   api_ctx ctx;
+  api__init();
   if (cfg == NULL) {
     api_config_default(&defaults);
     cfg = &defaults;

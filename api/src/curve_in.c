@@ -4,10 +4,10 @@
  * the core.
  */
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
+#include "km/alloc.h"
 #include "svg.h"
 
 void api__input_init(api_input *in) {
@@ -116,9 +116,9 @@ static bool parse_bspline(api_ctx *ctx, const cJSON *v, const char *ptr,
   }
   ok = true;
 done:
-  free(cp);
-  free(knots);
-  free(w);
+  km__free(cp);
+  km__free(knots);
+  km__free(w);
   return ok;
 }
 
@@ -158,7 +158,7 @@ static bool parse_points(api_ctx *ctx, const cJSON *v, const char *ptr,
   }
   ok = true;
 done:
-  free(pts);
+  km__free(pts);
   return ok;
 }
 

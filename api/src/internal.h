@@ -47,6 +47,16 @@
 #define API_P_INTERNAL "/problems/internal"
 #define API_P_STOPPED "/problems/stopped"
 
+/* Make cJSON allocate through the km/alloc.h hook; once per process, safe
+ * from any thread. Every entry point that builds a cJSON tree calls it
+ * first (api.c). A normal build's hook is libc's heap, cJSON's own
+ * default, so there is nothing to install. */
+#if defined(KM_ALLOC_HOOKED)
+void api__init(void);
+#else
+static inline void api__init(void) {}
+#endif
+
 /* The request being handled and the first error found in it. */
 typedef struct api_ctx {
   const api_config *cfg;

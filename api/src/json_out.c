@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "internal.h"
+#include "km/alloc.h"
 #include "svg.h"
 
 cJSON *api__number(double v) {
@@ -135,7 +136,7 @@ cJSON *api__curve_json(api_ctx *ctx, const km_curve *c, bool svg_d,
       goto fail;
     }
     cJSON *s = cJSON_CreateString(d);
-    free(d);
+    km__free(d);
     if (s == NULL) {
       api__oom(ctx);
       goto fail;

@@ -11,10 +11,10 @@
  */
 #include <math.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
+#include "km/alloc.h"
 
 const char *api__type_name(const cJSON *v) {
   if (v == NULL)
@@ -210,13 +210,13 @@ bool api__num_array(api_ctx *ctx, const cJSON *v, const char *ptr,
   api_elems it;
   if (!check_count(ctx, v, ptr, max, &count))
     return false;
-  a = malloc(count * sizeof *a);
+  a = km__malloc(count * sizeof *a);
   if (a == NULL)
     return api__oom(ctx);
   api__elems_start(&it, v);
   for (size_t i = 0; i < count; i++, api__elems_next(&it)) {
     if (!api__elems_num(ctx, &it, ptr, &a[i])) {
-      free(a);
+      km__free(a);
       return false;
     }
   }
@@ -244,13 +244,13 @@ bool api__point_array(api_ctx *ctx, const cJSON *v, const char *ptr,
   api_elems it;
   if (!check_count(ctx, v, ptr, max, &count))
     return false;
-  a = malloc(2 * count * sizeof *a);
+  a = km__malloc(2 * count * sizeof *a);
   if (a == NULL)
     return api__oom(ctx);
   api__elems_start(&it, v);
   for (size_t i = 0; i < count; i++, api__elems_next(&it)) {
     if (!api__elems_point(ctx, &it, ptr, &a[2 * i])) {
-      free(a);
+      km__free(a);
       return false;
     }
   }

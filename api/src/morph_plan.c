@@ -7,9 +7,9 @@
  * the input it belongs to ("/from" or "/to").
  */
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
+#include "km/alloc.h"
 #include "morph_plan.h"
 
 void api_morph_plan_free(api_morph_plan *plan) {
@@ -20,12 +20,12 @@ void api_morph_plan_free(api_morph_plan *plan) {
     km_curve_free(&plan->frames[i].curve);
     km_signature_free(&plan->frames[i].sig);
   }
-  free(plan->frames);
-  free(plan->matches);
-  free(plan->request_id);
+  km__free(plan->frames);
+  km__free(plan->matches);
+  km__free(plan->request_id);
   api__input_free(&plan->from);
   api__input_free(&plan->to);
-  free(plan);
+  km__free(plan);
 }
 
 /* ------------------------------------------------------ preparing a plan */
@@ -34,7 +34,7 @@ void api_morph_plan_free(api_morph_plan *plan) {
  * *out, written even on failure (out of memory) so the caller frees it. */
 static bool plan_new(api_ctx *ctx, const api_config *cfg,
                      const char *request_id, api_morph_plan **out) {
-  api_morph_plan *pl = calloc(1, sizeof *pl);
+  api_morph_plan *pl = km__calloc(1, sizeof *pl);
   *out = pl;
   if (pl == NULL)
     return api__oom(ctx);
@@ -43,7 +43,7 @@ static bool plan_new(api_ctx *ctx, const api_config *cfg,
   api__input_init(&pl->to);
   if (request_id != NULL) {
     size_t n = strlen(request_id);
-    if ((pl->request_id = malloc(n + 1)) == NULL)
+    if ((pl->request_id = km__malloc(n + 1)) == NULL)
       return api__oom(ctx);
     memcpy(pl->request_id, request_id, n + 1);
   }
@@ -126,6 +126,7 @@ api_status api_morph_prepare(const api_config *cfg, const api_request *req,
   km_stop stop_buf;
   const km_stop *stop = api__km_stop(req, &stop_buf);
 
+  api__init();
   if (cfg == NULL) {
     api_config_default(&defaults);
     cfg = &defaults;

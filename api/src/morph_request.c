@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "km/alloc.h"
 #include "morph_plan.h"
 
 /* Frames when neither "frames" nor "times" is given. */
@@ -202,7 +203,7 @@ static bool parse_matches(api_ctx *ctx, const cJSON *root,
     return api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded", "/matches",
                       "has %zu pairs; the limit is %zu", n,
                       pl->cfg.max_control_points);
-  pl->matches = malloc(2 * n * sizeof *pl->matches);
+  pl->matches = km__malloc(2 * n * sizeof *pl->matches);
   if (pl->matches == NULL)
     return api__oom(ctx);
   api__elems_start(&it, v);
@@ -243,19 +244,19 @@ static bool parse_times(api_ctx *ctx, const cJSON *root, size_t max_frames,
       return false;
     for (size_t i = 0; i < n; i++) {
       if (!(t[i] >= 0 && t[i] <= 1)) {
-        free(t);
+        km__free(t);
         api__ptr_idx(p, "/times", i);
         return api__invalid(ctx, p, "must be between 0 and 1");
       }
     }
-    pl->frames = calloc(n, sizeof *pl->frames);
+    pl->frames = km__calloc(n, sizeof *pl->frames);
     if (pl->frames == NULL) {
-      free(t);
+      km__free(t);
       return api__oom(ctx);
     }
     for (size_t i = 0; i < n; i++)
       pl->frames[i].t = t[i];
-    free(t);
+    km__free(t);
     pl->times_given = true;
   } else {
     long frames = DEFAULT_FRAMES;
@@ -270,7 +271,7 @@ static bool parse_times(api_ctx *ctx, const cJSON *root, size_t max_frames,
                         "%ld frames asked for; the limit is %zu", frames,
                         max_frames);
     n = (size_t)frames;
-    pl->frames = calloc(n, sizeof *pl->frames);
+    pl->frames = km__calloc(n, sizeof *pl->frames);
     if (pl->frames == NULL)
       return api__oom(ctx);
     for (size_t i = 0; i < n; i++)

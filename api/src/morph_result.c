@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "km/alloc.h"
 #include "morph_plan.h"
 
 /* Number of cubic pieces in an SVG path written as "M x y C ..." with the
@@ -61,7 +62,7 @@ static cJSON *animate_json(api_ctx *ctx, const api_morph_plan *pl) {
       return NULL;
     }
     pieces = count_pieces(d) > pieces ? count_pieces(d) : pieces;
-    free(d);
+    km__free(d);
   }
   a = cJSON_CreateArray();
   if (a == NULL) {
@@ -71,7 +72,7 @@ static cJSON *animate_json(api_ctx *ctx, const api_morph_plan *pl) {
   for (size_t i = 0; i < pl->nframes; i++) {
     char *d = api_svg_path_d_fixed(&pl->frames[i].curve, pieces);
     cJSON *s = d != NULL ? cJSON_CreateString(d) : NULL;
-    free(d);
+    km__free(d);
     if (s == NULL) {
       cJSON_Delete(a);
       api__oom(ctx);
@@ -110,7 +111,7 @@ fail:
  * none. */
 static cJSON *matches_used_json(api_ctx *ctx, const km_morph *morph) {
   size_t npairs = km_morph_matches_used(morph, NULL, 0);
-  double *pairs = malloc((npairs > 0 ? 2 * npairs : 1) * sizeof *pairs);
+  double *pairs = km__malloc((npairs > 0 ? 2 * npairs : 1) * sizeof *pairs);
   cJSON *mu = NULL;
   if (pairs == NULL) {
     api__oom(ctx);
@@ -121,7 +122,7 @@ static cJSON *matches_used_json(api_ctx *ctx, const km_morph *morph) {
     mu = api__num_array_json(ctx, pairs, npairs, 2);
   else if ((mu = cJSON_CreateArray()) == NULL)
     api__oom(ctx);
-  free(pairs);
+  km__free(pairs);
   return mu;
 }
 
@@ -158,7 +159,7 @@ fail:
 
 static api_status result_svg(api_ctx *ctx, api_morph_plan *pl,
                              api_response *out) {
-  api_svg_frame *fr = malloc(pl->nframes * sizeof *fr);
+  api_svg_frame *fr = km__malloc(pl->nframes * sizeof *fr);
   char *doc = NULL;
   if (fr != NULL) {
     for (size_t i = 0; i < pl->nframes; i++) {
@@ -167,7 +168,7 @@ static api_status result_svg(api_ctx *ctx, api_morph_plan *pl,
       fr[i].sig = pl->want_sig ? &pl->frames[i].sig : NULL;
     }
     doc = api_svg_morph_document(fr, pl->nframes, &pl->svgopt);
-    free(fr);
+    km__free(fr);
   }
   if (doc == NULL) {
     api__oom(ctx);

@@ -2,13 +2,13 @@
  * signature out, optionally with evenly spaced samples of kappa(s).
  */
 #include <math.h>
-#include <stdlib.h>
 
 #include "internal.h"
+#include "km/alloc.h"
 
 /* n samples [s, kappa(s)] at s = i L / (n - 1). */
 static cJSON *samples_json(api_ctx *ctx, const km_signature *sig, size_t n) {
-  double *v = malloc(2 * n * sizeof *v);
+  double *v = km__malloc(2 * n * sizeof *v);
   cJSON *a;
   if (v == NULL) {
     api__oom(ctx);
@@ -22,7 +22,7 @@ static cJSON *samples_json(api_ctx *ctx, const km_signature *sig, size_t n) {
     v[2 * i + 1] = km_fn_value(&sig->kappa, s);
   }
   a = api__num_array_json(ctx, v, n, 2);
-  free(v);
+  km__free(v);
   return a;
 }
 

@@ -2,9 +2,8 @@
  * curvature function kappa(s), corners and closure) checked member by
  * member, each failure named by its JSON pointer, then built by the core.
  */
-#include <stdlib.h>
-
 #include "internal.h"
+#include "km/alloc.h"
 
 /* "start": {"point": [x, y], "angle": a}, each optional; absent members
  * leave start and *angle as they are. */
@@ -83,7 +82,7 @@ static bool read_corners(api_ctx *ctx, const cJSON *v, const char *ptr,
     return api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded", p,
                       "has %zu elements; the limit is %zu", n,
                       ctx->cfg->max_control_points);
-  if ((*corners = malloc((n > 0 ? n : 1) * sizeof **corners)) == NULL)
+  if ((*corners = km__malloc((n > 0 ? n : 1) * sizeof **corners)) == NULL)
     return api__oom(ctx);
   *ncorners = n;
   /* a packed element (a number or an array) is no object: item NULL */
@@ -158,8 +157,8 @@ bool api__parse_signature(api_ctx *ctx, const cJSON *v, const char *ptr,
   ok = true;
 done:
   km_fn_free(&kappa);
-  free(kt.knots);
-  free(kt.coef);
-  free(corners);
+  km__free(kt.knots);
+  km__free(kt.coef);
+  km__free(corners);
   return ok;
 }

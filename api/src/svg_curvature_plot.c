@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "km/alloc.h"
 #include "km/fn.h"
 #include "km/signature.h"
 #include "svg_doc.h"
@@ -37,8 +38,8 @@ static bool sample_kappa(series *se, size_t budget) {
   if (per < 2) per = 2;
   size_t cap = spans * (per + 1) + 2;
   if (spans > 4000) cap = 4002;
-  se->x = malloc(cap * sizeof *se->x);
-  se->y = malloc(cap * sizeof *se->y);
+  se->x = km__malloc(cap * sizeof *se->x);
+  se->y = km__malloc(cap * sizeof *se->y);
   if (!se->x || !se->y) return false;
   size_t m = 0;
   if (spans > 4000) {
@@ -95,7 +96,7 @@ static double py(const plot *p, double v) {
  * frame brought none (or left out when that fails); *total counts them.
  * NULL when out of memory; a sampling that fails sets c->b.failed. */
 static series *plot_series(api_svg_doc *c, size_t *total) {
-  series *se = calloc(c->n ? c->n : 1, sizeof *se);
+  series *se = km__calloc(c->n ? c->n : 1, sizeof *se);
   if (!se) return NULL;
   /* Samples per frame: smooth curves for a few frames, a bounded document
    * for many. */
@@ -120,11 +121,11 @@ static series *plot_series(api_svg_doc *c, size_t *total) {
 
 static void series_free(series *se, size_t n) {
   for (size_t i = 0; i < n; i++) {
-    free(se[i].x);
-    free(se[i].y);
+    km__free(se[i].x);
+    km__free(se[i].y);
     if (se[i].has_own) km_signature_free(&se[i].own);
   }
-  free(se);
+  km__free(se);
 }
 
 /* The range shown: all of kappa and zero, unless a few samples near a
@@ -133,7 +134,7 @@ static void series_free(series *se, size_t n) {
  * to whole tick steps. */
 static void plot_range(api_svg_doc *c, plot *p, size_t total) {
   double lo = 0, hi = 0;
-  double *all = malloc((total ? total : 1) * sizeof *all);
+  double *all = km__malloc((total ? total : 1) * sizeof *all);
   if (!all) c->b.failed = true;
   if (all && total) {
     size_t m = 0;
@@ -154,7 +155,7 @@ static void plot_range(api_svg_doc *c, plot *p, size_t total) {
       }
     }
   }
-  free(all);
+  km__free(all);
   if (!(hi > lo)) {
     hi = lo + 1;
   }

@@ -16,10 +16,10 @@
  */
 #include <math.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
+#include "km/alloc.h"
 #include "svg_doc.h"
 
 #define DEF_FROM "#2166ac"
@@ -166,7 +166,7 @@ void api__svg_draw_curve(api_svg_doc *c, const km_curve *cv, double ox,
                           "stroke-linecap=\"round\" d=\"");
   api__svg_buf_put(&c->b, d);
   api__svg_buf_put(&c->b, "\"/>\n");
-  free(d);
+  km__free(d);
 }
 
 /* Union box of all frames, padded, never empty or flat. */

@@ -5,8 +5,8 @@
  */
 #include <math.h>
 #include <stdio.h>
-#include <stdlib.h>
 
+#include "km/alloc.h"
 #include "svg_doc.h"
 
 void api__svg_filmstrip(api_svg_doc *c, const api_svg_options *o) {
@@ -123,7 +123,7 @@ static char **animate_paths(api_svg_doc *c, size_t np, size_t *drawn) {
       if (!c->f[i].curve->closed) all_closed = false;
     }
   if (*drawn == 0) return NULL;
-  ds = calloc(c->n, sizeof *ds);
+  ds = km__calloc(c->n, sizeof *ds);
   if (!ds) {
     c->b.failed = true;
     return NULL;
@@ -258,6 +258,6 @@ void api__svg_animate(api_svg_doc *c, const api_svg_options *o) {
     animate_values(c, ds, drawn, first);
     animate_label(c, w, h, tfirst, tlast);
   }
-  for (size_t i = 0; i < c->n; i++) free(ds[i]);
-  free(ds);
+  for (size_t i = 0; i < c->n; i++) km__free(ds[i]);
+  km__free(ds);
 }

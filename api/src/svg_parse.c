@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "km/alloc.h"
 #include "km/path.h"
 #include "svg.h"
 
@@ -107,12 +108,12 @@ static km_status parse_number(parser *ps, const char *what, double *out) {
   }
   size_t n = i - start;
   char small[64];
-  char *buf = n < sizeof small ? small : malloc(n + 1);
+  char *buf = n < sizeof small ? small : km__malloc(n + 1);
   if (!buf) return fail(ps, start, KM_ENOMEM, "out of memory");
   memcpy(buf, s + start, n);
   buf[n] = '\0';
   double v = strtod(buf, NULL);
-  if (buf != small) free(buf);
+  if (buf != small) km__free(buf);
   if (!isfinite(v))
     return fail(ps, start, KM_ERANGE, "%s is too large for a double",
                 what);

@@ -22,6 +22,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "km/alloc.h"
 #include "km/limits.h"
 #include "svg.h"
 
@@ -30,7 +31,7 @@
 void api__svg_buf_init(api_svg_buf *b) { memset(b, 0, sizeof *b); }
 
 void api__svg_buf_free(api_svg_buf *b) {
-  free(b->s);
+  km__free(b->s);
   api__svg_buf_init(b);
 }
 
@@ -45,7 +46,7 @@ static bool reserve(api_svg_buf *b, size_t extra) {
     }
     cap *= 2;
   }
-  char *s = realloc(b->s, cap);
+  char *s = km__realloc(b->s, cap);
   if (!s) {
     b->failed = true;
     return false;
@@ -212,7 +213,7 @@ static bool extract_spans(const km_curve *c, spans *out) {
   size_t n = c->n;
   const double *U = c->knots;
   size_t maxb = n; /* at most n - p spans; n is a safe bound */
-  double(*q)[3] = malloc(maxb * (size_t)(p + 1) * sizeof *q);
+  double(*q)[3] = km__malloc(maxb * (size_t)(p + 1) * sizeof *q);
   if (!q) return false;
   double alphas[KM_MAX_DEGREE + 1];
   size_t m = n + (size_t)p; /* last knot index */
@@ -437,7 +438,7 @@ char *api_svg_path_d(const km_curve *c, double tol, double *err_bound) {
     }
   }
   if (c->closed) api__svg_buf_put(&w.buf, " Z");
-  free(sp.q);
+  km__free(sp.q);
   char *out = api__svg_buf_take(&w.buf);
   if (out && err_bound)
     *err_bound = w.approx + sqrt(2.0) * w.print_err + rounding;
@@ -491,11 +492,11 @@ static bool uniform_params(const km_curve *c, size_t n, double *t) {
   size_t ns = 0;
   for (size_t i = (size_t)c->degree; i < c->n; i++)
     if (c->knots[i + 1] > c->knots[i]) ns++;
-  double *cum = malloc((ns + 1) * sizeof *cum);
-  double *ka = malloc((ns + 1) * sizeof *ka);
+  double *cum = km__malloc((ns + 1) * sizeof *cum);
+  double *ka = km__malloc((ns + 1) * sizeof *ka);
   if (!cum || !ka) {
-    free(cum);
-    free(ka);
+    km__free(cum);
+    km__free(ka);
     return false;
   }
   double ext = extent(c);
@@ -536,8 +537,8 @@ static bool uniform_params(const km_curve *c, size_t n, double *t) {
     }
     t[j] = x;
   }
-  free(cum);
-  free(ka);
+  km__free(cum);
+  km__free(ka);
   return true;
 }
 
@@ -545,9 +546,9 @@ char *api_svg_path_d_fixed_z(const km_curve *c, size_t n_pieces,
                              bool with_z) {
   if (!c || c->n == 0 || !c->cp || !c->knots) return NULL;
   if (n_pieces < 1) n_pieces = 1;
-  double *ts = malloc((n_pieces + 1) * sizeof *ts);
+  double *ts = km__malloc((n_pieces + 1) * sizeof *ts);
   if (!ts || !uniform_params(c, n_pieces, ts)) {
-    free(ts);
+    km__free(ts);
     return NULL;
   }
   double ext = extent(c);
@@ -574,7 +575,7 @@ char *api_svg_path_d_fixed_z(const km_curve *c, size_t n_pieces,
     }
     put_cubic(&w, (const double(*)[2])cub);
   }
-  free(ts);
+  km__free(ts);
   if (with_z) api__svg_buf_put(&w.buf, " Z");
   return api__svg_buf_take(&w.buf);
 }
