@@ -283,6 +283,7 @@ km_status km_curve_transform(km_curve *out, const km_curve *c, double rot,
   km_status st = check_curve(c, err);
   if (st) return st;
   km_curve r;
+  km_curve_init(&r); /* a failed copy writes nothing, and r is freed */
   st = km_curve_copy(&r, c, err);
   if (!st) st = km__curve_transform_in_place(&r, rot, tx, ty, err);
   if (st) {
