@@ -210,7 +210,8 @@ static km_status orient_inputs(km_morph *m, double *cand, size_t *ncand,
                     "turns %ld times, to turns %ld times",
                     ta, tb);
   if (opt->nmatches > 0) return KM_OK;
-  *ncand = km__best_shifts(a, b, cand);
+  if (km__best_shifts(a, b, cand, ncand))
+    return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   if (!(cand[0] > 0)) return KM_OK;
   return km__input_rotate_start(b, cand[0] * b->sig.length, m->poll, err);
 }
@@ -460,7 +461,11 @@ static km_status exact_metrics(const km_morph *m, const km_signature *sig,
   metrics->bending_energy = km_signature_bending_energy(sig);
   metrics->self_intersections = km__self_intersections(placed, m->tol, poll);
   metrics->closure_gap = m->closed ? gap : 0.0;
-  return poll && poll->stopped ? km__stopped(err) : KM_OK;
+  if (poll && poll->stopped) return km__stopped(err);
+  /* -1 for a valid curve that was not stopped: no memory */
+  if (metrics->self_intersections < 0)
+    return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  return KM_OK;
 }
 
 /* sig moved by the frame's placement (rotation rot about the origin, then
@@ -502,7 +507,10 @@ static km_status frame_impl(const km_morph *m, double t, km__poll *poll,
     km__close_polygon(&f, how);
   else if (m->closed && !f.closed && how == KM_CLOSURE_LSQ)
     km__close_polygon(&f, KM_CLOSURE_C0); /* residual below rounding */
-  km__place_frame(m, t, &f, sig.length, &rot, T);
+  if (km__place_frame(m, t, &f, sig.length, &rot, T)) {
+    st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+    goto done;
+  }
   st = km_curve_transform(&placed, &f, rot, T[0], T[1], err);
   if (st) goto done;
   placed.closed = f.closed;

@@ -458,22 +458,20 @@ static size_t deepest_minima(const double *cost, double *cand) {
  * (tb' continued by the total turning past the end), expands into sums of
  * squares, prefix sums and the cyclic correlations sum_j ta_j tb_(j+k) and
  * sum_j pa_j . pb_(j+k), which the FFT gives for all k at once. */
-size_t km__best_shifts(const km__input *a, const km__input *b, double *cand) {
+km_status km__best_shifts(const km__input *a, const km__input *b,
+                          double *cand, size_t *n) {
   enum { N = ALIGN_N };
   double *buf = km__malloc(14 * (size_t)N * sizeof(double));
-  if (!buf) {
-    cand[0] = 0.0;
-    return 1;
-  }
+  if (!buf) return KM_ENOMEM;
   shift_work w = {buf,          buf + N,      buf + 2 * N,  buf + 3 * N,
                   buf + 4 * N,  buf + 5 * N,  buf + 6 * N,  buf + 7 * N,
                   buf + 8 * N,  buf + 9 * N,  buf + 10 * N, buf + 11 * N,
                   buf + 12 * N, buf + 13 * N, {0, 0, 0, 0, 0, 0}};
   shift_samples(a, b, &w);
   shift_costs(&w, b->sig.turning);
-  size_t n = deepest_minima(w.cost, cand);
+  *n = deepest_minima(w.cost, cand);
   km__free(buf);
-  return n;
+  return KM_OK;
 }
 
 /* An input's copy, signature and tables; a signature computed from its

@@ -94,9 +94,10 @@ void km__input_point_at(const km__input *in, double r, double out[2]);
 /* Tangent angle at arc length s (clamped to the piece at either end). */
 double km__input_theta_at(const km__input *in, double s);
 /* Fills cand[] with up to KM__SHIFT_CANDIDATES starts of b (fractions of
- * its length), best aligned with a first, and returns how many (at least
- * one: without memory the given start, 0). */
-size_t km__best_shifts(const km__input *a, const km__input *b, double *cand);
+ * its length), best aligned with a first, and *n (out) with how many (at
+ * least one). KM_OK or KM_ENOMEM (then nothing written). */
+km_status km__best_shifts(const km__input *a, const km__input *b,
+                          double *cand, size_t *n);
 
 /* Pieces of p restricted to [x0, x1] (x0 < x1, inside p's breaks) into
  * *out (initialised, empty; the caller frees it). KM_ENOMEM, no message. */

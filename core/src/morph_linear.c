@@ -18,8 +18,8 @@ static double curve_kappa(const km_curve *c, double t, double *speed) {
 
 /* Metrics of a curve measured directly (linear frames may have cusps, so
  * no signature is assumed): dense Gauss-Legendre per span. */
-static void curve_metrics(const km_curve *c, double tol, km__poll *poll,
-                          km_frame_metrics *mt) {
+static km_status curve_metrics(const km_curve *c, double tol,
+                               km__poll *poll, km_frame_metrics *mt) {
   double L = 0.0, kmax = 0.0, bend = 0.0;
   for (size_t i = (size_t)c->degree; i < c->n; i++) {
     double a = c->knots[i], b = c->knots[i + 1];
@@ -44,6 +44,9 @@ static void curve_metrics(const km_curve *c, double tol, km__poll *poll,
   mt->bending_energy = bend;
   mt->self_intersections = km__self_intersections(c, tol, poll);
   mt->closure_gap = 0.0;
+  /* -1 for a valid curve: stopped (the caller reports it) or no memory */
+  return mt->self_intersections < 0 && !(poll && poll->stopped) ? KM_ENOMEM
+                                                                 : KM_OK;
 }
 
 km_status km__linear_frame(const km_morph *m, double t, km_curve *out,
@@ -57,17 +60,24 @@ km_status km__linear_frame(const km_morph *m, double t, km_curve *out,
   if (f.w)
     for (size_t i = 0; i < f.n; i++) f.w[i] = (1 - t) * a->w[i] + t * b->w[i];
   f.closed = a->closed && b->closed;
-  if (metrics) curve_metrics(&f, m->tol, poll, metrics);
-  if (sig_out) {
+  st = metrics ? curve_metrics(&f, m->tol, poll, metrics) : KM_OK;
+  if (!st && sig_out) {
     km_signature_init(sig_out);
-    /* a linear frame may be singular (cusp): then no signature */
-    if (km__signature_compute(&f, m->tol, 1e-5, poll, sig_out, NULL) != KM_OK)
-      km_signature_init(sig_out);
+    /* a linear frame may be singular (cusp): then no signature, but out of
+     * memory is no answer about the frame */
+    st = km__signature_compute(&f, m->tol, 1e-5, poll, sig_out, NULL);
+    if (st != KM_OK) km_signature_init(sig_out);
+    if (st != KM_ENOMEM) st = KM_OK;
   }
   if (poll && poll->stopped) {
     km_curve_free(&f);
     km_signature_free(sig_out);
     return km__stopped(err);
+  }
+  if (st) {
+    km_curve_free(&f);
+    km_signature_free(sig_out);
+    return km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
   }
   *out = f;
   return KM_OK;

@@ -70,18 +70,19 @@ static void procrustes(const double (*F)[2], const double (*Q)[2],
  * places a frame given by samples F at frame arc lengths s[j] (weights w,
  * arc length the samples stand for): "fit" maps them in the least-squares
  * sense onto the linear blend Q of the inputs at corresponding points. */
-static void place_samples(const km_morph *m, double t, const double (*F)[2],
-                          const double *s, const double *w, size_t n,
-                          double *rot, double T[2]) {
+static km_status place_samples(const km_morph *m, double t,
+                               const double (*F)[2], const double *s,
+                               const double *w, size_t n, double *rot,
+                               double T[2]) {
   const km__input *a = &m->in[0], *b = &m->in[1];
   *rot = 0.0;
   T[0] = (1 - t) * a->sig.start[0] + t * b->sig.start[0];
   T[1] = (1 - t) * a->sig.start[1] + t * b->sig.start[1];
   if (t == 0.0 || t == 1.0 || m->opt.anchor == KM_ANCHOR_START || n == 0)
-    return;
+    return KM_OK;
   double fc[2] = {0, 0}, qc[2] = {0, 0}, W = 0.0;
   double (*Q)[2] = km__malloc(n * sizeof *Q);
-  if (!Q) return;
+  if (!Q) return KM_ENOMEM;
   for (size_t j = 0; j < n; j++) {
     double ra, rb, pa[2], pb[2];
     km__corresponding(m, t, s[j], &ra, &rb);
@@ -108,18 +109,20 @@ static void place_samples(const km_morph *m, double t, const double (*F)[2],
     procrustes(F, (const double (*)[2])Q, w, n, fc, qc, rot, T);
   }
   km__free(Q);
+  return KM_OK;
 }
 
 /* Placement of a frame curve whose parameter is arc length: samples at the
  * midpoints of FIT_N equal parts. */
-void km__place_frame(const km_morph *m, double t, const km_curve *f,
-                     double Lt, double *rot, double T[2]) {
+km_status km__place_frame(const km_morph *m, double t, const km_curve *f,
+                          double Lt, double *rot, double T[2]) {
   static const size_t N = FIT_N;
   double (*F)[2] = km__malloc(N * sizeof *F);
   double *s = km__malloc(2 * N * sizeof(double));
   double *w = s ? s + N : NULL;
-  size_t n = F && s ? N : 0; /* without memory: by the start */
-  for (size_t j = 0; j < n; j++) {
+  km_status st = KM_ENOMEM;
+  if (!F || !s) goto done;
+  for (size_t j = 0; j < N; j++) {
     double d[1][2];
     s[j] = Lt * ((double)j + 0.5) / (double)N;
     w[j] = 1.0;
@@ -127,9 +130,11 @@ void km__place_frame(const km_morph *m, double t, const km_curve *f,
     F[j][0] = d[0][0];
     F[j][1] = d[0][1];
   }
-  place_samples(m, t, (const double (*)[2])F, s, w, n, rot, T);
+  st = place_samples(m, t, (const double (*)[2])F, s, w, N, rot, T);
+done:
   km__free(F);
   km__free(s);
+  return st;
 }
 
 /* place_samples for a planned frame given by its points F at the plan's

@@ -14,9 +14,9 @@
 km_status km__place_plan_targets(km_morph *m, km_error *err);
 /* Rigid motion (rotation about the origin by *rot, then translation T)
  * that places frame t, a curve f parametrised by arc length over [0, Lt].
- * Never fails: without memory the frame is placed by its start. */
-void km__place_frame(const km_morph *m, double t, const km_curve *f,
-                     double Lt, double *rot, double T[2]);
+ * KM_OK or KM_ENOMEM (*rot and T then unspecified). */
+km_status km__place_frame(const km_morph *m, double t, const km_curve *f,
+                          double Lt, double *rot, double T[2]);
 /* The same for a planned frame given by its points F at the plan's nb
  * breaks (after km__place_plan_targets). */
 void km__place_planned(const km_morph *m, double t, const double (*F)[2],

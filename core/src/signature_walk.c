@@ -542,6 +542,12 @@ km_status km__signature_compute(const km_curve *c, double tol, double rel_tol,
   /* the spans in Bezier form, made once for both passes (a few hundred
    * bytes each: kept for curves of up to SPAN_CACHE control points) */
   w.spans = c->n <= SPAN_CACHE ? km__malloc(c->n * sizeof *w.spans) : NULL;
+  if (c->n <= SPAN_CACHE && !w.spans) {
+    /* out of memory is reported, not worked around: a caller short of
+     * memory is better told at once than slowed down */
+    st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+    goto cleanup;
+  }
   st = estimate_lengths(&b, &w);
   if (st) goto cleanup;
   st = set_tolerance(&b, &w, tol, rel_tol);

@@ -99,7 +99,8 @@ typedef struct km_frame_metrics {
   double bending_energy;    /* integral of kappa^2 ds */
   long self_intersections;  /* proper self-crossings of the returned curve
                                (km_curve_self_intersections at the morph's
-                               tolerance); -1 if memory ran out */
+                               tolerance); out of memory fails the frame
+                               with KM_ENOMEM */
   double closure_gap;       /* |C(L) - C(0)| before closure; 0 if open */
 } km_frame_metrics;
 
