@@ -239,11 +239,14 @@ double km__pp_max_abs(const km_pp *p) {
   return m;
 }
 
+/* Piece by piece on the stack: a maximum cannot report out of memory, so
+ * it must not need any (it was a looser bound then, a different answer). */
 double km_fn_max_abs(const km_fn *f) {
-  km_pp pp;
-  if (km__pp_from_fn(&pp, f)) return km_fn_abs_bound(f, -INFINITY, INFINITY);
-  double m = km__pp_max_abs(&pp);
-  km__pp_free(&pp);
+  km__fn_pieces it;
+  double x[2], c[KM_MAX_FN_DEGREE + 1], m = 0.0;
+  km__fn_pieces_start(&it, f);
+  while (km__fn_pieces_next(&it, x, c))
+    m = fmax(m, bern_max_abs(c, f->degree, m, 0));
   return m;
 }
 
@@ -253,32 +256,44 @@ static double binom(int n, int k) {
   return r;
 }
 
-double km__pp_integral_sq(const km_pp *p) {
-  int d = p->degree;
-  /* product of two degree-d Bernstein polynomials: coefficient k of degree
-   * 2d is sum over a of C(d,a) C(d,k-a) / C(2d,k) f_a g_(k-a); the integral
-   * over the piece is h times their mean */
-  double w[FN_MAX_DEGREE + 2][FN_MAX_DEGREE + 2];
+/* Product of two degree-d Bernstein polynomials: coefficient k of degree
+ * 2d is sum over a of C(d,a) C(d,k-a) / C(2d,k) f_a g_(k-a); the integral
+ * over a piece of width h is h times their mean. These are the weights. */
+static void sq_weights(int d, double w[FN_MAX_DEGREE + 2][FN_MAX_DEGREE + 2]) {
   for (int a = 0; a <= d; a++)
     for (int b = 0; b <= d; b++)
       w[a][b] = binom(d, a) * binom(d, b) / binom(2 * d, a + b);
+}
+
+static double piece_sq(double w[FN_MAX_DEGREE + 2][FN_MAX_DEGREE + 2],
+                       const double *c, int d, double h) {
+  double s = 0.0;
+  for (int a = 0; a <= d; a++)
+    for (int b = 0; b <= d; b++) s += w[a][b] * c[a] * c[b];
+  return h * s / (2 * d + 1);
+}
+
+double km__pp_integral_sq(const km_pp *p) {
+  int d = p->degree;
+  double w[FN_MAX_DEGREE + 2][FN_MAX_DEGREE + 2];
+  sq_weights(d, w);
   double total = 0.0;
-  for (size_t i = 0; i < p->m; i++) {
-    const double *c = p->c + i * (size_t)(d + 1);
-    double h = p->x[i + 1] - p->x[i], s = 0.0;
-    for (int a = 0; a <= d; a++)
-      for (int b = 0; b <= d; b++) s += w[a][b] * c[a] * c[b];
-    total += h * s / (2 * d + 1);
-  }
+  for (size_t i = 0; i < p->m; i++)
+    total += piece_sq(w, p->c + i * (size_t)(d + 1), d, p->x[i + 1] - p->x[i]);
   return total;
 }
 
+/* Piece by piece on the stack, like km_fn_max_abs: no memory to run out
+ * of (it answered NaN then). */
 double km_fn_integral_sq(const km_fn *f) {
-  km_pp pp;
-  if (km__pp_from_fn(&pp, f)) return NAN;
-  double v = km__pp_integral_sq(&pp);
-  km__pp_free(&pp);
-  return v;
+  km__fn_pieces it;
+  double w[FN_MAX_DEGREE + 2][FN_MAX_DEGREE + 2];
+  double x[2], c[KM_MAX_FN_DEGREE + 1], total = 0.0;
+  sq_weights(f->degree, w);
+  km__fn_pieces_start(&it, f);
+  while (km__fn_pieces_next(&it, x, c))
+    total += piece_sq(w, c, f->degree, x[1] - x[0]);
+  return total;
 }
 
 /* Coefficients of the piece of p covering [r0, r1] (normalised r over p's

@@ -494,27 +494,23 @@ void km__close_polygon(km_curve *c, km_closure how) {
  * the pieces' Bernstein coefficients). */
 static void interval_max(const km_fn *kappa, double L, double *out) {
   for (int iv = 0; iv < NB; iv++) out[iv] = 0.0;
-  km_pp p;
-  km__pp_init(&p);
-  if (km__pp_from_fn(&p, kappa)) {
-    double k = km_fn_max_abs(kappa); /* no memory: one bound for all */
-    for (int iv = 0; iv < NB; iv++) out[iv] = k;
-    return;
-  }
+  /* piece by piece on the stack: there is no status for out of memory */
+  km__fn_pieces it;
+  double x[2], c[KM_MAX_FN_DEGREE + 1];
   double h = L / NB;
-  int d = p.degree;
-  for (size_t i = 0; i < p.m; i++) {
-    double a = p.x[i], b = p.x[i + 1], w = b - a;
+  int d = kappa->degree;
+  km__fn_pieces_start(&it, kappa);
+  while (km__fn_pieces_next(&it, x, c)) {
+    double a = x[0], b = x[1], w = b - a;
     if (!(w > 0)) continue;
     int iv0 = (int)floor(a / h), iv1 = (int)floor(b / h);
     for (int iv = iv0 < 0 ? 0 : iv0; iv <= iv1 && iv < NB; iv++) {
       double lo = fmax(a, iv * h), hi = fmin(b, (iv + 1) * h), r[KM_MAX_FN_DEGREE + 2];
       if (!(hi > lo)) continue;
-      km__bern_restrict(p.c + i * (size_t)(d + 1), d, (lo - a) / w, (hi - a) / w, r);
+      km__bern_restrict(c, d, (lo - a) / w, (hi - a) / w, r);
       out[iv] = fmax(out[iv], km__bern_abs_bound(r, d));
     }
   }
-  km__pp_free(&p);
 }
 
 /* The lsq closure of a blended frame, kept within the inputs' largest

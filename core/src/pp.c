@@ -232,6 +232,41 @@ km_status km__pp_from_fn(km_pp *out, const km_fn *f) {
   return KM_OK;
 }
 
+void km__fn_pieces_start(km__fn_pieces *it, const km_fn *f) {
+  it->f = f;
+  it->bezier = is_piecewise_bezier(f);
+  it->i = it->bezier ? 0 : (size_t)f->degree;
+}
+
+bool km__fn_pieces_next(km__fn_pieces *it, double x[2], double *c) {
+  const km_fn *f = it->f;
+  int p = f->degree;
+  size_t w = (size_t)(p + 1);
+  double u[KM_MAX_FN_DEGREE + 2];
+  if (it->bezier) {
+    if (it->i >= f->n / w) return false;
+    x[0] = f->knots[it->i * w];
+    x[1] = f->knots[(it->i + 1) * w];
+    memcpy(c, f->coef + it->i * w, w * sizeof(double));
+    it->i++;
+    return true;
+  }
+  for (; it->i < f->n; it->i++) {
+    size_t i = it->i;
+    double a = f->knots[i], b = f->knots[i + 1];
+    if (!(b > a)) continue;
+    x[0] = a;
+    x[1] = b;
+    for (int j = 0; j <= p; j++) {
+      for (int q = 0; q < p; q++) u[q] = q < p - j ? a : b;
+      c[j] = p == 0 ? f->coef[i] : blossom(f, i, u);
+    }
+    it->i++;
+    return true;
+  }
+  return false;
+}
+
 km_status km__pp_to_fn(km_fn *out, const km_pp *p) {
   int d = p->degree;
   size_t n = p->m * (size_t)(d + 1);

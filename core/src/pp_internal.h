@@ -4,6 +4,7 @@
 #ifndef KM_PP_INTERNAL_H
 #define KM_PP_INTERNAL_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "km/fn.h"
@@ -24,6 +25,19 @@ void km__pp_free(km_pp *p);
 km_status km__pp_alloc(km_pp *p, int degree, size_t m);
 /* B-spline function -> pieces (exact, by knot insertion). */
 km_status km__pp_from_fn(km_pp *out, const km_fn *f);
+/* The pieces km__pp_from_fn makes, one at a time and in its order, on the
+ * caller's stack: for the value functions (a maximum, an interval bound)
+ * that have no status to report out of memory with. Start with
+ * km__fn_pieces_start, then each km__fn_pieces_next writes the next
+ * piece's interval [x[0], x[1]] and its degree + 1 Bernstein coefficients
+ * c, or returns false when there is none left. */
+typedef struct km__fn_pieces {
+  const km_fn *f;
+  bool bezier; /* f is piecewise Bezier already: its pieces are its coef */
+  size_t i;    /* the next piece (Bezier) or knot span (otherwise) */
+} km__fn_pieces;
+void km__fn_pieces_start(km__fn_pieces *it, const km_fn *f);
+bool km__fn_pieces_next(km__fn_pieces *it, double x[2], double *c);
 /* Pieces -> B-spline function (breaks of multiplicity degree+1). */
 km_status km__pp_to_fn(km_fn *out, const km_pp *p);
 /* C(d, j) for d <= KM_MAX_FN_DEGREE + 1 (pp.c). */
