@@ -7,7 +7,7 @@
 # memory closes the run.
 #
 # Usage: tests/hardening/run.sh [slow] [cli] [barrage] [asan] [load]
-#        [faults] [sigterm]     (default: all)
+#        [faults] [sigterm] [hostile]     (default: all)
 # Needs build/kmorph, build/kmorphd and build/asan/kmorphd (make
 # test-hardening builds them). HARDENING_LONG=1 lengthens load and faults.
 set -u
@@ -17,7 +17,7 @@ export KM_RESULTS=$results
 mkdir -p build
 PY=/usr/bin/python3
 [ -x "$PY" ] || PY=python3
-parts=${*:-slow cli barrage asan load faults sigterm}
+parts=${*:-slow cli barrage asan load faults sigterm hostile}
 summary=build/hardening-summary.txt
 : >"$summary"
 status=0
@@ -101,6 +101,7 @@ for p in $parts; do
         --daemon build/asan/kmorphd --asan --name barrage-asan
       timed "server tests, ASan daemon" asan_contract ;;
     load | faults | sigterm) timed "$p" "$PY" tests/hardening/load.py "$p" ;;
+    hostile) timed "hostile mix" "$PY" tests/hardening/hostile_check.py ;;
     *) echo "unknown part $p"; status=1 ;;
   esac
 done
