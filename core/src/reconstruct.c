@@ -530,9 +530,10 @@ km_status km__reconstruct(const km_signature *sig, int degree, double tol,
   if (st) return km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
   pl.limit = KM_MAX_OUTPUT_PIECES + 2 * tp.theta.m;
   if (pl.limit > KM_MAX_PIECES) pl.limit = KM_MAX_PIECES;
-  /* a piece adds at most `degree` control points (a corner on each side) */
-  if (max_points > 0 && max_points / (size_t)degree < pl.limit)
-    pl.limit = max_points / (size_t)degree;
+  /* a piece adds `degree` control points to the one the curve starts
+   * with, so n pieces take n * degree + 1 */
+  if (max_points > 0 && (max_points - 1) / (size_t)degree < pl.limit)
+    pl.limit = (max_points - 1) / (size_t)degree;
   st = plan_pieces(&pl, &tp, degree, tol, sig, err);
   if (st) goto cleanup;
   size_t np = pl.n;

@@ -591,6 +591,42 @@ static void reconstruction_holds_to_a_number_of_points(void **state) {
   km_signature_free(&sig);
 }
 
+/* A polyline of three unit edges turning 1 rad at each inner corner is
+ * three straight pieces, 3 * 3 + 1 = 10 control points at degree 3 (a
+ * Hermite piece adds three points to the one it starts from): a limit of
+ * 10 holds it, one of 9 must refuse it rather than answer 10 points. */
+static void polyline_is_held_to_a_limit_of_exactly_its_points(void **state) {
+  (void)state;
+  km_error err;
+  km_signature sig;
+  km_fn kappa;
+  km_fn_init(&kappa);
+  assert_status(km_fn_constant(&kappa, 0.0, 3.0, 0.0, &err), KM_OK);
+  const double start[2] = {0, 0};
+  const km_corner corners[2] = {{1.0, 1.0}, {2.0, 1.0}};
+  assert_status(km_signature_create(&sig, 3.0, start, 0.0, &kappa, corners,
+                                    2, false, &err),
+                KM_OK);
+  km_curve r;
+  km_curve_init(&r);
+  assert_status(km_reconstruct_within(&sig, 3, 1e-6, 0, &r, NULL, &err),
+                KM_OK);
+  size_t needed = r.n;
+  km_curve_free(&r);
+  assert_int_equal(needed, 10);
+  assert_status(
+      km_reconstruct_within(&sig, 3, 1e-6, needed, &r, NULL, &err), KM_OK);
+  assert_true(r.n <= needed);
+  km_curve_free(&r);
+  km_status st = km_reconstruct_within(&sig, 3, 1e-6, needed - 1, &r, NULL,
+                                       &err);
+  assert_status(st, KM_ELIMIT);
+  assert_int_equal(err.field, KM_FIELD_TOLERANCE);
+  km_curve_free(&r);
+  km_fn_free(&kappa);
+  km_signature_free(&sig);
+}
+
 static const struct CMUnitTest tests[] = {
     cmocka_unit_test(unit_circle_is_reconstructed_within_each_tolerance),
     cmocka_unit_test(cornu_spirals_are_reconstructed_within_tolerance),
@@ -604,6 +640,7 @@ static const struct CMUnitTest tests[] = {
     cmocka_unit_test(reconstruct_rejects_other_degrees),
     cmocka_unit_test(reconstruction_that_turns_without_end_is_refused),
     cmocka_unit_test(reconstruction_holds_to_a_number_of_points),
+    cmocka_unit_test(polyline_is_held_to_a_limit_of_exactly_its_points),
     cmocka_unit_test(corner_one_ulp_before_a_curvature_break_keeps_its_turn),
 };
 
