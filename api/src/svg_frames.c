@@ -61,22 +61,34 @@ void api__svg_filmstrip(api_svg_doc *c, const api_svg_options *o) {
   }
 }
 
-void api__svg_overlay(api_svg_doc *c, const api_svg_options *o) {
-  api_svg_bbox bb = api__svg_frames_bbox(c);
-  double aspect = (bb.y1 - bb.y0) / (bb.x1 - bb.x0);
-  const double legend = 24.0;
-  double w = o->width > 0 ? o->width : 480.0;
+/* One panel holding every frame's box, with a band of `band` pixels below
+ * it: the document sized (the asked size, else default_width wide and as
+ * tall as the frames' aspect wants, within 1:4 and 4:1) and opened, and
+ * the scale and offset that fit the frames into the panel. */
+static double open_panel(api_svg_doc *c, const api_svg_options *o,
+                         double default_width, double band, const char *kind,
+                         api_svg_bbox *bb, double *ox, double *oy) {
+  *bb = api__svg_frames_bbox(c);
+  double aspect = (bb->y1 - bb->y0) / (bb->x1 - bb->x0);
+  double w = o->width > 0 ? o->width : default_width;
   double h = o->height > 0
                  ? o->height
-                 : ceil(w * fmin(fmax(aspect, 0.25), 4) + legend);
+                 : ceil(w * fmin(fmax(aspect, 0.25), 4) + band);
   c->W = w;
   c->H = h;
   char title[80];
-  snprintf(title, sizeof title, "kmorph overlay of %zu frames", c->n);
+  snprintf(title, sizeof title, "kmorph %s of %zu frames", kind, c->n);
   api__svg_doc_open(c, title);
-  double ox = 6, oy = 6;
-  double s =
-      api__svg_fit(&bb, fmax(w - 12, 1), fmax(h - legend - 12, 1), &ox, &oy);
+  *ox = 6;
+  *oy = 6;
+  return api__svg_fit(bb, fmax(w - 12, 1), fmax(h - band - 12, 1), ox, oy);
+}
+
+void api__svg_overlay(api_svg_doc *c, const api_svg_options *o) {
+  api_svg_bbox bb;
+  double ox, oy;
+  double s = open_panel(c, o, 480.0, 24.0, "overlay", &bb, &ox, &oy);
+  double w = c->W, h = c->H;
   for (size_t i = 0; i < c->n; i++) {
     char col[8];
     api__svg_frame_colour(c, i, col);
@@ -230,21 +242,10 @@ static void animate_label(api_svg_doc *c, double w, double h, double tfirst,
 }
 
 void api__svg_animate(api_svg_doc *c, const api_svg_options *o) {
-  api_svg_bbox bb = api__svg_frames_bbox(c);
-  double aspect = (bb.y1 - bb.y0) / (bb.x1 - bb.x0);
-  const double label = 20.0;
-  double w = o->width > 0 ? o->width : 400.0;
-  double h = o->height > 0
-                 ? o->height
-                 : ceil(w * fmin(fmax(aspect, 0.25), 4) + label);
-  c->W = w;
-  c->H = h;
-  char title[80];
-  snprintf(title, sizeof title, "kmorph animation of %zu frames", c->n);
-  api__svg_doc_open(c, title);
-  double ox = 6, oy = 6;
-  double s =
-      api__svg_fit(&bb, fmax(w - 12, 1), fmax(h - label - 12, 1), &ox, &oy);
+  api_svg_bbox bb;
+  double ox, oy;
+  double s = open_panel(c, o, 400.0, 20.0, "animation", &bb, &ox, &oy);
+  double w = c->W, h = c->H;
   size_t drawn = 0;
   char **ds = animate_paths(c, animate_pieces(c), &drawn);
   if (!ds) return;
