@@ -287,6 +287,9 @@ bool api__parse_include(api_ctx *ctx, const cJSON *root, bool allow_animate,
  * no-convergence error (the core produced something it cannot stand
  * behind) and returns false; allocation failures record 503. ---- */
 bool api__add_num(api_ctx *ctx, cJSON *obj, const char *key, double v);
+/* item as obj's member key; takes ownership of item (deleted, and 503
+ * recorded, when the member cannot be added). */
+bool api__add_item(api_ctx *ctx, cJSON *obj, const char *key, cJSON *item);
 /* A finite number as a cJSON item that prints exactly (round-trips). */
 cJSON *api__number(double v);
 cJSON *api__num_array_json(api_ctx *ctx, const double *v, size_t n,

@@ -55,14 +55,21 @@ static bool nonfinite(api_ctx *ctx, const char *what) {
                     what);
 }
 
+bool api__add_item(api_ctx *ctx, cJSON *obj, const char *key, cJSON *item) {
+  /* cJSON copies the key, and when that copy fails the item stays ours */
+  if (cJSON_AddItemToObject(obj, key, item))
+    return true;
+  cJSON_Delete(item);
+  return api__oom(ctx);
+}
+
 bool api__add_num(api_ctx *ctx, cJSON *obj, const char *key, double v) {
   if (!isfinite(v))
     return nonfinite(ctx, key);
   cJSON *n = api__number(v);
   if (n == NULL)
     return api__oom(ctx);
-  cJSON_AddItemToObject(obj, key, n);
-  return true;
+  return api__add_item(ctx, obj, key, n);
 }
 
 /* n values (stride 1) or n points (stride 2) as a JSON array. */
@@ -103,8 +110,7 @@ static bool add_array(api_ctx *ctx, cJSON *obj, const char *key,
   cJSON *a = api__num_array_json(ctx, v, n, stride);
   if (a == NULL)
     return false;
-  cJSON_AddItemToObject(obj, key, a);
-  return true;
+  return api__add_item(ctx, obj, key, a);
 }
 
 cJSON *api__curve_json(api_ctx *ctx, const km_curve *c, bool svg_d,
@@ -141,7 +147,8 @@ cJSON *api__curve_json(api_ctx *ctx, const km_curve *c, bool svg_d,
       api__oom(ctx);
       goto fail;
     }
-    cJSON_AddItemToObject(o, "svg_d", s);
+    if (!api__add_item(ctx, o, "svg_d", s))
+      goto fail;
   }
   return o;
 fail:
@@ -173,7 +180,8 @@ cJSON *api__signature_json(api_ctx *ctx, const km_signature *sig) {
       api__oom(ctx);
       goto fail;
     }
-    cJSON_AddItemToObject(start, "point", pt);
+    if (!api__add_item(ctx, start, "point", pt))
+      goto fail;
   }
   if (!api__add_num(ctx, start, "angle", sig->angle))
     goto fail;

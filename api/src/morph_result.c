@@ -95,11 +95,12 @@ static cJSON *frame_json(api_ctx *ctx, const api_morph_plan *pl,
     goto fail;
   if ((c = api__curve_json(ctx, &f->curve, pl->inc.svg_d, pl->tol)) == NULL)
     goto fail;
-  cJSON_AddItemToObject(fo, "curve", c);
+  if (!api__add_item(ctx, fo, "curve", c))
+    goto fail;
   if (pl->metrics) {
-    if ((c = metrics_json(ctx, &f->metrics)) == NULL)
+    if ((c = metrics_json(ctx, &f->metrics)) == NULL ||
+        !api__add_item(ctx, fo, "metrics", c))
       goto fail;
-    cJSON_AddItemToObject(fo, "metrics", c);
   }
   return fo;
 fail:

@@ -69,8 +69,8 @@ static cJSON *answer_json(api_ctx *ctx, const options *o, double length,
   if ((jc = api__curve_json(ctx, curve, o->inc.svg_d,
                             o->tol > 0 ? o->tol : 1e-5 * length)) == NULL)
     goto fail;
-  cJSON_AddItemToObject(res, "curve", jc);
-  if (!api__add_num(ctx, res, "error_bound", bound))
+  if (!api__add_item(ctx, res, "curve", jc) ||
+      !api__add_num(ctx, res, "error_bound", bound))
     goto fail;
   return res;
 fail:

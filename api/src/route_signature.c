@@ -77,13 +77,13 @@ static cJSON *answer_json(api_ctx *ctx, const km_signature *use,
     api__oom(ctx);
     return NULL;
   }
-  if ((js = api__signature_json(ctx, use)) == NULL)
+  if ((js = api__signature_json(ctx, use)) == NULL ||
+      !api__add_item(ctx, res, "signature", js))
     goto fail;
-  cJSON_AddItemToObject(res, "signature", js);
   if (samples > 0) {
-    if ((js = samples_json(ctx, use, samples)) == NULL)
+    if ((js = samples_json(ctx, use, samples)) == NULL ||
+        !api__add_item(ctx, res, "samples", js))
       goto fail;
-    cJSON_AddItemToObject(res, "samples", js);
   }
   return res;
 fail:
