@@ -53,24 +53,30 @@ void km_morph_free(km_morph *m) {
   km__free(m);
 }
 
-/* Whether the lsq closure goes by the frames' corners: so if it can at
- * t = 1/4, 1/2 and 3/4, for every frame of the morph (a sequence must not
- * switch between closures). */
-static bool corners_close(const km_morph *m) {
+/* Whether the lsq closure goes by the frames' corners (*close): so if it
+ * can at t = 1/4, 1/2 and 3/4, for every frame of the morph (a sequence
+ * must not switch between closures). A trial that fails rules the corners
+ * out, except for want of memory: KM_ENOMEM, as the same morph with memory
+ * might close by its corners. */
+static km_status corners_close(const km_morph *m, bool *close) {
+  *close = false;
   for (int k = 1; k <= 3; k++) {
     km_signature blended, closed;
     km_signature_init(&blended);
     km_signature_init(&closed);
     double gap;
     bool used = false;
-    bool ok = km__blend_signature(m, k / 4.0, &blended, NULL) == KM_OK &&
-              km__close_lsq(&blended, true, NULL, &closed, &gap, &used, m->poll,
-                        NULL) == KM_OK;
+    km_status st = km__blend_signature(m, k / 4.0, &blended, NULL);
+    if (!st)
+      st = km__close_lsq(&blended, true, NULL, &closed, &gap, &used, m->poll,
+                         NULL);
     km_signature_free(&blended);
     km_signature_free(&closed);
-    if (!ok || !used) return false;
+    if (st == KM_ENOMEM) return st;
+    if (st || !used) return KM_OK;
   }
-  return true;
+  *close = true;
+  return KM_OK;
 }
 
 /* Frames of the default morph (turning blend, no matches, cubic output)
@@ -84,7 +90,9 @@ static km_status plan_frames(km_morph *m, km_error *err) {
   if (m->opt.method != KM_METHOD_CURVATURE) return KM_OK;
   if (m->opt.blend != KM_BLEND_TURNING || m->nk != 2 || m->opt.degree != 3) {
     bool corners = a->sig.ncorners + b->sig.ncorners > 0;
-    m->close_by_corners = lsq && corners && corners_close(m);
+    m->close_by_corners = false;
+    if (lsq && corners && corners_close(m, &m->close_by_corners))
+      return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
     return KM_OK;
   }
   const km_pp tp[2] = {a->theta, b->theta};

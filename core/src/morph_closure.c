@@ -106,11 +106,12 @@ void km__closure_metric_solve(const double *Lc, double *y) {
   }
 }
 
-bool km__close_by_corners(const double *S, const double *tau, size_t nc,
-                          double *delta) {
-  if (nc < 3) return false;
+km_status km__close_by_corners(const double *S, const double *tau, size_t nc,
+                               double *delta, bool *closes) {
+  *closes = false;
+  if (nc < 3) return KM_OK;
   double *W = km__malloc((4 * nc + 1) * sizeof(double));
-  if (!W) return false;
+  if (!W) return KM_ENOMEM;
   double *D = W + nc, *J = W + 2 * nc + 1; /* J: 2 nc (suffix sums) */
   double wsum = 0.0;
   for (size_t k = 0; k < nc; k++) {
@@ -158,7 +159,8 @@ bool km__close_by_corners(const double *S, const double *tau, size_t nc,
   for (size_t k = 0; ok && k < nc; k++)
     if (fabs(delta[k]) > 0.5 * fabs(tau[k])) ok = false;
   km__free(W);
-  return ok;
+  *closes = ok;
+  return KM_OK;
 }
 
 /* ---- closing a blended signature --------------------------------------- */
@@ -414,15 +416,19 @@ km_status km__close_lsq(const km_signature *sig, bool by_corners,
   qnode *q = NULL;
   size_t nq = 0;
   stretches sc = {NULL, NULL, NULL, 0};
+  bool closed = false, corners_close = false;
   km_status st = km__build_theta(sig, &kp, &tp);
   if (!st) st = closure_nodes(&kp, &tp, L / NB, poll, &q, &nq);
   if (!st) st = stretch_sums(sig, q, nq, &sc, gap0);
+  if (!st) closed = *gap0 <= 1e-12 * L;
+  if (!st && !closed && by_corners)
+    st = km__close_by_corners(sc.S, sc.tau, sc.nc, sc.delta, &corners_close);
   if (st) goto done;
-  if (*gap0 <= 1e-12 * L) {
+  if (closed) {
     /* closed already: either closure would change nothing */
     if (used_corners) *used_corners = by_corners;
     st = km_signature_copy(out, sig, err);
-  } else if (by_corners && km__close_by_corners(sc.S, sc.tau, sc.nc, sc.delta)) {
+  } else if (corners_close) {
     st = turn_corners(sig, sc.delta, out, err);
     if (used_corners) *used_corners = st == KM_OK;
   } else {

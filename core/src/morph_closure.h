@@ -44,12 +44,13 @@ void km__closure_metric_solve(const double *Lc, double *y);
  * G = sum_m e^(i (delta_1 + ... + delta_m)) S_m = 0 with sum delta = 0 (the
  * tangent stays closed). delta is the least such change in sum
  * delta_k^2 / |tau_k| (corners change in proportion to their turn), by
- * Gauss-Newton. Smooth stretches keep their curvature exactly. Returns
- * false (delta unusable) with fewer than three corners, without
- * convergence, or when a corner would change by more than half its
- * turn. */
-bool km__close_by_corners(const double *S, const double *tau, size_t nc,
-                          double *delta);
+ * Gauss-Newton. Smooth stretches keep their curvature exactly. *closes
+ * receives false (delta unusable) with fewer than three corners, without
+ * convergence, or when a corner would change by more than half its turn.
+ * KM_ENOMEM (*closes false) without memory for the iteration: not a
+ * "cannot close", which would silently take the smooth closure. */
+km_status km__close_by_corners(const double *S, const double *tau, size_t nc,
+                               double *delta, bool *closes);
 
 /* Closed curve nearest in curvature (L2, weighted by weights[iv] on the
  * basis interval iv when weights is not NULL) to the closed signature sig,

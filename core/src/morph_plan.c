@@ -532,22 +532,30 @@ static void break_tables(const builder *b, km__frame_plan *p) {
 /* Corners close the frames of this morph if they can at t = 1/4, 1/2 and
  * 3/4; the choice holds for every frame, so that a sequence does not
  * switch between two closures (a frame where it fails takes the smooth
- * one). Without memory for the trial the smooth closure is chosen. */
-static void choose_corner_closure(km__frame_plan *p, km__poll *poll) {
+ * one). Fewer than three corners leave the smooth closure. Without memory
+ * for the trial the morph fails: choosing the smooth closure instead would
+ * answer with other frames than the same request with memory. */
+static km_status choose_corner_closure(km__frame_plan *p, km__poll *poll) {
   size_t nc = p->ncorners, np = p->np;
+  if (nc < 3) return KM_OK;
   double *buf =
-      nc >= 3 ? km__malloc((km__plan_frame_scratch(p) + 4 * nc + 2 + np) *
-                           sizeof(double))
-              : NULL;
-  if (!buf) return;
+      km__malloc((km__plan_frame_scratch(p) + 4 * nc + 2 + np) * sizeof(double));
+  if (!buf) return KM_ENOMEM;
   double *tau = buf + km__plan_frame_scratch(p), *delta = tau + nc, *S = delta + nc;
   double *dp = S + 2 * (nc + 1), c0[NF] = {0};
+  km_status st = KM_OK;
   p->by_corners = true;
-  for (int k = 1; k <= 3 && p->by_corners; k++)
-    p->by_corners = km__plan_close_frame(p, k / 4.0, 0.0, false, false, c0, buf,
-                                         buf + 2 * np, poll) == KM_OK &&
-                    km__plan_corner_closure(p, k / 4.0, buf, tau, delta, S, dp);
+  for (int k = 1; k <= 3 && p->by_corners && !st; k++) {
+    /* a trial frame that does not close smoothly (or is stopped) rules
+     * the corners out; only running out of memory fails the morph */
+    p->by_corners = km__plan_close_frame(p, k / 4.0, 0.0, false, false, c0,
+                                         buf, buf + 2 * np, poll) == KM_OK;
+    if (p->by_corners)
+      st = km__plan_corner_closure(p, k / 4.0, buf, tau, delta, S, dp,
+                                   &p->by_corners);
+  }
   km__free(buf);
+  return st;
 }
 
 /* The corrections frames start from, at t = k / WARM_POINTS: the
@@ -621,8 +629,8 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const
   break_tables(&b, p);
   /* corners or the kept corrections (zero where corners close the
    * frames: one they cannot close takes steps from zero) */
-  if (closed) choose_corner_closure(p, poll);
-  if (closed && !p->by_corners) st = warm_corrections(p, poll);
+  if (closed) st = choose_corner_closure(p, poll);
+  if (!st && closed && !p->by_corners) st = warm_corrections(p, poll);
   if (!st && poll && poll->stopped) st = KM_ECANCELLED;
   if (!st) {
     *out = p;

@@ -272,11 +272,11 @@ km_status km__plan_close_frame(const km__frame_plan *p, double t, double theta0,
 }
 
 /* Closes a frame by its corners (km__close_by_corners) given the pieces'
- * integrals sum (rotated in place on success); dp[k] receives the turn
- * added before piece k. Scratch: tau, delta (nc each), S (2 (nc + 1)). */
-bool km__plan_corner_closure(const km__frame_plan *p, double t, double *sum,
-                           double *tau, double *delta, double *S,
-                           double *dp) {
+ * integrals sum (rotated in place when they close it); dp[k] receives the
+ * turn added before piece k. Scratch: tau, delta (nc each), S (2 (nc + 1)). */
+km_status km__plan_corner_closure(const km__frame_plan *p, double t,
+                                  double *sum, double *tau, double *delta,
+                                  double *S, double *dp, bool *closes) {
   size_t np = p->np, nc = p->ncorners, m = 0;
   S[0] = S[1] = 0.0;
   for (size_t k = 0; k < np; k++) {
@@ -289,7 +289,8 @@ bool km__plan_corner_closure(const km__frame_plan *p, double t, double *sum,
     S[2 * m] += sum[2 * k];
     S[2 * m + 1] += sum[2 * k + 1];
   }
-  if (!km__close_by_corners(S, tau, nc, delta)) return false;
+  km_status st = km__close_by_corners(S, tau, nc, delta, closes);
+  if (st || !*closes) return st;
   double d = 0.0;
   m = 0;
   for (size_t k = 0; k < np; k++) {
@@ -299,7 +300,7 @@ bool km__plan_corner_closure(const km__frame_plan *p, double t, double *sum,
     sum[2 * k] = cs * x - sn * y;
     sum[2 * k + 1] = sn * x + cs * y;
   }
-  return true;
+  return KM_OK;
 }
 
 /* The closure correction a frame at t starts from: the polynomial through
@@ -332,7 +333,8 @@ static km_status frame_closure(const km__frame_plan *p, double t,
   for (size_t k = 0; k < np; k++) dp[k] = 0.0;
   if (lsq && p->by_corners) {
     st = km__plan_close_frame(p, t, theta0, false, false, c, sum, e, poll);
-    by_corners = !st && km__plan_corner_closure(p, t, sum, tau, delta, S, dp);
+    if (!st)
+      st = km__plan_corner_closure(p, t, sum, tau, delta, S, dp, &by_corners);
   }
   if (st || by_corners) return st;
   /* the smooth curvature takes the correction, by steps from the

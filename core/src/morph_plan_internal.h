@@ -62,11 +62,12 @@ km_status km__plan_close_frame(const km__frame_plan *p, double t,
                                double *c, double *sum, double *scratch,
                                km__poll *poll);
 /* Closes a frame by its corners (km__close_by_corners) given the pieces'
- * integrals sum (rotated in place on success); dp[k] receives the turn
- * added before piece k. Scratch: tau, delta (ncorners each), S (2
- * (ncorners + 1)). False where the corners cannot close it. */
-bool km__plan_corner_closure(const km__frame_plan *p, double t, double *sum,
-                             double *tau, double *delta, double *S,
-                             double *dp);
+ * integrals sum (rotated in place when they close it); dp[k] receives the
+ * turn added before piece k. Scratch: tau, delta (ncorners each), S (2
+ * (ncorners + 1)). *closes false where the corners cannot close it;
+ * KM_ENOMEM (*closes false) without memory. */
+km_status km__plan_corner_closure(const km__frame_plan *p, double t,
+                                  double *sum, double *tau, double *delta,
+                                  double *S, double *dp, bool *closes);
 
 #endif
