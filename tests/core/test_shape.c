@@ -232,12 +232,175 @@ static void copy_is_deep(void **state) {
   free_curves(c, 2);
 }
 
+
+/* ---- pairing ------------------------------------------------------------ */
+
+static void make_shape(km_shape *s, km_curve *c, size_t n) {
+  km_shape_init(s);
+  assert_status(km_shape_create(s, c, n, KM_FILL_EVENODD, NULL, NULL), KM_OK);
+}
+
+static void get_pairs(const km_shape *a, const km_shape *b,
+                      km_shape_pair **p, size_t *n) {
+  km_error err;
+  assert_status(km_shape_pair_auto(a, b, NULL, NULL, p, n, &err), KM_OK);
+}
+
+/* the partner in b of contour i of a; -1 vanishing, -2 in no pair */
+static long partner_of(const km_shape_pair *p, size_t n, long i) {
+  for (size_t k = 0; k < n; k++)
+    if (p[k].from == i) return p[k].to;
+  return -2;
+}
+
+static void ring_pairs_outer_with_outer_and_hole_with_hole(void **state) {
+  (void)state;
+  /* given: a ring, and a wider ring listed hole first, each circle of the
+   * second drawn from another start point (rotated about its centre) */
+  km_curve a[2], b[2], tmp;
+  circle(&a[0], 0, 0, 2, 1);
+  circle(&a[1], 0, 0, 1, 0);
+  circle(&tmp, 5, 1, 1.5, 1);
+  km_curve_init(&b[0]);
+  assert_status(km_curve_transform(&b[0], &tmp, 2.0, 5 - 5 * cos(2.0) + sin(2.0),
+                                   1 - 5 * sin(2.0) - cos(2.0), NULL), KM_OK);
+  km_curve_free(&tmp);
+  circle(&b[1], 5, 1, 3, 1);
+  km_shape sa, sb;
+  make_shape(&sa, a, 2);
+  make_shape(&sb, b, 2);
+  km_shape_pair *p = NULL;
+  size_t n = 0;
+  get_pairs(&sa, &sb, &p, &n);
+  /* then: outer 0 with outer 1, hole 1 with hole 0, nothing unpaired */
+  assert_int_equal(n, 2);
+  assert_int_equal(partner_of(p, n, 0), 1);
+  assert_int_equal(partner_of(p, n, 1), 0);
+  assert_status(km_shape_pair_check(&sa, &sb, p, n, NULL), KM_OK);
+  km_shape_pairs_free(p);
+  km_shape_free(&sa);
+  km_shape_free(&sb);
+  free_curves(a, 2);
+  free_curves(b, 2);
+}
+
+/* an outline with a large hole on the left and a small one on the right */
+static void two_holes(km_curve *c, const size_t *order, double dx) {
+  km_curve k[3];
+  rect(&k[0], dx, 0, dx + 12, 6, 1);
+  circle(&k[1], dx + 3.5, 3, 2, 0);
+  circle(&k[2], dx + 9, 3, 1.2, 0);
+  for (int i = 0; i < 3; i++) c[i] = k[order[i]];
+}
+
+static void pairing_does_not_depend_on_order_or_start(void **state) {
+  (void)state;
+  const size_t id[3] = {0, 1, 2}, perm[3] = {2, 0, 1};
+  km_curve a[3], b[3];
+  two_holes(a, id, 0);
+  two_holes(b, perm, 30); /* b[0] small hole, b[1] outline, b[2] big hole */
+  km_shape sa, sb;
+  make_shape(&sa, a, 3);
+  make_shape(&sb, b, 3);
+  km_shape_pair *p = NULL;
+  size_t n = 0;
+  get_pairs(&sa, &sb, &p, &n);
+  assert_int_equal(n, 3);
+  assert_int_equal(partner_of(p, n, 0), 1);
+  assert_int_equal(partner_of(p, n, 1), 2);
+  assert_int_equal(partner_of(p, n, 2), 0);
+  km_shape_pairs_free(p);
+  /* the other way round gives the inverse pairing */
+  get_pairs(&sb, &sa, &p, &n);
+  assert_int_equal(partner_of(p, n, 1), 0);
+  assert_int_equal(partner_of(p, n, 2), 1);
+  assert_int_equal(partner_of(p, n, 0), 2);
+  km_shape_pairs_free(p);
+  km_shape_free(&sa);
+  km_shape_free(&sb);
+  free_curves(a, 3);
+  free_curves(b, 3);
+}
+
+static void o_to_c_leaves_the_counter_unpaired(void **state) {
+  (void)state;
+  km_curve o[2], c[1];
+  circle(&o[0], 0, 0, 2, 1);
+  circle(&o[1], 0, 0, 1.2, 0);
+  rect(&c[0], -2, -2, 2, 2, 1);
+  km_shape so, sc;
+  make_shape(&so, o, 2);
+  make_shape(&sc, c, 1);
+  km_shape_pair *p = NULL;
+  size_t n = 0;
+  get_pairs(&so, &sc, &p, &n);
+  assert_int_equal(n, 2);
+  assert_int_equal(p[0].from, 0);
+  assert_int_equal(p[0].to, 0);
+  assert_int_equal(p[1].from, 1);
+  assert_int_equal(p[1].to, -1);
+  km_shape_pairs_free(p);
+  /* and the counter appears going back */
+  get_pairs(&sc, &so, &p, &n);
+  assert_int_equal(n, 2);
+  assert_int_equal(p[1].from, -1);
+  assert_int_equal(p[1].to, 1);
+  km_shape_pairs_free(p);
+  km_shape_free(&so);
+  km_shape_free(&sc);
+  free_curves(o, 2);
+  free_curves(c, 1);
+}
+
+static void caller_pairing_is_checked(void **state) {
+  (void)state;
+  const size_t id[3] = {0, 1, 2};
+  km_curve a[3], b[3];
+  two_holes(a, id, 0);
+  two_holes(b, id, 0);
+  km_shape sa, sb;
+  make_shape(&sa, a, 3);
+  make_shape(&sb, b, 3);
+  km_error err;
+  /* holes crossed over: allowed (same parent pair, same role) */
+  const km_shape_pair ok[3] = {{0, 0}, {1, 2}, {2, 1}};
+  assert_status(km_shape_pair_check(&sa, &sb, ok, 3, &err), KM_OK);
+  /* one hole vanishing, the other appearing */
+  const km_shape_pair vanish[4] = {{0, 0}, {1, 1}, {2, -1}, {-1, 2}};
+  assert_status(km_shape_pair_check(&sa, &sb, vanish, 4, &err), KM_OK);
+  const km_shape_pair role[3] = {{0, 0}, {1, -1}, {2, 1}};
+  const km_shape_pair outer_hole[4] = {{0, 1}, {1, 0}, {2, 2}, {-1, -1}};
+  assert_status(km_shape_pair_check(&sa, &sb, role, 3, &err), KM_EMATCH);
+  assert_int_equal(err.index, 3); /* b's contour 2 is in no pair */
+  assert_int_equal(err.field, KM_FIELD_MATCHES);
+  assert_status(km_shape_pair_check(&sa, &sb, outer_hole, 4, &err), KM_EMATCH);
+  assert_int_equal(err.index, 0);
+  const km_shape_pair twice[3] = {{0, 0}, {1, 1}, {1, 2}};
+  assert_status(km_shape_pair_check(&sa, &sb, twice, 3, &err), KM_EMATCH);
+  assert_int_equal(err.index, 2);
+  const km_shape_pair range[3] = {{0, 0}, {1, 1}, {2, 3}};
+  assert_status(km_shape_pair_check(&sa, &sb, range, 3, &err), KM_EMATCH);
+  assert_int_equal(err.index, 2);
+  /* a hole paired under a vanishing parent: its parent is not paired */
+  const km_shape_pair orphan[4] = {{0, -1}, {-1, 0}, {1, 1}, {2, 2}};
+  assert_status(km_shape_pair_check(&sa, &sb, orphan, 4, &err), KM_EMATCH);
+  assert_int_equal(err.index, 2);
+  km_shape_free(&sa);
+  km_shape_free(&sb);
+  free_curves(a, 3);
+  free_curves(b, 3);
+}
+
 static const struct CMUnitTest tests[] = {
     cmocka_unit_test(ring_nests_the_hole_and_orients_by_role),
     cmocka_unit_test(nonzero_keeps_a_same_turning_inner_contour_filled),
     cmocka_unit_test(nesting_tree_does_not_depend_on_contour_order),
     cmocka_unit_test(shape_refuses_bad_contours_naming_them),
     cmocka_unit_test(copy_is_deep),
+    cmocka_unit_test(ring_pairs_outer_with_outer_and_hole_with_hole),
+    cmocka_unit_test(pairing_does_not_depend_on_order_or_start),
+    cmocka_unit_test(o_to_c_leaves_the_counter_unpaired),
+    cmocka_unit_test(caller_pairing_is_checked),
 };
 
 TM_SUITE("shape", tests, NULL, NULL);
