@@ -31,4 +31,17 @@ void km__curve_area(const km_curve *c, double *area, double centroid[2]);
 long km__poly_crossings(const double *P, size_t np, const double *Q,
                         size_t nq, km__poll *poll);
 
+/* The compound morph (shape_morph.c), read by its frames (shape_frame.c). */
+typedef enum km__pair_kind { KM__PAIRED, KM__VANISH, KM__APPEAR } km__pair_kind;
+
+struct km_shape_morph {
+  size_t npairs;
+  km_shape_pair *pairs;
+  km_morph **morphs;
+  km__pair_kind *kind;
+  double *centre; /* 2 per pair: the unpaired contour's centroid */
+  double *point;  /* 2 per pair: where it vanishes or appears */
+  long *parent_from, *parent_to; /* parent slots on each side, -1 none */
+};
+
 #endif

@@ -1,0 +1,202 @@
+/* shape_frame.c - frames of a compound morph: each pair's curve, the
+ * unpaired contours scaled toward their points, the nesting adjustment
+ * and the frame's metrics (mutual crossings, nesting).
+ */
+#include <math.h>
+#include <string.h>
+
+#include "km/alloc.h"
+#include "km/shape.h"
+#include "shape_internal.h"
+#include "status_internal.h"
+
+void km_shape_frame_init(km_shape_frame *f) {
+  if (f) memset(f, 0, sizeof *f);
+}
+
+void km_shape_frame_free(km_shape_frame *f) {
+  if (!f) return;
+  for (size_t k = 0; f->contours && k < f->ncontours; k++)
+    km_curve_free(&f->contours[k]);
+  km__free(f->contours);
+  km__free(f->metrics);
+  km__free(f->present);
+  km__free(f->parent);
+  km_shape_frame_init(f);
+}
+
+/* x -> g + s (x - g) + d on the control points (affine maps are exact on
+ * NURBS: the weights stay). */
+static void move_curve(km_curve *c, const double g[2], double s,
+                       const double d[2]) {
+  for (size_t i = 0; i < c->n; i++) {
+    c->cp[2 * i] = g[0] + s * (c->cp[2 * i] - g[0]) + d[0];
+    c->cp[2 * i + 1] = g[1] + s * (c->cp[2 * i + 1] - g[1]) + d[1];
+  }
+}
+
+/* The curve of slot k at t (present false for a collapsed contour). */
+static km_status contour_at(const km_shape_morph *m, size_t k, double t,
+                            const km_stop *stop, km_shape_frame *f,
+                            km_error *err) {
+  km__pair_kind kind = m->kind[k];
+  double s = kind == KM__VANISH ? 1.0 - t : kind == KM__APPEAR ? t : 1.0;
+  if (!(s > 0.0)) return KM_OK; /* collapsed: omitted, slot kept */
+  km_frame_metrics *mt = &f->metrics[k];
+  km_status st = km_morph_frame_until(m->morphs[k], t, stop, &f->contours[k],
+                                      mt, NULL, err);
+  if (st != KM_OK) {
+    if (err && st != KM_ECANCELLED) err->index = (long)k;
+    return st;
+  }
+  f->present[k] = true;
+  if (kind == KM__PAIRED) return KM_OK;
+  double a, g[2], d[2];
+  km__curve_area(&f->contours[k], &a, g);
+  const double *c = m->centre + 2 * k, *p = m->point + 2 * k;
+  /* the centroid on the line from the contour's centroid to its point */
+  double u = kind == KM__VANISH ? t : 1.0 - t;
+  d[0] = (1 - u) * c[0] + u * p[0] - g[0];
+  d[1] = (1 - u) * c[1] + u * p[1] - g[1];
+  move_curve(&f->contours[k], g, s, d);
+  mt->length *= s;
+  mt->max_abs_kappa /= s;
+  mt->bending_energy /= s;
+  mt->closure_gap *= s;
+  return KM_OK;
+}
+
+static bool all_inside(const double *P, size_t np, const double *Q,
+                       size_t nq, const double d[2]) {
+  for (size_t i = 0; i < np; i++) {
+    double q[2] = {P[2 * i] + d[0], P[2 * i + 1] + d[1]};
+    if (km__poly_winding(Q, nq, q) == 0) return false;
+  }
+  return true;
+}
+
+static void centroid_of(const double *P, size_t np, double g[2]) {
+  g[0] = g[1] = 0.0;
+  for (size_t i = 0; i + 1 < np; i++) {
+    g[0] += P[2 * i];
+    g[1] += P[2 * i + 1];
+  }
+  g[0] /= (double)(np - 1);
+  g[1] /= (double)(np - 1);
+}
+
+/* Translate slot k toward its parent's centroid by the smallest fraction
+ * (to 1/1024) that puts all its points inside the parent; true if moved. */
+static bool adjust(km_shape_frame *f, size_t k, double **fl, size_t *np) {
+  size_t p = (size_t)f->parent[k];
+  const double zero[2] = {0, 0};
+  if (all_inside(fl[k], np[k], fl[p], np[p], zero)) return false;
+  double gk[2], gp[2], d[2];
+  centroid_of(fl[k], np[k], gk);
+  centroid_of(fl[p], np[p], gp);
+  double full[2] = {gp[0] - gk[0], gp[1] - gk[1]};
+  if (!all_inside(fl[k], np[k], fl[p], np[p], full)) return false;
+  double lo = 0.0, hi = 1.0;
+  for (int it = 0; it < 10; it++) {
+    double mid = 0.5 * (lo + hi);
+    d[0] = mid * full[0];
+    d[1] = mid * full[1];
+    if (all_inside(fl[k], np[k], fl[p], np[p], d)) hi = mid;
+    else lo = mid;
+  }
+  d[0] = hi * full[0];
+  d[1] = hi * full[1];
+  move_curve(&f->contours[k], zero, 1.0, d);
+  for (size_t i = 0; i < np[k]; i++) {
+    fl[k][2 * i] += d[0];
+    fl[k][2 * i + 1] += d[1];
+  }
+  return true;
+}
+
+static int frame_depth(const km_shape_frame *f, size_t k) {
+  int d = 0;
+  for (long p = f->parent[k]; p >= 0 && (size_t)d <= f->ncontours;
+       p = f->parent[p])
+    d++;
+  return d;
+}
+
+/* Nesting adjustment parents first, then the metrics. */
+static km_status finish(km_shape_frame *f, double **fl, size_t *np,
+                        km__poll *poll) {
+  int maxd = 0;
+  for (size_t k = 0; k < f->ncontours; k++)
+    if (frame_depth(f, k) > maxd) maxd = frame_depth(f, k);
+  const double zero[2] = {0, 0};
+  for (int d = 1; d <= maxd; d++)
+    for (size_t k = 0; k < f->ncontours; k++)
+      if (f->present[k] && f->parent[k] >= 0 && f->present[f->parent[k]] &&
+          frame_depth(f, k) == d && adjust(f, k, fl, np))
+        f->adjusted++;
+  f->nesting_ok = true;
+  for (size_t k = 0; k < f->ncontours; k++)
+    if (f->present[k] && f->parent[k] >= 0 && f->present[f->parent[k]] &&
+        !all_inside(fl[k], np[k], fl[f->parent[k]], np[f->parent[k]], zero))
+      f->nesting_ok = false;
+  f->mutual_intersections = 0;
+  for (size_t k = 0; k < f->ncontours; k++)
+    for (size_t l = k + 1; f->present[k] && l < f->ncontours; l++) {
+      if (!f->present[l]) continue;
+      long c = km__poly_crossings(fl[k], np[k], fl[l], np[l], poll);
+      if (c < 0) return KM_ECANCELLED;
+      f->mutual_intersections += c;
+    }
+  return KM_OK;
+}
+
+static km_status frame_alloc(km_shape_frame *f, size_t n) {
+  f->ncontours = n;
+  f->contours = km__calloc(n, sizeof *f->contours);
+  f->metrics = km__calloc(n, sizeof *f->metrics);
+  f->present = km__calloc(n, sizeof *f->present);
+  f->parent = km__calloc(n, sizeof *f->parent);
+  return f->contours && f->metrics && f->present && f->parent ? KM_OK
+                                                              : KM_ENOMEM;
+}
+
+km_status km_shape_morph_frame_until(const km_shape_morph *m, double t,
+                                     const km_stop *stop,
+                                     km_shape_frame *out, km_error *err) {
+  if (!m || !out)
+    return km__fail(err, KM_EINVAL, KM_FIELD_NONE, -1, NAN, "no morph");
+  if (!(t >= 0.0 && t <= 1.0))
+    return km__fail(err, KM_ERANGE, KM_FIELD_TIMES, -1, t,
+                    "t = %g is outside [0, 1]", t);
+  km_shape_frame f;
+  km_shape_frame_init(&f);
+  size_t n = m->npairs;
+  double **fl = km__calloc(n, sizeof *fl);
+  size_t *np = km__calloc(n, sizeof *np);
+  km__poll poll;
+  km__poll_init(&poll, stop);
+  km_status st = fl && np ? frame_alloc(&f, n) : KM_ENOMEM;
+  if (st == KM_ENOMEM)
+    km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, "out of memory");
+  for (size_t k = 0; st == KM_OK && k < n; k++) {
+    bool near_from = (t < 0.5 && m->pairs[k].from >= 0) || m->pairs[k].to < 0;
+    f.parent[k] = near_from ? m->parent_from[k] : m->parent_to[k];
+    st = contour_at(m, k, t, stop, &f, err);
+    if (st == KM_OK && f.present[k]) {
+      st = km__shape_flatten(&f.contours[k], &fl[k], &np[k]);
+      if (st == KM_ENOMEM)
+        km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, "out of memory");
+    }
+  }
+  if (st == KM_OK) st = finish(&f, fl, np, &poll);
+  if (st == KM_ECANCELLED) km__stopped(err);
+  if (st != KM_OK) goto cleanup;
+  *out = f;
+  km_shape_frame_init(&f);
+cleanup:
+  for (size_t k = 0; fl && k < n; k++) km__free(fl[k]);
+  km__free(fl);
+  km__free(np);
+  km_shape_frame_free(&f);
+  return st;
+}

