@@ -415,3 +415,35 @@ cleanup:
     km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, "out of memory");
   return st;
 }
+
+/* The point nearest x among points set in from the closed polyline P by
+ * 3% of its extent along each edge's normal, on the side whose winding
+ * is not 0: a point well inside a region of any shape, near x. */
+void km__poly_interior_point(const double *P, size_t np, const double x[2],
+                             double out[2]) {
+  double x0 = P[0], x1 = P[0], y0 = P[1], y1 = P[1];
+  for (size_t i = 1; i < np; i++) {
+    x0 = fmin(x0, P[2 * i]);
+    x1 = fmax(x1, P[2 * i]);
+    y0 = fmin(y0, P[2 * i + 1]);
+    y1 = fmax(y1, P[2 * i + 1]);
+  }
+  double delta = 0.03 * hypot(x1 - x0, y1 - y0), best = INFINITY;
+  out[0] = x[0];
+  out[1] = x[1];
+  for (size_t i = 0; i + 1 < np; i++) {
+    const double *a = P + 2 * i, *b = a + 2;
+    double dx = b[0] - a[0], dy = b[1] - a[1], l = hypot(dx, dy);
+    if (!(l > 0)) continue;
+    for (int side = -1; side <= 1; side += 2) {
+      double q[2] = {0.5 * (a[0] + b[0]) - side * delta * dy / l,
+                     0.5 * (a[1] + b[1]) + side * delta * dx / l};
+      double d = hypot(q[0] - x[0], q[1] - x[1]);
+      if (d < best && km__poly_winding(P, np, q) != 0) {
+        best = d;
+        out[0] = q[0];
+        out[1] = q[1];
+      }
+    }
+  }
+}

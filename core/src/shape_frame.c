@@ -85,7 +85,8 @@ static void centroid_of(const double *P, size_t np, double g[2]) {
   g[1] /= (double)(np - 1);
 }
 
-/* Translate slot k toward its parent's centroid by the smallest fraction
+/* Translate slot k toward the point inside its parent nearest its
+ * centroid by the smallest fraction
  * (to 1/1024) that puts all its points inside the parent; true if moved. */
 static bool adjust(km_shape_frame *f, size_t k, double **fl, size_t *np) {
   size_t p = (size_t)f->parent[k];
@@ -93,7 +94,7 @@ static bool adjust(km_shape_frame *f, size_t k, double **fl, size_t *np) {
   if (all_inside(fl[k], np[k], fl[p], np[p], zero)) return false;
   double gk[2], gp[2], d[2];
   centroid_of(fl[k], np[k], gk);
-  centroid_of(fl[p], np[p], gp);
+  km__poly_interior_point(fl[p], np[p], gk, gp);
   double full[2] = {gp[0] - gk[0], gp[1] - gk[1]};
   if (!all_inside(fl[k], np[k], fl[p], np[p], full)) return false;
   double lo = 0.0, hi = 1.0;

@@ -31,6 +31,11 @@ void km__curve_area(const km_curve *c, double *area, double centroid[2]);
 long km__poly_crossings(const double *P, size_t np, const double *Q,
                         size_t nq, km__poll *poll);
 
+/* A point inside the closed polyline P (np points) near x (shape.c); x
+ * itself when no edge offset lands inside. */
+void km__poly_interior_point(const double *P, size_t np, const double x[2],
+                             double out[2]);
+
 /* The compound morph (shape_morph.c), read by its frames (shape_frame.c). */
 typedef enum km__pair_kind { KM__PAIRED, KM__VANISH, KM__APPEAR } km__pair_kind;
 

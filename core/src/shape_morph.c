@@ -94,23 +94,15 @@ static long nearest_host(const km_shape_morph *m, const km_shape *s,
   return best;
 }
 
-/* Move p toward contour j's centroid until it is inside j (bisection on
- * the segment; left as it is when the centroid is outside too). */
+/* p itself when inside contour j of o, else the nearest of the points
+ * set in from j's flattening (km__poly_interior_point). */
 static void pull_inside(const km_shape *o, size_t j, double p[2]) {
-  const double *g = o->centroid + 2 * j;
-  if (km_shape_winding(o, j, p) != 0 || km_shape_winding(o, j, g) == 0) return;
-  double lo = 0.0, hi = 1.0, q[2];
-  for (int it = 0; it < 40; it++) {
-    double mid = 0.5 * (lo + hi);
-    q[0] = p[0] + mid * (g[0] - p[0]);
-    q[1] = p[1] + mid * (g[1] - p[1]);
-    if (km_shape_winding(o, j, q) != 0) hi = mid;
-    else lo = mid;
-  }
-  /* a little past the boundary, so the point is not on it */
-  double f = hi + 0.05 * (1.0 - hi);
-  p[0] += f * (g[0] - p[0]);
-  p[1] += f * (g[1] - p[1]);
+  if (km_shape_winding(o, j, p) != 0) return;
+  double q[2];
+  km__poly_interior_point(o->flat + 2 * o->flat_off[j],
+                          o->flat_off[j + 1] - o->flat_off[j], p, q);
+  p[0] = q[0];
+  p[1] = q[1];
 }
 
 /* Where the unpaired contour of slot k ends (vanishing) or starts. */
