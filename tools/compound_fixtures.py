@@ -39,8 +39,10 @@ MDI_VERSION = "7.4.47"
 EM = 100
 
 # (id prefix, family label, file, Debian package). Two TrueType families
-# (quadratic outlines, glyf) and one CFF family (cubic outlines), each in a
-# sans and a serif cut, so pairs see both segment kinds and both styles.
+# (quadratic outlines, glyf), each in a sans and a serif cut; cubic
+# outlines come from the icons. A CFF family (URW base35, cubic) is left
+# out: its AGPL-3.0 licence would reach the outlines copied here. The
+# reader still handles CFF.
 FONTS = [
     ("dejavu-sans", "DejaVu Sans",
      "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf", "fonts-dejavu-core"),
@@ -52,12 +54,6 @@ FONTS = [
     ("liberation-serif", "Liberation Serif",
      "/usr/share/fonts/truetype/liberation2/LiberationSerif-Regular.ttf",
      "fonts-liberation2"),
-    ("nimbus-sans", "Nimbus Sans",
-     "/usr/share/fonts/opentype/urw-base35/NimbusSans-Regular.otf",
-     "fonts-urw-base35"),
-    ("nimbus-roman", "Nimbus Roman",
-     "/usr/share/fonts/opentype/urw-base35/NimbusRoman-Regular.otf",
-     "fonts-urw-base35"),
 ]
 
 # Glyphs with holes, glyphs with dots, and the partners of the unequal
@@ -98,10 +94,10 @@ GLYPH_PAIRS = [
     ("liberation-serif/g", "liberation-serif/q",
      "double-storey g: two holes become one"),
     ("liberation-serif/8", "liberation-serif/0", "two holes become one"),
-    ("nimbus-sans/O", "nimbus-sans/C", "ring opens, cubic outlines"),
-    ("nimbus-sans/i", "nimbus-sans/l", "dot vanishes, cubic outlines"),
-    ("nimbus-roman/B", "nimbus-roman/R", "two holes become one, cubic"),
-    ("nimbus-roman/e", "nimbus-roman/c", "hole vanishes, cubic serif"),
+    ("dejavu-serif/O", "dejavu-serif/C", "ring opens, serif"),
+    ("dejavu-serif/i", "dejavu-serif/l", "dot vanishes, serif"),
+    ("liberation-serif/B", "liberation-serif/R", "two holes become one, serif"),
+    ("liberation-serif/e", "liberation-serif/c", "hole vanishes, serif"),
     # equal contour counts: holes pair with holes
     ("dejavu-sans/b", "dejavu-sans/d", "mirror images, one hole each"),
     ("dejavu-sans/p", "dejavu-sans/q", "mirror images below the baseline"),
@@ -111,14 +107,14 @@ GLYPH_PAIRS = [
     ("liberation-sans/i", "liberation-sans/j", "stem and dot each"),
     ("liberation-serif/P", "liberation-serif/R", "one hole, a leg grows"),
     ("liberation-serif/a", "liberation-serif/e", "one hole each"),
-    ("nimbus-sans/0", "nimbus-sans/O", "one hole each, cubic"),
-    ("nimbus-sans/4", "nimbus-sans/A", "triangular hole each"),
-    ("nimbus-roman/o", "nimbus-roman/p", "one hole each, a stem grows"),
-    ("nimbus-roman/8", "nimbus-roman/B", "two holes each"),
+    ("dejavu-serif/0", "dejavu-serif/O", "one hole each, serif"),
+    ("liberation-sans/4", "liberation-sans/A", "triangular hole each"),
+    ("dejavu-serif/o", "dejavu-serif/p", "one hole each, a stem grows"),
+    ("dejavu-serif/8", "dejavu-serif/B", "two holes each"),
     # across fonts: the same letter, a different design
     ("dejavu-sans/g", "liberation-serif/g",
      "single-storey g to double-storey g"),
-    ("dejavu-sans/a", "nimbus-roman/a", "quadratic sans to cubic serif"),
+    ("dejavu-sans/a", "liberation-serif/a", "sans to serif"),
     ("liberation-sans/Q", "dejavu-serif/Q", "tail drawn two ways"),
 ]
 
@@ -176,7 +172,7 @@ class Frame:
     glyphs (band: whole font units around their union), so that all of
     them share a baseline and lie inside [0, 100]^2. The typographic
     ascender and descender would not do: digits and round letters
-    overshoot them (Nimbus Roman's 6 by a unit)."""
+    overshoot them (a serif 6 by a unit)."""
 
     def __init__(self, font, advance, band):
         upm = font["head"].unitsPerEm
@@ -457,8 +453,7 @@ def main():
                  "on-curve midpoints written out), CFF glyphs M/L/C. "
                  "contours counts the closed subpaths. Fill rule nonzero.",
         "license": "DejaVu fonts: Bitstream Vera / DejaVu license; "
-                   "Liberation fonts: SIL Open Font License 1.1; "
-                   "URW base35 (Nimbus): AGPL-3.0 with font exception. "
+                   "Liberation fonts: SIL Open Font License 1.1. "
                    "See README.md.",
         "glyphs": gl})
     write(os.path.join(args.out, "icons.json"), {
