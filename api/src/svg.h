@@ -33,6 +33,20 @@ km_status api_svg_parse_path(const char *d, size_t len, double tol,
                              km_curve *out, size_t *err_offset, char *msg,
                              size_t msgcap);
 
+/* The same grammar with several subpaths: each subpath (from a moveto
+ * that is followed by drawing) becomes one curve, as api_svg_parse_path
+ * would make it alone. *out (n curves) and *offsets (the character
+ * offset of each subpath's moveto) are malloc'd, written on KM_OK only,
+ * freed by the caller (each curve with km_curve_free). More than
+ * max_subpaths subpaths is KM_ELIMIT at the first one past it; a subpath
+ * that draws nothing (zero length) is KM_EDEGENERATE at its moveto;
+ * other statuses and *err_offset, msg as api_svg_parse_path. */
+km_status api_svg_parse_subpaths(const char *d, size_t len, double tol,
+                                 size_t max_subpaths, km_curve **out,
+                                 size_t **offsets, size_t *n,
+                                 size_t *err_offset, char *msg,
+                                 size_t msgcap);
+
 /* The curve as an SVG path of cubic Beziers ("M x y C ..." and "Z" if
  * closed), within tol of the curve (degree > 3 and rational curves are
  * approximated; *err_bound, if not NULL, receives the bound). NULL on

@@ -6,9 +6,11 @@
  * every form the grammar allows ("1e-3", ".5.5" = 0.5 0.5, "-1-2"), arc
  * flags written without separators ("a1 1 0 00 1 1") and comma-wsp where
  * the grammar allows it. Geometry goes straight into a km_path builder,
- * which keeps every piece exact. Only one subpath is accepted: a moveto or
- * a drawing command after the path was drawn and closed is an error, except
- * trailing movetos that draw nothing. Every error carries the character
+ * which keeps every piece exact. api_svg_parse_path accepts one subpath:
+ * a moveto or a drawing command after the path was drawn and closed is an
+ * error, except trailing movetos that draw nothing. api_svg_parse_subpaths
+ * runs the same scanner and finishes a curve at every further moveto (or
+ * drawing after a Z), so its first subpath is what the other would give. Every error carries the character
  * offset and what the grammar expected there.
  */
 #include <math.h>
@@ -27,6 +29,14 @@ typedef struct parser {
   size_t err_off;
   char *msg;
   size_t msgcap;
+  /* Several subpaths allowed (api_svg_parse_subpaths): the finished ones,
+   * the offset of each one's moveto, and the bound on their count. */
+  bool multi;
+  km_curve *subs;
+  size_t *sub_offs;
+  size_t nsub, capsub, maxsub;
+  size_t cur_off; /* offset of the current subpath's moveto */
+  double tol;
 } parser;
 
 static bool is_wsp(char c) {
@@ -182,6 +192,8 @@ typedef struct pen {
   double lcx, lcy;       /* last control point (S, T) */
 } pen;
 
+static km_status finish_subpath(parser *ps, pen *pn);
+
 /* The path data must start with a moveto. */
 static km_status expect_moveto(parser *ps) {
   char fb[16];
@@ -239,7 +251,13 @@ static km_status move_to(parser *ps, pen *pn, double ox, double oy,
   km_error e;
   km_status st = parse_args(ps, 2, N_XY, v);
   if (st) return st;
-  if (pn->drawn) {
+  if (pn->drawn && ps->multi) {
+    /* The subpath so far is finished; this moveto starts the next one,
+     * relative to where the last one ended (its start, after a Z). */
+    if ((st = finish_subpath(ps, pn)) != KM_OK)
+      return st;
+    ps->cur_off = cmd_off;
+  } else if (pn->drawn) {
     /* Only a trailing moveto that draws nothing is tolerated. */
     skip_wsp(ps);
     if (ps->pos < ps->len)
@@ -378,6 +396,16 @@ static km_status argument_set(parser *ps, pen *pn, char up, bool rel,
                               bool first, size_t cmd_off, size_t arg_off) {
   double ox = rel ? pn->cx : 0.0, oy = rel ? pn->cy : 0.0;
   km_status st = KM_OK;
+  if (up != 'M' && pn->done && ps->multi) {
+    /* Drawing after a Z without a moveto starts a subpath at the last
+     * one's start (SVG 1.1, 8.3.3). */
+    km_error e;
+    if ((st = finish_subpath(ps, pn)) != KM_OK)
+      return st;
+    ps->cur_off = first ? cmd_off : arg_off;
+    if ((st = km_path_move_to(&pn->path, pn->cx, pn->cy, &e)) != KM_OK)
+      return geom_fail(ps, ps->cur_off, st, &e);
+  }
   if ((up != 'M') && pn->done)
     return fail(ps, first ? cmd_off : arg_off, KM_EINVAL, "%s",
                 "a second subpath: one subpath per curve (the path "
@@ -441,10 +469,104 @@ static km_status to_curve(parser *ps, const pen *pn, double tol,
   return KM_OK;
 }
 
+/* The drawn subpath as a curve appended to ps->subs, its offset to
+ * ps->sub_offs; the pen is left empty for the next one. A subpath past
+ * ps->maxsub is KM_ELIMIT at its moveto; one that draws nothing is the
+ * builder's failure at its moveto. */
+static km_status finish_subpath(parser *ps, pen *pn) {
+  km_curve c;
+  km_status st;
+  if (ps->nsub == ps->maxsub)
+    return fail(ps, ps->cur_off, KM_ELIMIT,
+                "subpath %zu is one past the limit of %zu subpaths",
+                ps->nsub, ps->maxsub);
+  if (ps->nsub == ps->capsub) {
+    size_t cap = ps->capsub ? 2 * ps->capsub : 4;
+    km_curve *c2 = km__realloc(ps->subs, cap * sizeof *c2);
+    if (c2 == NULL)
+      return fail(ps, ps->cur_off, KM_ENOMEM, "%s", "out of memory");
+    ps->subs = c2;
+    size_t *o2 = km__realloc(ps->sub_offs, cap * sizeof *o2);
+    if (o2 == NULL)
+      return fail(ps, ps->cur_off, KM_ENOMEM, "%s", "out of memory");
+    ps->sub_offs = o2;
+    ps->capsub = cap;
+  }
+  if ((st = to_curve(ps, pn, ps->tol, &c)) != KM_OK) {
+    /* A path of one subpath fails as api_svg_parse_path would. */
+    if (ps->nsub == 0 && ps->pos >= ps->len)
+      return st;
+    if (st == KM_EDEGENERATE)
+      return fail(ps, ps->cur_off, st,
+                  "subpath %zu has zero length (it draws nothing)",
+                  ps->nsub);
+    ps->err_off = ps->cur_off;
+    return st;
+  }
+  ps->subs[ps->nsub] = c;
+  ps->sub_offs[ps->nsub++] = ps->cur_off;
+  km_path_free(&pn->path);
+  km_path_init(&pn->path);
+  pn->drawn = pn->done = false;
+  return KM_OK;
+}
+
+km_status api_svg_parse_subpaths(const char *d, size_t len, double tol,
+                                 size_t max_subpaths, km_curve **out,
+                                 size_t **offsets, size_t *n,
+                                 size_t *err_offset, char *msg,
+                                 size_t msgcap) {
+  parser ps = {.s = d ? d : "", .len = d ? len : 0, .msg = msg,
+               .msgcap = msgcap, .multi = true};
+  pen pn = {.prev = 0};
+  km_status st;
+  char fb[16];
+  km_path_init(&pn.path);
+  if (msg && msgcap) msg[0] = '\0';
+  ps.maxsub = max_subpaths > 0 ? max_subpaths : 1;
+  ps.tol = tol;
+
+  if ((st = expect_moveto(&ps))) goto cleanup;
+  ps.cur_off = ps.pos;
+  while (ps.pos < ps.len) {
+    size_t cmd_off = ps.pos;
+    char c = ps.s[ps.pos];
+    if (!strchr("MmZzLlHhVvCcSsQqTtAa", c) || c == '\0') {
+      st = fail(&ps, ps.pos, KM_EINVAL,
+                "expected a path command (M L H V C S Q T A Z), found %s",
+                found(&ps, fb));
+      goto cleanup;
+    }
+    ps.pos++;
+    skip_wsp(&ps);
+    if ((st = command(&ps, &pn, c, cmd_off))) goto cleanup;
+  }
+  if (pn.drawn && (st = finish_subpath(&ps, &pn)) != KM_OK) goto cleanup;
+  if (ps.nsub == 0) {
+    st = fail(&ps, 0, KM_EDEGENERATE, "%s", "the path draws nothing");
+    goto cleanup;
+  }
+  *out = ps.subs;
+  *offsets = ps.sub_offs;
+  *n = ps.nsub;
+  ps.subs = NULL;
+  ps.sub_offs = NULL;
+  ps.nsub = 0;
+
+cleanup:
+  if (st && err_offset) *err_offset = ps.err_off;
+  for (size_t i = 0; i < ps.nsub; i++) km_curve_free(&ps.subs[i]);
+  km__free(ps.subs);
+  km__free(ps.sub_offs);
+  km_path_free(&pn.path);
+  return st;
+}
+
 km_status api_svg_parse_path(const char *d, size_t len, double tol,
                              km_curve *out, size_t *err_offset, char *msg,
                              size_t msgcap) {
-  parser ps = {d ? d : "", d ? len : 0, 0, 0, msg, msgcap};
+  parser ps = {.s = d ? d : "", .len = d ? len : 0, .msg = msg,
+               .msgcap = msgcap};
   pen pn = {.prev = 0};
   km_status st;
   char fb[16];
