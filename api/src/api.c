@@ -37,6 +37,7 @@ void api_config_default(api_config *cfg) {
   cfg->max_samples = 100000;
   cfg->max_json_depth = 64;
   cfg->max_output_bytes = 64u * 1024u * 1024u;
+  cfg->max_contours = KM_SHAPE_DEFAULT_MAX_CONTOURS;
 }
 
 void api_response_init(api_response *r) {

@@ -1,9 +1,11 @@
 /* curve_in.c - input curves of a request: a Curve object of type
- * "bspline", "points" (fitted), "svg" (path data) or "signature", checked
- * member by member, each failure named by its JSON pointer, then built by
- * the core.
+ * "bspline", "points" (fitted), "svg" (path data), "signature" or "shape"
+ * (closed contours, each a Curve), checked member by member, each failure
+ * named by its JSON pointer, then built by the core. An "svg" whose d has
+ * several subpaths is a shape too; with one it is the curve it always was.
  */
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "internal.h"
@@ -16,6 +18,11 @@ void api__input_init(api_input *in) {
   km_curve_init(&in->curve);
   km_signature_init(&in->sig);
   in->length = 0;
+  in->is_shape = false;
+  in->ncontours = 0;
+  in->contours = NULL;
+  in->offsets = NULL;
+  in->fill = KM_FILL_NONZERO;
 }
 
 void api__input_free(api_input *in) {
@@ -23,7 +30,44 @@ void api__input_free(api_input *in) {
     return;
   km_curve_free(&in->curve);
   km_signature_free(&in->sig);
+  for (size_t i = 0; in->contours != NULL && i < in->ncontours; i++)
+    km_curve_free(&in->contours[i]);
+  km__free(in->contours);
+  km__free(in->offsets);
   api__input_init(in);
+}
+
+size_t api__max_contours(const api_config *cfg) {
+  size_t m = cfg->max_contours;
+  if (m == 0)
+    return KM_SHAPE_DEFAULT_MAX_CONTOURS;
+  return m > KM_SHAPE_MAX_CONTOURS ? KM_SHAPE_MAX_CONTOURS : m;
+}
+
+void api__contour_ptr(char *buf, const api_input *in, const char *ptr,
+                      size_t i) {
+  char p[API_POINTER_MAX];
+  if (in->offsets != NULL) {
+    api__ptr_key(buf, ptr, "d");
+    return;
+  }
+  api__ptr_key(p, ptr, "contours");
+  api__ptr_idx(buf, p, i);
+}
+
+void api__contour_where(char *buf, size_t cap, const api_input *in,
+                        size_t i) {
+  if (in->offsets != NULL)
+    snprintf(buf, cap, "subpath %zu (at offset %zu of d)", i,
+             in->offsets[i]);
+  else
+    snprintf(buf, cap, "contour %zu", i);
+}
+
+bool api__refuse_shape(api_ctx *ctx, const char *ptr) {
+  return api__invalid(ctx, ptr,
+                      "is a shape of several contours; this route takes "
+                      "one curve");
 }
 
 
@@ -162,12 +206,28 @@ done:
   return ok;
 }
 
+/* Contour i of in, closed, else 422 naming it. */
+static bool check_closed(api_ctx *ctx, const api_input *in, const char *ptr,
+                         size_t i) {
+  char p[API_POINTER_MAX], where[96];
+  if (in->contours[i].closed)
+    return true;
+  api__contour_ptr(p, in, ptr, i);
+  api__contour_where(where, sizeof where, in, i);
+  return api__failf(ctx, 422, API_P_INVALID_CURVE, "Invalid curve", p,
+                    "%s is open: every contour of a shape must be closed "
+                    "(end it with Z, or give \"closed\": true)",
+                    where);
+}
+
+/* The subpaths of d: one is the curve itself, several a shape. */
 static bool parse_svg(api_ctx *ctx, const cJSON *v, const char *ptr,
-                      double tol, km_curve *out) {
+                      double tol, api_input *out) {
   char p[API_POINTER_MAX];
   char msg[API_TEXT_MAX];
   const cJSON *jd;
-  size_t off = 0;
+  size_t off = 0, n = 0, *offs = NULL, points = 0;
+  km_curve *subs = NULL;
   km_status st;
   if ((jd = api__require(ctx, v, ptr, "d")) == NULL)
     return false;
@@ -178,20 +238,91 @@ static bool parse_svg(api_ctx *ctx, const cJSON *v, const char *ptr,
   msg[0] = '\0';
   /* Without a request tolerance nothing is known of the drawing's scale
    * yet; a tiny absolute tolerance only lets exact repairs happen. */
-  st = api_svg_parse_path(jd->valuestring, strlen(jd->valuestring),
-                          tol > 0 ? tol : 1e-9, out, &off, msg, sizeof msg);
+  st = api_svg_parse_subpaths(jd->valuestring, strlen(jd->valuestring),
+                              tol > 0 ? tol : 1e-9,
+                              api__max_contours(ctx->cfg), &subs, &offs, &n,
+                              &off, msg, sizeof msg);
   if (st == KM_ENOMEM)
     return api__oom(ctx);
+  if (st == KM_ELIMIT)
+    return api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded", p,
+                      "too many subpaths at offset %zu: %s", off, msg);
   if (st != KM_OK)
     return api__failf(ctx, 422, API_P_INVALID_CURVE, "Invalid curve", p,
                       "invalid path data at offset %zu: %s", off,
                       msg[0] != '\0' ? msg : km_status_message(st));
-  if (out->n > ctx->cfg->max_control_points) {
-    size_t n = out->n;
-    km_curve_free(out);
+  for (size_t i = 0; i < n; i++)
+    points += subs[i].n;
+  if (n == 1) {
+    out->curve = subs[0];
+    km__free(subs);
+    km__free(offs);
+  } else {
+    out->is_shape = true;
+    out->contours = subs;
+    out->offsets = offs;
+    out->ncontours = n;
+  }
+  if (points > ctx->cfg->max_control_points)
     return api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded", p,
                       "the path makes %zu control points; the limit is %zu",
-                      n, ctx->cfg->max_control_points);
+                      points, ctx->cfg->max_control_points);
+  for (size_t i = 0; i < out->ncontours; i++)
+    if (!check_closed(ctx, out, ptr, i))
+      return false;
+  return true;
+}
+
+/* A "shape": contours (each a closed curve, not a signature or a shape)
+ * and a fill rule. */
+static bool parse_shape(api_ctx *ctx, const cJSON *v, const char *ptr,
+                        double tol, api_input *out) {
+  static const char *const fills[] = {"nonzero", "evenodd"};
+  char p[API_POINTER_MAX], q[API_POINTER_MAX];
+  const cJSON *jc, *item;
+  size_t n, i = 0, max = api__max_contours(ctx->cfg), points = 0;
+  int fill = 0;
+  if (!api__member_enum(ctx, v, ptr, "fill_rule", fills, 2, &fill, NULL) ||
+      (jc = api__require(ctx, v, ptr, "contours")) == NULL)
+    return false;
+  api__ptr_key(p, ptr, "contours");
+  if (!cJSON_IsArray(jc) || api__array_packed(jc, NULL) != NULL ||
+      (n = api__array_len(jc)) == 0)
+    return api__invalid(ctx, p, "must be a non-empty array of curves");
+  if (n > max) {
+    api__ptr_idx(q, p, max);
+    return api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded", q,
+                      "a shape has at most %zu contours, not %zu", max, n);
+  }
+  out->fill = fill == 1 ? KM_FILL_EVENODD : KM_FILL_NONZERO;
+  if ((out->contours = km__calloc(n, sizeof *out->contours)) == NULL)
+    return api__oom(ctx);
+  out->is_shape = true;
+  cJSON_ArrayForEach(item, jc) {
+    api_input c;
+    api__input_init(&c);
+    api__ptr_idx(q, p, i);
+    bool ok = api__parse_curve(ctx, item, q, tol, &c);
+    if (ok && (c.is_signature || c.is_shape))
+      ok = api__invalid(ctx, q,
+                        "a contour must be one curve (bspline, points or "
+                        "svg of one subpath)");
+    if (!ok) {
+      api__input_free(&c);
+      return false;
+    }
+    out->contours[i] = c.curve;
+    km_curve_init(&c.curve);
+    api__input_free(&c);
+    out->ncontours = ++i;
+    points += out->contours[i - 1].n;
+    if (!check_closed(ctx, out, ptr, i - 1))
+      return false;
+    if (points > ctx->cfg->max_control_points)
+      return api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded", q,
+                        "the contours up to this one have %zu control "
+                        "points; the limit is %zu",
+                        points, ctx->cfg->max_control_points);
   }
   return true;
 }
@@ -199,7 +330,7 @@ static bool parse_svg(api_ctx *ctx, const cJSON *v, const char *ptr,
 bool api__parse_curve(api_ctx *ctx, const cJSON *v, const char *ptr,
                       double tol, api_input *out) {
   static const char *const types[] = {"bspline", "points", "signature",
-                                      "svg"};
+                                      "svg", "shape"};
   int type = -1;
   bool present = false;
   char p[API_POINTER_MAX];
@@ -208,13 +339,13 @@ bool api__parse_curve(api_ctx *ctx, const cJSON *v, const char *ptr,
   if (!cJSON_IsObject(v))
     return api__invalid(ctx, ptr, "must be a curve object, not %s",
                         api__type_name(v));
-  if (!api__member_enum(ctx, v, ptr, "type", types, 4, &type, &present))
+  if (!api__member_enum(ctx, v, ptr, "type", types, 5, &type, &present))
     return false;
   if (!present) {
     api__ptr_key(p, ptr, "type");
     return api__invalid(ctx, p,
-                        "is required: \"bspline\", \"points\", \"signature\" "
-                        "or \"svg\"");
+                        "is required: \"bspline\", \"points\", \"signature\", "
+                        "\"svg\" or \"shape\"");
   }
   switch (type) {
   case 0:
@@ -239,13 +370,24 @@ bool api__parse_curve(api_ctx *ctx, const cJSON *v, const char *ptr,
     out->length = out->sig.length;
     return true;
   }
-  default:
-    if (!parse_svg(ctx, v, ptr, tol, &out->curve))
+  case 3:
+    if (!parse_svg(ctx, v, ptr, tol, out))
       return false;
     out->kind = API_KIND_SVG;
     break;
+  default:
+    if (!parse_shape(ctx, v, ptr, tol, out))
+      return false;
+    out->kind = API_KIND_CURVE;
+    break;
   }
   out->is_signature = false;
+  if (out->is_shape) {
+    out->length = 0;
+    for (size_t i = 0; i < out->ncontours; i++)
+      out->length += km_curve_length(&out->contours[i]);
+    return true;
+  }
   out->length = km_curve_length(&out->curve);
   if (!isfinite(out->length) || !(out->length > 0))
     return api__fail(ctx, 422, API_P_INVALID_CURVE, "Invalid curve", ptr,

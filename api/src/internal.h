@@ -25,6 +25,7 @@
 
 #include "kmapi/api.h"
 #include "km/kmorph.h"
+#include "km/shape.h"
 
 #define API_POINTER_MAX 256
 #define API_TEXT_MAX 512
@@ -254,22 +255,45 @@ bool api__read_knots(api_ctx *ctx, const cJSON *obj, const char *base,
 
 /* ---- curves and signatures from JSON ---- */
 
-/* An input curve as given: a curve, or a signature (type "signature"). */
+/* An input curve as given: a curve, a signature (type "signature"), or a
+ * compound shape (type "shape", or an "svg" whose d has several
+ * subpaths). A shape's contours are kept as given (closed, not yet
+ * reoriented); its nesting is built where it is morphed. */
 typedef struct api_input {
   bool is_signature;
   api_kind kind; /* how it was given, for mapping core errors */
   km_curve curve;
   km_signature sig;
-  double length; /* arc length of the input */
+  double length; /* arc length of the input (all contours of a shape) */
+  bool is_shape;
+  size_t ncontours;
+  km_curve *contours;  /* is_shape: ncontours closed curves */
+  size_t *offsets;     /* svg shapes: each subpath's offset in d; else NULL */
+  km_fill_rule fill;
 } api_input;
 
 void api__input_init(api_input *in);
 void api__input_free(api_input *in);
 
 /* Parse a Curve object at ptr. tol > 0 is the request tolerance, or <= 0
- * when none was given (the SVG parser then uses a small absolute one). */
+ * when none was given (the SVG parser then uses a small absolute one).
+ * A shape (out->is_shape) comes back with every contour closed and at
+ * most cfg->max_contours of them; callers that take no shapes refuse it
+ * with api__refuse_shape. */
 bool api__parse_curve(api_ctx *ctx, const cJSON *v, const char *ptr,
                       double tol, api_input *out);
+/* The pointer naming contour i of a shape input at ptr: "<ptr>/contours/i"
+ * for a JSON shape, "<ptr>/d" for SVG (whose messages give the subpath's
+ * offset, api__contour_where). */
+void api__contour_ptr(char *buf, const api_input *in, const char *ptr,
+                      size_t i);
+/* "contour i" or "subpath i (at offset N of d)" for messages. */
+void api__contour_where(char *buf, size_t cap, const api_input *in,
+                        size_t i);
+/* 422 at ptr: a shape where only one curve is taken. */
+bool api__refuse_shape(api_ctx *ctx, const char *ptr);
+/* The contours limit of a context (its default for 0). */
+size_t api__max_contours(const api_config *cfg);
 /* Parse a Signature object at ptr. */
 bool api__parse_signature(api_ctx *ctx, const cJSON *v, const char *ptr,
                           km_signature *out);

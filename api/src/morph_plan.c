@@ -16,9 +16,14 @@ void api_morph_plan_free(api_morph_plan *plan) {
   if (plan == NULL)
     return;
   km_morph_free(plan->morph);
+  km_shape_morph_free(plan->smorph);
+  km_shape_free(&plan->sfrom);
+  km_shape_free(&plan->sto);
+  km__free(plan->cmatches);
   for (size_t i = 0; plan->frames != NULL && i < plan->nframes; i++) {
     km_curve_free(&plan->frames[i].curve);
     km_signature_free(&plan->frames[i].sig);
+    km_shape_frame_free(&plan->frames[i].shape);
   }
   km__free(plan->frames);
   km__free(plan->matches);
@@ -41,6 +46,8 @@ static bool plan_new(api_ctx *ctx, const api_config *cfg,
   pl->cfg = *cfg;
   api__input_init(&pl->from);
   api__input_init(&pl->to);
+  km_shape_init(&pl->sfrom);
+  km_shape_init(&pl->sto);
   if (request_id != NULL) {
     size_t n = strlen(request_id);
     if ((pl->request_id = km__malloc(n + 1)) == NULL)
@@ -100,6 +107,8 @@ static bool plan_build(api_ctx *ctx, api_morph_plan *pl,
   pl->opt.tolerance = pl->tol;
   /* frames are curves of the answer: held to the limit on curves */
   pl->opt.max_points = pl->cfg.max_control_points;
+  if (pl->shapes)
+    return api__shape_build(ctx, pl, stop);
   if (pl->opt.method == KM_METHOD_CURVATURE &&
       (!input_signature(ctx, &pl->from, "/from", pl->tol, stop) ||
        !input_signature(ctx, &pl->to, "/to", pl->tol, stop)))
@@ -135,7 +144,9 @@ api_status api_morph_prepare(const api_config *cfg, const api_request *req,
   api__ctx_init(&ctx, cfg);
   if (!plan_new(&ctx, cfg, req->request_id, &pl) ||
       !plan_read(&ctx, req, max_frames, pl) ||
-      !plan_build(&ctx, pl, stop) || !api__morph_check_size(&ctx, pl, stop))
+      !plan_build(&ctx, pl, stop) ||
+      !(pl->shapes ? api__shape_check_size(&ctx, pl, stop)
+                   : api__morph_check_size(&ctx, pl, stop)))
     goto fail;
   *plan = pl;
   return API_STEP_DONE;
@@ -174,6 +185,12 @@ api_status api_morph_render_frame_until(api_morph_plan *plan, size_t i,
   f = &plan->frames[i];
   if (f->state == API_FRAME_DONE)
     return API_STEP_DONE;
+  if (plan->shapes) {
+    api__shape_render(plan, f, stop != NULL ? &ks : NULL);
+    if (f->state == API_FRAME_DONE)
+      return API_STEP_DONE;
+    return f->st == KM_ENOMEM || f->st == KM_ECANCELLED ? 503 : 422;
+  }
   km_curve_free(&f->curve);
   km_signature_free(&f->sig);
   memset(&f->err, 0, sizeof f->err);

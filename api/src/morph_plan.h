@@ -35,6 +35,7 @@ typedef struct api_frame_slot {
   km_curve curve;
   km_frame_metrics metrics;
   km_signature sig; /* only for curvature plots */
+  km_shape_frame shape; /* compound morphs: the frame, in place of curve */
   km_status st;
   km_error err;
 } api_frame_slot;
@@ -58,6 +59,13 @@ struct api_morph_plan {
   char stroke[API_COLOUR_MAX], from_color[API_COLOUR_MAX],
       to_color[API_COLOUR_MAX];
   size_t predicted; /* upper bound on the result's bytes */
+  /* A compound morph (either input a shape): the shapes, their morph,
+   * and the request's contour pairing (NULL: automatic). */
+  bool shapes;
+  km_shape sfrom, sto;
+  km_shape_morph *smorph;
+  km_shape_pair *cmatches;
+  size_t ncmatches;
 };
 
 /* "method" names, indexed by km_morph_method. */
@@ -80,5 +88,49 @@ bool api__morph_read_request(api_ctx *ctx, const cJSON *root,
  * False with the error in ctx. */
 bool api__morph_check_size(api_ctx *ctx, api_morph_plan *pl,
                            const km_stop *stop);
+
+/* A frame's metrics object (morph_result.c). */
+cJSON *api__metrics_json(api_ctx *ctx, const km_frame_metrics *m);
+/* Cubic pieces of a path "M x y C ..." as api_svg_path_d writes it. */
+size_t api__count_pieces(const char *d);
+
+/* ---- compound morphs (morph_shape.c) ---- */
+
+/* The optional "contour_matches": [[i | null, j | null], ...], at most
+ * 2 x the contour limit pairs, into pl->cmatches (the contours' ranges are
+ * checked once the shapes are built). False with the error in ctx. */
+bool api__shape_read_matches(api_ctx *ctx, const cJSON *root,
+                             api_morph_plan *pl);
+
+/* After both inputs are read: a compound morph when either is a shape
+ * (pl->shapes); refuses what a compound morph does not take (a signature
+ * input, an open single curve, explicit arc-length "matches", an SVG
+ * answer) and contour_matches without a shape. */
+bool api__shape_check_request(api_ctx *ctx, api_morph_plan *pl);
+
+/* Build both shapes and their morph under pl->opt (stop polled), every
+ * failure naming the contour ("/from/contours/2", or for SVG "/from/d"
+ * with the subpath's offset). */
+bool api__shape_build(api_ctx *ctx, api_morph_plan *pl, const km_stop *stop);
+
+/* Render frame slot f of a compound morph. */
+void api__shape_render(api_morph_plan *pl, api_frame_slot *f,
+                       const km_stop *stop);
+
+/* Bound the answer of a compound morph (as api__morph_check_size). */
+bool api__shape_check_size(api_ctx *ctx, api_morph_plan *pl,
+                           const km_stop *stop);
+
+/* The JSON answer's frame of a compound morph: t, contours (null for an
+ * absent one), svg_d when asked, metrics when asked. */
+cJSON *api__shape_frame_json(api_ctx *ctx, const api_morph_plan *pl,
+                             const api_frame_slot *f);
+
+/* "contour_matches_used": the pairs of the morph. */
+cJSON *api__shape_pairs_json(api_ctx *ctx, const api_morph_plan *pl);
+
+/* "animate_d" of a compound morph: every frame as one path of the present
+ * contours, each slot with one common number of pieces. */
+cJSON *api__shape_animate_json(api_ctx *ctx, const api_morph_plan *pl);
 
 #endif

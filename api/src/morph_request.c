@@ -281,6 +281,7 @@ static bool parse_times(api_ctx *ctx, const cJSON *root, size_t max_frames,
   for (size_t i = 0; i < n; i++) {
     km_curve_init(&pl->frames[i].curve);
     km_signature_init(&pl->frames[i].sig);
+    km_shape_frame_init(&pl->frames[i].shape);
   }
   return true;
 }
@@ -327,7 +328,8 @@ static bool parse_options(api_ctx *ctx, const cJSON *root,
   pl->opt.degree = (int)degree;
   /* An explicit "format" wins over the Accept header. */
   pl->svg = fmt_present ? format == 1 : false;
-  return parse_svg_options(ctx, root, pl) && parse_matches(ctx, root, pl);
+  return parse_svg_options(ctx, root, pl) && parse_matches(ctx, root, pl) &&
+         api__shape_read_matches(ctx, root, pl);
 }
 
 bool api__morph_read_request(api_ctx *ctx, const cJSON *root,
@@ -343,5 +345,6 @@ bool api__morph_read_request(api_ctx *ctx, const cJSON *root,
                           cJSON_GetObjectItemCaseSensitive(root, "from"),
                           "/from", pl->tol, &pl->from) &&
          api__parse_curve(ctx, cJSON_GetObjectItemCaseSensitive(root, "to"),
-                          "/to", pl->tol, &pl->to);
+                          "/to", pl->tol, &pl->to) &&
+         api__shape_check_request(ctx, pl);
 }

@@ -12,7 +12,7 @@
 
 /* Number of cubic pieces in an SVG path written as "M x y C ..." with the
  * C command not repeated: six numbers a piece after the two of the moveto. */
-static size_t count_pieces(const char *d) {
+size_t api__count_pieces(const char *d) {
   size_t numbers = 0;
   while (*d != '\0') {
     char *end;
@@ -31,7 +31,7 @@ static size_t count_pieces(const char *d) {
   return numbers > 2 ? (numbers - 2) / 6 : 1;
 }
 
-static cJSON *metrics_json(api_ctx *ctx, const km_frame_metrics *m) {
+cJSON *api__metrics_json(api_ctx *ctx, const km_frame_metrics *m) {
   cJSON *o = cJSON_CreateObject();
   if (o == NULL) {
     api__oom(ctx);
@@ -61,7 +61,7 @@ static cJSON *animate_json(api_ctx *ctx, const api_morph_plan *pl) {
       api__oom(ctx);
       return NULL;
     }
-    pieces = count_pieces(d) > pieces ? count_pieces(d) : pieces;
+    pieces = api__count_pieces(d) > pieces ? api__count_pieces(d) : pieces;
     km__free(d);
   }
   a = cJSON_CreateArray();
@@ -86,8 +86,10 @@ static cJSON *animate_json(api_ctx *ctx, const api_morph_plan *pl) {
 /* One frame's object: its t, its curve, its metrics when asked for. */
 static cJSON *frame_json(api_ctx *ctx, const api_morph_plan *pl,
                          const api_frame_slot *f) {
-  cJSON *fo = cJSON_CreateObject(), *c;
-  if (fo == NULL) {
+  cJSON *fo, *c;
+  if (pl->shapes)
+    return api__shape_frame_json(ctx, pl, f);
+  if ((fo = cJSON_CreateObject()) == NULL) {
     api__oom(ctx);
     return NULL;
   }
@@ -98,7 +100,7 @@ static cJSON *frame_json(api_ctx *ctx, const api_morph_plan *pl,
   if (!api__add_item(ctx, fo, "curve", c))
     goto fail;
   if (pl->metrics) {
-    if ((c = metrics_json(ctx, &f->metrics)) == NULL ||
+    if ((c = api__metrics_json(ctx, &f->metrics)) == NULL ||
         !api__add_item(ctx, fo, "metrics", c))
       goto fail;
   }
@@ -179,13 +181,18 @@ static api_status result_json(api_ctx *ctx, api_morph_plan *pl,
     if (!text_put_item(&t, i > 0 ? "," : "", fo))
       goto oom;
   }
-  cJSON *item = matches_used_json(ctx, pl->morph);
+  cJSON *item = pl->shapes ? api__shape_pairs_json(ctx, pl)
+                            : matches_used_json(ctx, pl->morph);
   if (item == NULL)
     goto fail;
-  if (!text_put_item(&t, "],\"matches_used\":", item))
+  if (!text_put_item(&t,
+                     pl->shapes ? "],\"contour_matches_used\":"
+                                : "],\"matches_used\":",
+                     item))
     goto oom;
   if (pl->inc.animate_d) {
-    if ((item = animate_json(ctx, pl)) == NULL)
+    if ((item = pl->shapes ? api__shape_animate_json(ctx, pl)
+                           : animate_json(ctx, pl)) == NULL)
       goto fail;
     if (!text_put_item(&t, ",\"animate_d\":", item))
       goto oom;

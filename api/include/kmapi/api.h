@@ -36,6 +36,9 @@ typedef struct api_config {
                                      before it is rendered) is 422
                                      limit-exceeded naming /frames,
                                      /times, /samples or /tolerance */
+  size_t max_contours;            /* 64 contours (subpaths) per shape; 0
+                                     asks for the default; more is 422
+                                     limit-exceeded naming the contour */
 } api_config;
 
 /* Fill *cfg (out, not read) with the defaults listed above. */

@@ -1,0 +1,570 @@
+/* morph_shape.c - the morph of compound shapes: the request's contour
+ * pairing, the shapes built from the inputs, their frames rendered, the
+ * answer's size bounded and its frames printed.
+ *
+ * DESIGN: a compound morph runs through the same plan as a single one
+ * (api_morph_prepare, render_frame_until, result), with the shapes and
+ * their km_shape_morph in place of the km_morph and a km_shape_frame in
+ * each slot. A single curve on one side is a shape of one contour. Every
+ * failure names the contour it is about: "/from/contours/2" for a JSON
+ * shape, "/from/d" with the subpath's offset for SVG, since a pointer
+ * cannot reach inside a string.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "km/alloc.h"
+#include "morph_plan.h"
+
+/* A contour index of "contour_matches": null, or an integer in
+ * [0, KM_SHAPE_MAX_CONTOURS). */
+static bool match_index(api_ctx *ctx, const cJSON *item, const double *num,
+                        const char *ptr, long *out) {
+  double v;
+  if (num == NULL && cJSON_IsNull(item)) {
+    *out = -1;
+    return true;
+  }
+  if (num == NULL && !cJSON_IsNumber(item))
+    return api__invalid(ctx, ptr, "must be a contour index or null");
+  v = num != NULL ? *num : item->valuedouble;
+  if (!(v >= 0 && v < KM_SHAPE_MAX_CONTOURS) || v != floor(v))
+    return api__invalid(ctx, ptr,
+                        "must be a contour index (an integer >= 0) or null");
+  *out = (long)v;
+  return true;
+}
+
+/* Pair k of "contour_matches" (an element, packed or not) into *pr. */
+static bool match_pair(api_ctx *ctx, const api_elems *it, const char *ptr,
+                       km_shape_pair *pr) {
+  char p[API_POINTER_MAX], q[API_POINTER_MAX];
+  long idx[2];
+  api__ptr_idx(p, ptr, it->index);
+  if (it->packed != NULL && it->width != 2)
+    return api__invalid(ctx, p, "must be a pair [i, j] of contour indices");
+  if (it->packed == NULL &&
+      (!cJSON_IsArray(it->item) || api__array_len(it->item) != 2))
+    return api__invalid(ctx, p,
+                        "must be a pair [i, j] (contour indices, or null "
+                        "for an unpaired contour)");
+  size_t w = 0;
+  const double *nums =
+      it->packed != NULL ? it->packed + 2 * it->index
+                         : api__array_packed(it->item, &w);
+  if (w != 0)
+    return api__invalid(ctx, p, "must be a pair [i, j] of contour indices");
+  for (int k = 0; k < 2; k++) {
+    const cJSON *e = nums == NULL ? cJSON_GetArrayItem(it->item, k) : NULL;
+    api__ptr_idx(q, p, (size_t)k);
+    if (!match_index(ctx, e, nums != NULL ? nums + k : NULL, q, &idx[k]))
+      return false;
+  }
+  if (idx[0] < 0 && idx[1] < 0)
+    return api__invalid(ctx, p, "must name a contour on at least one side");
+  pr->from = idx[0];
+  pr->to = idx[1];
+  return true;
+}
+
+bool api__shape_read_matches(api_ctx *ctx, const cJSON *root,
+                             api_morph_plan *pl) {
+  const cJSON *v = cJSON_GetObjectItemCaseSensitive(root, "contour_matches");
+  size_t n, max = 2 * api__max_contours(&pl->cfg);
+  api_elems it;
+  if (v == NULL || cJSON_IsNull(v))
+    return true;
+  if (!cJSON_IsArray(v) || (n = api__array_len(v)) == 0)
+    return api__invalid(ctx, "/contour_matches",
+                        "must be a non-empty array of [i, j] pairs (null "
+                        "for an unpaired contour)");
+  if (n > max)
+    return api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded",
+                      "/contour_matches", "has %zu pairs; the limit is %zu",
+                      n, max);
+  if ((pl->cmatches = km__malloc(n * sizeof *pl->cmatches)) == NULL)
+    return api__oom(ctx);
+  api__elems_start(&it, v);
+  for (size_t i = 0; i < n; i++) {
+    if (i > 0)
+      api__elems_next(&it);
+    if (!match_pair(ctx, &it, "/contour_matches", &pl->cmatches[i]))
+      return false;
+  }
+  pl->ncmatches = n;
+  return true;
+}
+
+/* The single-curve side of a compound morph must be a closed curve. */
+static bool check_single(api_ctx *ctx, const api_input *in,
+                         const char *ptr) {
+  if (in->is_shape)
+    return true;
+  if (in->is_signature)
+    return api__invalid(ctx, ptr,
+                        "a signature cannot be morphed with a shape: give "
+                        "the contour as a curve");
+  if (!in->curve.closed)
+    return api__invalid(ctx, ptr,
+                        "an open curve cannot be morphed with a shape: "
+                        "every contour of a shape is closed");
+  return true;
+}
+
+bool api__shape_check_request(api_ctx *ctx, api_morph_plan *pl) {
+  if (!pl->from.is_shape && !pl->to.is_shape) {
+    if (pl->cmatches != NULL)
+      return api__invalid(ctx, "/contour_matches",
+                          "pairs the contours of shapes: neither input "
+                          "has several contours");
+    return true;
+  }
+  pl->shapes = true;
+  if (!check_single(ctx, &pl->from, "/from") ||
+      !check_single(ctx, &pl->to, "/to"))
+    return false;
+  if (pl->opt.nmatches > 0)
+    return api__invalid(ctx, "/matches",
+                        "arc-length matches pair points of two single "
+                        "curves; pair the contours of shapes with "
+                        "\"contour_matches\"");
+  if (pl->svg)
+    return api__invalid(ctx, "/format",
+                        "SVG documents of compound shapes are not "
+                        "available: ask for \"format\": \"json\" (svg_d in "
+                        "\"include\" gives each frame's path)");
+  return true;
+}
+
+/* ------------------------------------------------------------ building */
+
+/* The failure st of contour i of in (at ptr): the core's problem under the
+ * contour's pointer, its place ahead of the message. */
+static bool contour_fail(api_ctx *ctx, const api_input *in, const char *ptr,
+                         long i, km_status st, const km_error *err) {
+  char p[API_POINTER_MAX], where[96], msg[API_TEXT_MAX];
+  km_error e = *err;
+  if (st == KM_ENOMEM)
+    return api__oom(ctx);
+  if (st == KM_ECANCELLED)
+    return api__stopped(ctx);
+  e.field = KM_FIELD_NONE;
+  if (!in->is_shape || i < 0 || (size_t)i >= in->ncontours)
+    return api__core_fail(ctx, st, &e, ptr, API_KIND_REQUEST);
+  api__contour_ptr(p, in, ptr, (size_t)i);
+  api__contour_where(where, sizeof where, in, (size_t)i);
+  api__core_fail(ctx, st, &e, p, API_KIND_CURVE);
+  if (ctx->message[0] != '\0' && strncmp(ctx->message, where,
+                                         strlen(where)) != 0) {
+    snprintf(msg, sizeof msg, "%s: ", where);
+    strncat(msg, ctx->message, sizeof msg - strlen(msg) - 1);
+    memcpy(ctx->message, msg, sizeof msg);
+    memcpy(ctx->detail, msg, sizeof msg);
+  }
+  return false;
+}
+
+static bool shape_of(api_ctx *ctx, const api_input *in, const char *ptr,
+                     const api_config *cfg, km_shape *out) {
+  km_shape_limits lim = {api__max_contours(cfg), cfg->max_control_points};
+  const km_curve *c = in->is_shape ? in->contours : &in->curve;
+  size_t n = in->is_shape ? in->ncontours : 1;
+  km_error err;
+  km_status st = km_shape_create(out, c, n, in->fill, &lim, &err);
+  if (st != KM_OK)
+    return contour_fail(ctx, in, ptr, err.index, st, &err);
+  return true;
+}
+
+/* A pairing's failure: the pair of "contour_matches" at fault. */
+static bool matches_fail(api_ctx *ctx, const api_morph_plan *pl,
+                         const km_error *err) {
+  char p[API_POINTER_MAX];
+  if (err->index >= 0 && (size_t)err->index < pl->ncmatches)
+    api__ptr_idx(p, "/contour_matches", (size_t)err->index);
+  else
+    snprintf(p, sizeof p, "/contour_matches");
+  return api__fail(ctx, 422, API_P_INVALID_REQUEST, "Invalid request", p,
+                   err->message[0] != '\0' ? err->message
+                                           : km_status_message(KM_EMATCH));
+}
+
+/* A pair's morph failed: name the contour of its from side (its to side
+ * when it has none). */
+static bool pair_fail(api_ctx *ctx, const api_morph_plan *pl,
+                      const km_shape_pair *pairs, size_t npairs,
+                      km_status st, const km_error *err) {
+  if (err->index >= 0 && (size_t)err->index < npairs) {
+    const km_shape_pair *pr = &pairs[err->index];
+    if (pr->from >= 0)
+      return contour_fail(ctx, &pl->from, "/from", pr->from, st, err);
+    return contour_fail(ctx, &pl->to, "/to", pr->to, st, err);
+  }
+  return contour_fail(ctx, &pl->from, "", -1, st, err);
+}
+
+bool api__shape_build(api_ctx *ctx, api_morph_plan *pl, const km_stop *stop) {
+  km_shape_morph_options so;
+  km_shape_pair *pairs = NULL;
+  size_t npairs = 0;
+  km_error err;
+  km_status st;
+  bool ok = false;
+  if (!shape_of(ctx, &pl->from, "/from", &pl->cfg, &pl->sfrom) ||
+      !shape_of(ctx, &pl->to, "/to", &pl->cfg, &pl->sto))
+    return false;
+  if (pl->cmatches != NULL) {
+    st = km_shape_pair_check(&pl->sfrom, &pl->sto, pl->cmatches,
+                             pl->ncmatches, &err);
+    if (st != KM_OK)
+      return st == KM_EMATCH ? matches_fail(ctx, pl, &err)
+                             : contour_fail(ctx, &pl->from, "", -1, st, &err);
+    pairs = pl->cmatches;
+    npairs = pl->ncmatches;
+  } else {
+    /* paired here, not inside the morph, so that a pair's failure can
+     * name its contours */
+    st = km_shape_pair_auto(&pl->sfrom, &pl->sto, NULL, stop, &pairs,
+                            &npairs, &err);
+    if (st != KM_OK)
+      return contour_fail(ctx, &pl->from, "", -1, st, &err);
+  }
+  km_shape_morph_options_default(&so);
+  so.morph = pl->opt;
+  so.morph.stop = NULL;
+  so.pairs = pairs;
+  so.npairs = npairs;
+  st = km_shape_morph_create(&pl->smorph, &pl->sfrom, &pl->sto, &so, stop,
+                             &err);
+  if (st == KM_EMATCH && pl->cmatches != NULL)
+    matches_fail(ctx, pl, &err);
+  else if (st != KM_OK)
+    pair_fail(ctx, pl, pairs, npairs, st, &err);
+  else
+    ok = true;
+  if (pairs != pl->cmatches)
+    km_shape_pairs_free(pairs);
+  return ok;
+}
+
+void api__shape_render(api_morph_plan *pl, api_frame_slot *f,
+                       const km_stop *stop) {
+  km_shape_frame_free(&f->shape);
+  memset(&f->err, 0, sizeof f->err);
+  f->st = km_shape_morph_frame_until(pl->smorph, f->t, stop, &f->shape,
+                                     &f->err);
+  f->state = f->st == KM_OK ? API_FRAME_DONE : API_FRAME_FAILED;
+}
+
+/* -------------------------------------------------------- the answer's size */
+
+/* Members, keys and punctuation of a frame, and of one contour's slot (its
+ * metrics' numbers included), besides the curves' numbers. */
+#define SHAPE_FRAME_FIXED 200
+#define SHAPE_SLOT_FIXED 400
+#define SHAPE_DOC_FIXED 4096
+
+/* Degree and rationality of the frames' curves: the method's degree for
+ * curvature morphs, the inputs' highest for linear ones. */
+static void frame_kind(const api_morph_plan *pl, int *degree,
+                       bool *rational) {
+  const km_shape *sh[2] = {&pl->sfrom, &pl->sto};
+  *degree = pl->opt.degree;
+  *rational = false;
+  if (pl->opt.method != KM_METHOD_LINEAR)
+    return;
+  *degree = 1;
+  for (int k = 0; k < 2; k++)
+    for (size_t i = 0; i < sh[k]->ncontours; i++) {
+      const km_curve *c = &sh[k]->contours[i];
+      *degree = c->degree > *degree ? c->degree : *degree;
+      *rational = *rational || c->w != NULL;
+    }
+}
+
+/* Control points of each slot at most (points[npairs], zeroed): frames
+ * at the first, middle and last times are built and counted; a slot's
+ * count is taken as exact when every frame is among them or its count
+ * agrees at two or more of them (a planned pair's count does not move with
+ * t), else given a quarter more. */
+static km_status slot_points(const api_morph_plan *pl, const km_stop *stop,
+                             size_t npairs, size_t *points, km_error *err) {
+  size_t idx[3] = {0, pl->nframes / 2, pl->nframes - 1};
+  size_t *seen = km__calloc(npairs ? 2 * npairs : 1, sizeof *seen);
+  km_shape_frame f;
+  km_status st = KM_OK;
+  if (seen == NULL)
+    return KM_ENOMEM;
+  km_shape_frame_init(&f);
+  for (int k = 0; k < 3 && st == KM_OK; k++) {
+    st = km_shape_morph_frame_until(pl->smorph, pl->frames[idx[k]].t, stop,
+                                    &f, err);
+    for (size_t j = 0; st == KM_OK && j < npairs && j < f.ncontours; j++) {
+      size_t n = f.present[j] ? f.contours[j].n : 0;
+      if (n == 0)
+        continue;
+      if (seen[2 * j] > 0 && n != points[j])
+        seen[2 * j + 1] = 1; /* counts differ */
+      points[j] = n > points[j] ? n : points[j];
+      seen[2 * j]++;
+    }
+    km_shape_frame_free(&f);
+  }
+  for (size_t j = 0; st == KM_OK && j < npairs; j++)
+    if (pl->nframes > 3 && (seen[2 * j] < 2 || seen[2 * j + 1]))
+      points[j] += points[j] / 4 + 8;
+  km__free(seen);
+  return st;
+}
+
+/* Upper bound on the answer's bytes for slots of points[] control
+ * points. */
+static size_t predict_bytes(const api_morph_plan *pl, const size_t *points,
+                            size_t npairs) {
+  int degree;
+  bool rational;
+  bool hermite = pl->opt.method == KM_METHOD_CURVATURE;
+  size_t per = SHAPE_FRAME_FIXED;
+  frame_kind(pl, &degree, &rational);
+  for (size_t j = 0; j < npairs; j++) {
+    size_t paths = (pl->inc.svg_d ? 1 : 0) + (pl->inc.animate_d ? 1 : 0);
+    size_t numbers = api__path_numbers(points[j], degree, hermite);
+    size_t slot = SHAPE_SLOT_FIXED +
+                  api__curve_json_bytes(points[j], degree, rational, false);
+    if (numbers > (SIZE_MAX / 4 - slot) / (API_SVG_NUM_BYTES + 1))
+      return SIZE_MAX;
+    slot += paths * (16 + API_SVG_NUM_BYTES * numbers);
+    if (slot > SIZE_MAX / 4 - per)
+      return SIZE_MAX;
+    per += slot;
+  }
+  size_t fixed = SHAPE_DOC_FIXED + (2 * API_JSON_NUM_BYTES + 3) * npairs;
+  if (pl->nframes > 0 && per > (SIZE_MAX - fixed) / pl->nframes)
+    return SIZE_MAX;
+  return fixed + per * pl->nframes;
+}
+
+bool api__shape_check_size(api_ctx *ctx, api_morph_plan *pl,
+                           const km_stop *stop) {
+  size_t npairs = km_shape_morph_pairs(pl->smorph, NULL, 0), total = 0;
+  size_t limit = pl->cfg.max_output_bytes;
+  size_t *points = km__calloc(npairs ? npairs : 1, sizeof *points);
+  km_error err;
+  km_status st;
+  bool ok = false;
+  if (points == NULL)
+    return api__oom(ctx);
+  st = slot_points(pl, stop, npairs, points, &err);
+  if (st != KM_OK) {
+    contour_fail(ctx, &pl->from, "", -1, st, &err);
+    goto done;
+  }
+  pl->predicted = predict_bytes(pl, points, npairs);
+  for (size_t j = 0; j < npairs; j++)
+    total += points[j];
+  if (limit == 0 || pl->predicted <= limit) {
+    ok = true;
+    goto done;
+  }
+  size_t nframes = pl->nframes;
+  pl->nframes = 2;
+  bool tol_dominates = predict_bytes(pl, points, npairs) > limit;
+  pl->nframes = nframes;
+  api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded",
+             tol_dominates ? "/tolerance" : api_morph_frames_pointer(pl),
+             "the answer would take up to %zu bytes (%zu frames of %zu "
+             "contours, up to %zu control points in all); the limit is %zu "
+             "bytes: %s",
+             pl->predicted, nframes, npairs, total, limit,
+             tol_dominates ? "loosen the tolerance" : "ask for fewer frames");
+done:
+  km__free(points);
+  return ok;
+}
+
+/* ------------------------------------------------------------- printing */
+
+/* The paths of the frame's present contours joined into one "d": each
+ * slot's own (pieces NULL) or with pieces[k] pieces and its Z. */
+static cJSON *joined_d(api_ctx *ctx, const km_shape_frame *sf, double tol,
+                       const size_t *pieces) {
+  api_svg_buf b;
+  cJSON *s = NULL;
+  api__svg_buf_init(&b);
+  for (size_t k = 0; k < sf->ncontours; k++) {
+    if (!sf->present[k])
+      continue;
+    char *d = pieces != NULL
+                  ? api_svg_path_d_fixed_z(&sf->contours[k], pieces[k], true)
+                  : api_svg_path_d(&sf->contours[k], tol, NULL);
+    if (d == NULL) {
+      b.failed = true;
+      break;
+    }
+    if (b.len > 0)
+      api__svg_buf_put(&b, " ");
+    api__svg_buf_put(&b, d);
+    km__free(d);
+  }
+  char *all = api__svg_buf_take(&b);
+  if (all != NULL)
+    s = cJSON_CreateString(all);
+  km__free(all);
+  if (s == NULL)
+    api__oom(ctx);
+  return s;
+}
+
+/* {"contours": [Metrics | null], "mutual_intersections", "nesting_ok"} */
+static cJSON *shape_metrics_json(api_ctx *ctx, const km_shape_frame *sf) {
+  cJSON *o = cJSON_CreateObject(), *a = cJSON_CreateArray(), *m;
+  if (o == NULL || a == NULL) {
+    cJSON_Delete(o);
+    cJSON_Delete(a);
+    api__oom(ctx);
+    return NULL;
+  }
+  if (!api__add_item(ctx, o, "contours", a))
+    goto fail;
+  for (size_t k = 0; k < sf->ncontours; k++) {
+    m = sf->present[k] ? api__metrics_json(ctx, &sf->metrics[k])
+                       : cJSON_CreateNull();
+    if (m == NULL || !cJSON_AddItemToArray(a, m)) {
+      cJSON_Delete(m);
+      api__oom(ctx);
+      goto fail;
+    }
+  }
+  if (!api__add_num(ctx, o, "mutual_intersections",
+                    (double)sf->mutual_intersections))
+    goto fail;
+  if (cJSON_AddBoolToObject(o, "nesting_ok", sf->nesting_ok) == NULL) {
+    api__oom(ctx);
+    goto fail;
+  }
+  return o;
+fail:
+  cJSON_Delete(o);
+  return NULL;
+}
+
+cJSON *api__shape_frame_json(api_ctx *ctx, const api_morph_plan *pl,
+                             const api_frame_slot *f) {
+  const km_shape_frame *sf = &f->shape;
+  cJSON *fo = cJSON_CreateObject(), *a = cJSON_CreateArray(), *c;
+  if (fo == NULL || a == NULL) {
+    cJSON_Delete(fo);
+    cJSON_Delete(a);
+    api__oom(ctx);
+    return NULL;
+  }
+  if (!api__add_num(ctx, fo, "t", f->t)) {
+    cJSON_Delete(a);
+    goto fail;
+  }
+  if (!api__add_item(ctx, fo, "contours", a))
+    goto fail;
+  for (size_t k = 0; k < sf->ncontours; k++) {
+    c = sf->present[k] ? api__curve_json(ctx, &sf->contours[k], false, pl->tol)
+                       : cJSON_CreateNull();
+    if (c == NULL || !cJSON_AddItemToArray(a, c)) {
+      cJSON_Delete(c);
+      api__oom(ctx);
+      goto fail;
+    }
+  }
+  if (pl->inc.svg_d && ((c = joined_d(ctx, sf, pl->tol, NULL)) == NULL ||
+                        !api__add_item(ctx, fo, "svg_d", c)))
+    goto fail;
+  if (pl->metrics && ((c = shape_metrics_json(ctx, sf)) == NULL ||
+                      !api__add_item(ctx, fo, "metrics", c)))
+    goto fail;
+  return fo;
+fail:
+  cJSON_Delete(fo);
+  return NULL;
+}
+
+/* A contour index of a pair, or null. */
+static cJSON *index_json(long i) {
+  return i >= 0 ? cJSON_CreateNumber((double)i) : cJSON_CreateNull();
+}
+
+cJSON *api__shape_pairs_json(api_ctx *ctx, const api_morph_plan *pl) {
+  size_t n = km_shape_morph_pairs(pl->smorph, NULL, 0);
+  km_shape_pair *pairs = km__malloc((n ? n : 1) * sizeof *pairs);
+  cJSON *a = cJSON_CreateArray();
+  if (pairs == NULL || a == NULL)
+    goto oom;
+  n = km_shape_morph_pairs(pl->smorph, pairs, n);
+  for (size_t k = 0; k < n; k++) {
+    cJSON *pr = cJSON_CreateArray();
+    cJSON *i = index_json(pairs[k].from), *j = index_json(pairs[k].to);
+    bool ok = pr != NULL && i != NULL && j != NULL &&
+              cJSON_AddItemToArray(pr, i);
+    if (ok)
+      i = NULL;
+    ok = ok && cJSON_AddItemToArray(pr, j);
+    if (ok)
+      j = NULL;
+    ok = ok && cJSON_AddItemToArray(a, pr);
+    if (!ok) {
+      cJSON_Delete(i);
+      cJSON_Delete(j);
+      cJSON_Delete(pr);
+      goto oom;
+    }
+  }
+  km__free(pairs);
+  return a;
+oom:
+  km__free(pairs);
+  cJSON_Delete(a);
+  api__oom(ctx);
+  return NULL;
+}
+
+cJSON *api__shape_animate_json(api_ctx *ctx, const api_morph_plan *pl) {
+  size_t n = km_shape_morph_pairs(pl->smorph, NULL, 0);
+  size_t *pieces = km__malloc((n ? n : 1) * sizeof *pieces);
+  cJSON *a = NULL, *s;
+  if (pieces == NULL)
+    goto oom;
+  for (size_t k = 0; k < n; k++)
+    pieces[k] = 1;
+  /* one piece count per slot, the most any frame needs: then every frame
+   * writes a slot with the same commands */
+  for (size_t i = 0; i < pl->nframes; i++) {
+    const km_shape_frame *sf = &pl->frames[i].shape;
+    for (size_t k = 0; k < n && k < sf->ncontours; k++) {
+      if (!sf->present[k])
+        continue;
+      char *d = api_svg_path_d(&sf->contours[k], pl->tol, NULL);
+      if (d == NULL)
+        goto oom;
+      size_t p = api__count_pieces(d);
+      pieces[k] = p > pieces[k] ? p : pieces[k];
+      km__free(d);
+    }
+  }
+  if ((a = cJSON_CreateArray()) == NULL)
+    goto oom;
+  for (size_t i = 0; i < pl->nframes; i++) {
+    if ((s = joined_d(ctx, &pl->frames[i].shape, pl->tol, pieces)) == NULL)
+      goto fail;
+    if (!cJSON_AddItemToArray(a, s)) {
+      cJSON_Delete(s);
+      goto oom;
+    }
+  }
+  km__free(pieces);
+  return a;
+oom:
+  api__oom(ctx);
+fail:
+  km__free(pieces);
+  cJSON_Delete(a);
+  return NULL;
+}
