@@ -130,11 +130,11 @@ bool api__shape_check_request(api_ctx *ctx, api_morph_plan *pl) {
                         "arc-length matches pair points of two single "
                         "curves; pair the contours of shapes with "
                         "\"contour_matches\"");
-  if (pl->svg)
-    return api__invalid(ctx, "/format",
-                        "SVG documents of compound shapes are not "
-                        "available: ask for \"format\": \"json\" (svg_d in "
-                        "\"include\" gives each frame's path)");
+  if (pl->svg && pl->svgopt.layout != API_SVG_FILMSTRIP)
+    return api__invalid(ctx, "/svg/layout",
+                        "compound shapes are drawn as a filmstrip only: "
+                        "ask for \"layout\": \"filmstrip\" (or JSON, whose "
+                        "svg_d gives each frame's path)");
   return true;
 }
 
@@ -331,8 +331,11 @@ static size_t predict_bytes(const api_morph_plan *pl, const size_t *points,
   for (size_t j = 0; j < npairs; j++) {
     size_t paths = (pl->inc.svg_d ? 1 : 0) + (pl->inc.animate_d ? 1 : 0);
     size_t numbers = api__path_numbers(points[j], degree, hermite);
-    size_t slot = SHAPE_SLOT_FIXED +
+    /* an SVG document holds each slot's path once a frame, nothing else */
+    size_t slot = pl->svg ? 64 : SHAPE_SLOT_FIXED +
                   api__curve_json_bytes(points[j], degree, rational, false);
+    if (pl->svg)
+      paths = 1;
     if (numbers > (SIZE_MAX / 4 - slot) / (API_SVG_NUM_BYTES + 1))
       return SIZE_MAX;
     slot += paths * (16 + API_SVG_NUM_BYTES * numbers);

@@ -10,6 +10,7 @@
 #include <stddef.h>
 
 #include "km/curve.h"
+#include "km/shape.h"
 #include "km/signature.h"
 
 /* Parse one SVG 1.1 path `d` (one subpath; every command, absolute and
@@ -94,6 +95,21 @@ typedef struct api_svg_frame {
 
 /* A complete, well-formed SVG document of a morph. NULL on out-of-memory. */
 char *api_svg_morph_document(const api_svg_frame *frames, size_t n,
+                             const api_svg_options *opt);
+
+/* A frame of a compound morph for its document. */
+typedef struct api_svg_shape_frame {
+  double t;
+  const km_shape_frame *shape;
+  km_fill_rule fill; /* the rule its path is filled under */
+} api_svg_shape_frame;
+
+/* A complete, well-formed SVG filmstrip of a compound morph: per frame one
+ * path of its present contours, filled (opt->stroke at 35% opacity) under
+ * the frame's fill rule and stroked; opt's layout is not looked at (the
+ * caller refuses the others), its sizes and stroke are. NULL on
+ * out-of-memory. */
+char *api_svg_shape_document(const api_svg_shape_frame *frames, size_t n,
                              const api_svg_options *opt);
 
 /* As api_svg_path_d_fixed, with the closing "Z" written when with_z is true

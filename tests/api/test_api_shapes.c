@@ -348,8 +348,10 @@ static void contours_past_the_limit_are_refused(void **state) {
 
 static void what_shapes_do_not_take_is_named(void **state) {
   (void)state;
-  at_problem(MORPH, "{\"from\":" RING ",\"to\":" RING ",\"format\":\"svg\"}",
-             422, "/format");
+  at_problem(MORPH,
+             "{\"from\":" RING ",\"to\":" RING ",\"format\":\"svg\","
+             "\"svg\":{\"layout\":\"overlay\"}}",
+             422, "/svg/layout");
   at_problem(MORPH,
              "{\"from\":" RING ",\"to\":" RING ",\"matches\":[[0.5,0.5]]}",
              422, "/matches");
@@ -365,6 +367,87 @@ static void what_shapes_do_not_take_is_named(void **state) {
              "{\"from\":" SQ(0) ",\"to\":" SQ(3)
              ",\"contour_matches\":[[0,0]]}",
              422, "/contour_matches");
+}
+
+/* ---- SVG documents ---- */
+
+/* The paths of an SVG document: their count, and each one's subpaths
+ * (moveto letters of its d) and fill-rule checked. */
+static size_t check_paths(const char *doc, const char *rule,
+                          const size_t *subpaths, size_t n) {
+  size_t count = 0;
+  char want[40];
+  snprintf(want, sizeof want, "fill-rule=\"%s\"", rule);
+  for (const char *p = strstr(doc, "<path "); p != NULL;
+       p = strstr(p + 1, "<path ")) {
+    const char *end = strstr(p, "/>"), *d = strstr(p, " d=\"");
+    assert_non_null(end);
+    assert_non_null(d);
+    assert_true(d < end);
+    const char *r = strstr(p, want);
+    assert_true(r != NULL && r < end);
+    size_t m = 0, z = 0;
+    for (const char *q = d + 4; *q != '"'; q++) {
+      m += *q == 'M';
+      z += *q == 'Z';
+    }
+    assert_true(count < n);
+    assert_int_equal(m, subpaths[count]);
+    assert_int_equal(z, subpaths[count]);
+    count++;
+  }
+  return count;
+}
+
+static void svg_filmstrip_fills_every_frame(void **state) {
+  (void)state;
+  api_response res;
+  const size_t two[3] = {2, 2, 2};
+  at_call(MORPH,
+          "{\"from\":" RING ",\"to\":" RING ",\"frames\":3,"
+          "\"format\":\"svg\"}",
+          &res, NULL);
+  assert_int_equal(res.status, 200);
+  assert_string_equal(res.content_type, "image/svg+xml");
+  assert_non_null(strstr(res.body, "</svg>"));
+  /* one filled path a frame, one subpath a contour */
+  assert_int_equal(check_paths(res.body, "nonzero", two, 3), 3);
+  api_response_free(&res);
+  at_call(MORPH,
+          "{\"from\":{\"type\":\"shape\",\"fill_rule\":\"evenodd\","
+          "\"contours\":[" SQ(0) "," SQ(3) "]},\"to\":{\"type\":"
+          "\"shape\",\"fill_rule\":\"evenodd\",\"contours\":[" SQ(0) ","
+          SQ(3) "]},\"frames\":2,\"format\":\"svg\"}",
+          &res, NULL);
+  assert_int_equal(res.status, 200);
+  assert_int_equal(check_paths(res.body, "evenodd", two, 2), 2);
+  api_response_free(&res);
+}
+
+/* The O of the fixtures loses its hole on the way to the C: the last
+ * frame's path has one subpath; the bound holds for documents too. */
+static void svg_of_o_to_c_within_its_bound(void **state) {
+  (void)state;
+  char *body = glyph_request("dejavu-sans/O", "dejavu-sans/C",
+                             ",\"frames\":3,\"format\":\"svg\"");
+  const size_t sub[3] = {2, 2, 1};
+  api_config cfg;
+  api_request req;
+  api_response err, res;
+  api_morph_plan *plan = NULL;
+  api_config_default(&cfg);
+  memset(&req, 0, sizeof req);
+  req.route = MORPH;
+  req.body = body;
+  req.length = strlen(body);
+  assert_int_equal(api_morph_prepare(&cfg, &req, 10, &plan, &err),
+                   API_STEP_DONE);
+  assert_int_equal(api_morph_result(plan, &res), 200);
+  assert_int_equal(check_paths(res.body, "nonzero", sub, 3), 3);
+  assert_true(api_morph_predicted_bytes(plan) >= res.length);
+  api_morph_plan_free(plan);
+  api_response_free(&res);
+  free(body);
 }
 
 /* ---- the prepared plan, its stop and its size ---- */
@@ -518,6 +601,8 @@ static const struct CMUnitTest tests[] = {
     cmocka_unit_test(subpath_offsets_are_given),
     cmocka_unit_test(contours_past_the_limit_are_refused),
     cmocka_unit_test(what_shapes_do_not_take_is_named),
+    cmocka_unit_test(svg_filmstrip_fills_every_frame),
+    cmocka_unit_test(svg_of_o_to_c_within_its_bound),
     cmocka_unit_test(prepared_shapes_give_the_same_answer),
     cmocka_unit_test(answers_stay_within_their_bound),
     cmocka_unit_test(a_ring_has_one_signature_per_contour),

@@ -6,6 +6,7 @@ import json
 import math
 import os
 import unittest
+import xml.etree.ElementTree as ET
 
 from kmtest import ROOT, ContractCase, Daemon, circle_svg, run_job
 
@@ -122,14 +123,28 @@ class CompoundMorphs(ContractCase):
         self.assertEqual(r.status, 422)
         self.assertEqual(doc["errors"][0]["pointer"], "/from/contours/1")
 
-    def test_svg_document_of_shapes_names_format(self):
-        r = self.d.request("POST", "/v1/morph",
-                           body={"from": ring(2.0, 1.0),
-                                 "to": ring(3.0, 1.0)},
+    def test_svg_document_of_shapes_is_a_filled_filmstrip(self):
+        body = self.body(4)
+        del body["include"]
+        r = self.d.request("POST", "/v1/morph", body=body,
+                           headers={"Accept": "image/svg+xml"})
+        self.assertEqual(r.status, 200, r.body[:300])
+        svg = self.assertDocumented(r, "/v1/morph", "post").decode()
+        root = ET.fromstring(svg)
+        paths = root.findall(".//{http://www.w3.org/2000/svg}path")
+        # one filled path a frame; the ends have the inputs' contour counts
+        self.assertEqual(len(paths), 4)
+        for p in paths:
+            self.assertIn(p.get("fill-rule"), ("nonzero", "evenodd"))
+            self.assertNotEqual(p.get("fill"), "none")
+        self.assertEqual(paths[0].get("d").count("M"), PAIR["counts"][0])
+        self.assertEqual(paths[-1].get("d").count("M"), PAIR["counts"][1])
+        body["svg"] = {"layout": "animate"}
+        r = self.d.request("POST", "/v1/morph", body=body,
                            headers={"Accept": "image/svg+xml"})
         doc = self.assertDocumented(r, "/v1/morph", "post")
         self.assertEqual(r.status, 422)
-        self.assertEqual(doc["errors"][0]["pointer"], "/format")
+        self.assertEqual(doc["errors"][0]["pointer"], "/svg/layout")
 
 
 if __name__ == "__main__":
