@@ -295,17 +295,26 @@ static km_status frame_impl(const km_morph *m, double t, km__poll *poll,
                             km_curve *out, km_frame_metrics *metrics,
                             km_signature *sig_out, km_error *err);
 
-static long preview_crossings(const km_morph *m, long cap) {
+/* The crossings into *count, or KM_ENOMEM / KM_ECANCELLED: a preview that
+ * could not be made must fail the morph, not make another start win. */
+static km_status preview_crossings(const km_morph *m, long cap, long *count) {
   long total = 0;
   static const double T[5] = {3 / 6.0, 2 / 6.0, 4 / 6.0, 1 / 6.0, 5 / 6.0};
   for (int k = 0; k < 5 && total < cap; k++) {
     km_curve c;
-    if (frame_impl(m, T[k], m->poll, &c, NULL, NULL, NULL) != KM_OK) return LONG_MAX;
+    km_status st = frame_impl(m, T[k], m->poll, &c, NULL, NULL, NULL);
+    if (st == KM_ENOMEM || st == KM_ECANCELLED) return st;
+    if (st != KM_OK) {
+      total = LONG_MAX; /* a frame that cannot be built loses */
+      break;
+    }
     long x = km__self_intersections(&c, m->tol, m->poll);
     km_curve_free(&c);
-    if (x > 0) total += x;
+    if (x < 0) return m->poll && m->poll->stopped ? KM_ECANCELLED : KM_ENOMEM;
+    total += x;
   }
-  return total;
+  *count = total;
+  return KM_OK;
 }
 
 /* Among starts that align about as well, prefer one whose frames do not
@@ -314,34 +323,44 @@ static long preview_crossings(const km_morph *m, long cap) {
  * failing that the one with the fewest crossings, the better aligned
  * among equals. Only planned morphs preview (the default: turning blend,
  * cubic output): a frame of any other costs a blend and a reconstruction,
- * twenty of them more than the whole morph. Returns the morph kept (m or
- * one made from it) and frees the others. */
-static km_morph *pick_start(km_morph *m, const double *cand, size_t ncand,
+ * twenty of them more than the whole morph. *m is replaced by the morph
+ * kept (m or one made from it) and the others are freed; on failure
+ * (KM_ENOMEM, KM_ECANCELLED) every one is freed and *m is NULL. */
+static km_status pick_start(km_morph **mp, const double *cand, size_t ncand,
                             km__poll *poll) {
-  km_morph *alts[KM__SHIFT_CANDIDATES] = {m};
+  km_morph *alts[KM__SHIFT_CANDIDATES] = {*mp};
   size_t n = 1, pick = SIZE_MAX;
-  if (preview_crossings(m, 1) == 0) pick = 0;
-  for (size_t i = 1; i < ncand && pick == SIZE_MAX; i++) {
+  long x = 0;
+  km_status st = preview_crossings(alts[0], 1, &x);
+  if (st == KM_OK && x == 0) pick = 0;
+  for (size_t i = 1; st == KM_OK && i < ncand && pick == SIZE_MAX; i++) {
     km_morph *alt = NULL;
     double d = cand[i] - cand[0];
-    if (morph_shifted(m, d < 0 ? d + 1.0 : d, poll, &alt, NULL) != KM_OK)
-      continue;
+    km_status sst = morph_shifted(alts[0], d < 0 ? d + 1.0 : d, poll, &alt,
+                                  NULL);
+    if (sst == KM_ENOMEM || sst == KM_ECANCELLED) {
+      st = sst;
+      break;
+    }
+    if (sst != KM_OK) continue;
     alts[n++] = alt;
-    if (preview_crossings(alt, 1) == 0) pick = n - 1;
+    st = preview_crossings(alt, 1, &x);
+    if (st == KM_OK && x == 0) pick = n - 1;
   }
-  if (pick == SIZE_MAX) {
+  if (st == KM_OK && pick == SIZE_MAX) {
     long best = LONG_MAX;
-    for (size_t k = 0; k < n; k++) {
-      long x = preview_crossings(alts[k], best);
-      if (x < best || pick == SIZE_MAX) {
+    for (size_t k = 0; k < n && st == KM_OK; k++) {
+      st = preview_crossings(alts[k], best, &x);
+      if (st == KM_OK && (x < best || pick == SIZE_MAX)) {
         best = x;
         pick = k;
       }
     }
   }
   for (size_t k = 0; k < n; k++)
-    if (k != pick) km_morph_free(alts[k]);
-  return alts[pick];
+    if (st != KM_OK || k != pick) km_morph_free(alts[k]);
+  *mp = st == KM_OK ? alts[pick] : NULL;
+  return st;
 }
 
 km_status km_morph_create(km_morph **out, const km_morph_input *from,
@@ -356,11 +375,12 @@ km_status km_morph_create(km_morph **out, const km_morph_input *from,
   if (st == KM_ECANCELLED || (st && poll.stopped)) return km__stopped(err);
   if (st) return st;
   if (ncand > 1 && opt->method == KM_METHOD_CURVATURE && m->plan)
-    m = pick_start(m, cand, ncand, &poll);
-  if (poll.stopped) {
+    st = pick_start(&m, cand, ncand, &poll);
+  if (poll.stopped || st == KM_ECANCELLED) {
     km_morph_free(m);
     return km__stopped(err);
   }
+  if (st) return km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
   m->poll = NULL;
   m->opt.stop = NULL;
   *out = m;

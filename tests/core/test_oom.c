@@ -15,6 +15,7 @@
 #include "testutil.h"
 #include "testmain.h"
 #include "oomhook.h"
+#include "fixtures.h"
 
 /* Runs per loop at most: more than any call here allocates. */
 #define OOM_MAX_RUNS 20000
@@ -28,6 +29,7 @@ typedef struct shapes {
   km_curve arch;    /* open cubic arch */
   km_curve wave;    /* open cubic S */
   km_signature sig; /* of the circle */
+  km_curve letter_u, letter_s; /* U_to_S: several starts to preview */
 } shapes;
 
 static void open_cubic(km_curve *c, const double cp[10]) {
@@ -50,6 +52,21 @@ static int shapes_setup(void **state) {
   km_curve_init(&s.rect);
   assert_status(km_curve_create(&s.rect, 2, 17, kn, cp, w, true, NULL),
                 KM_OK);
+  {
+    /* U -> S: its best-aligned start's frames cross, so the morph plans
+     * and previews further starts to pick one. */
+    tf_bspline b;
+    const char which[2] = {'a', 'b'};
+    km_curve *dst[2] = {&s.letter_u, &s.letter_s};
+    for (int k = 0; k < 2; k++) {
+      assert_int_equal(tf_load_shape("U_to_S", which[k], &b), 0);
+      km_curve_init(dst[k]);
+      assert_status(km_curve_create(dst[k], b.degree, b.n, b.knots, b.cp,
+                                    b.w, b.closed, NULL),
+                    KM_OK);
+      tf_bspline_free(&b);
+    }
+  }
   open_cubic(&s.arch, arch);
   open_cubic(&s.wave, wave);
   km_signature_init(&s.sig);
@@ -64,6 +81,8 @@ static int shapes_teardown(void **state) {
   km_curve_free(&s->rect);
   km_curve_free(&s->arch);
   km_curve_free(&s->wave);
+  km_curve_free(&s->letter_u);
+  km_curve_free(&s->letter_s);
   km_signature_free(&s->sig);
   return 0;
 }
@@ -221,6 +240,15 @@ static void morph_curvature_closed_survives_oom(void **state) {
   oom_loop("morph curvature closed", run_morph, &c, false, OOM_MAX_RUNS);
 }
 
+/* A failed allocation while previewing the starts must fail the morph:
+ * it made another start win and answered a different morph. */
+static void morph_start_preview_survives_oom(void **state) {
+  shapes *s = *state;
+  morph_case c = {&s->letter_u, &s->letter_s, KM_METHOD_CURVATURE, NULL, 0, false,
+                  false};
+  oom_loop("morph start preview", run_morph, &c, false, OOM_MAX_RUNS);
+}
+
 static void morph_curvature_closed_metrics_survives_oom(void **state) {
   shapes *s = *state;
   morph_case c = {&s->circle, &s->rect, KM_METHOD_CURVATURE, NULL, 0, false,
@@ -272,6 +300,7 @@ static const struct CMUnitTest tests[] = {
     cmocka_unit_test(path_to_curve_survives_oom),
     cmocka_unit_test(morph_curvature_closed_survives_oom),
     cmocka_unit_test(morph_curvature_closed_metrics_survives_oom),
+    cmocka_unit_test(morph_start_preview_survives_oom),
     cmocka_unit_test(morph_curvature_open_survives_oom),
     cmocka_unit_test(morph_linear_closed_survives_oom),
     cmocka_unit_test(morph_linear_open_survives_oom),
