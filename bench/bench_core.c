@@ -127,9 +127,9 @@ int main(void) {
          "length, one thread\n\n");
   printf("%8s %10s %8s | %11s %8s %9s | %11s %8s %9s\n", "", "signature",
          "kappa", "reconstruct", "output", "", "reconstruct", "output", "");
-  printf("%8s %10s %8s | %11s %8s %9s | %11s %8s %9s\n", "ctrl pts",
-         "us/call", "pieces", "deg 3 us", "points", "bound/tol", "deg 5 us",
-         "points", "bound/tol");
+  printf("%8s %10s %8s | %11s %8s %9s | %11s %8s %9s\n", "ctrl pts", "us/call",
+         "pieces", "deg 3 us", "points", "bound/tol", "deg 5 us", "points",
+         "bound/tol");
   for (int k = 0; k < 3; k++) {
     km_curve c;
     if (make_shape(sizes[k], &c) != 0) return 1;
@@ -144,8 +144,7 @@ int main(void) {
     km_signature_init(&sig);
     if (km_signature_compute(&c, tol, &sig, &err) != KM_OK) return 1;
     size_t pieces = 0;
-    for (size_t i = 0; i + 1 < sig.kappa.n + (size_t)sig.kappa.degree + 1;
-         i++)
+    for (size_t i = 0; i + 1 < sig.kappa.n + (size_t)sig.kappa.degree + 1; i++)
       if (sig.kappa.knots[i + 1] > sig.kappa.knots[i]) pieces++;
     j.sig = &sig;
 
@@ -158,15 +157,14 @@ int main(void) {
       t_rec[d] = time_per_call(do_reconstruct, &j, reps, 5);
       km_curve out;
       km_curve_init(&out);
-      if (km_reconstruct(&sig, j.degree, tol, &out, &bound[d], &err) !=
-          KM_OK)
+      if (km_reconstruct(&sig, j.degree, tol, &out, &bound[d], &err) != KM_OK)
         return 1;
       npts[d] = out.n;
       km_curve_free(&out);
     }
     printf("%8zu %10.1f %8zu | %11.1f %8zu %9.2f | %11.1f %8zu %9.2f\n",
-           sizes[k], t_sig, pieces, t_rec[0], npts[0], bound[0] / tol,
-           t_rec[1], npts[1], bound[1] / tol);
+           sizes[k], t_sig, pieces, t_rec[0], npts[0], bound[0] / tol, t_rec[1],
+           npts[1], bound[1] / tol);
     if (sizes[k] == 200 && (t_sig > 1000.0 || t_rec[0] > 500.0)) status = 2;
     km_signature_free(&sig);
     km_curve_free(&c);

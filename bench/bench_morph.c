@@ -68,8 +68,9 @@ typedef struct run_stats {
 } run_stats;
 
 /* One morph: create + FRAMES frames. Returns 0 or -1 (message printed). */
-static int morph_once(const km_curve *a, const km_curve *b, km_morph_method method,
-                      double *create_s, double *frames_s, run_stats *info) {
+static int morph_once(const km_curve *a, const km_curve *b,
+                      km_morph_method method, double *create_s,
+                      double *frames_s, run_stats *info) {
   km_morph_options o;
   km_morph_options_default(&o);
   o.method = method;
@@ -85,7 +86,8 @@ static int morph_once(const km_curve *a, const km_curve *b, km_morph_method meth
   for (int i = 0; i < FRAMES; i++) {
     km_curve f;
     km_curve_init(&f);
-    if (km_morph_frame(m, (double)i / (FRAMES - 1), &f, NULL, NULL, &err) != KM_OK) {
+    if (km_morph_frame(m, (double)i / (FRAMES - 1), &f, NULL, NULL, &err) !=
+        KM_OK) {
       fprintf(stderr, "km_morph_frame: %s\n", err.message);
       km_morph_free(m);
       return -1;
@@ -114,8 +116,8 @@ static int morph_once(const km_curve *a, const km_curve *b, km_morph_method meth
  * over seconds, and a best taken within a few milliseconds would depend
  * on the moment. */
 #define MIN_SECONDS 1.0
-static int morph_best(const km_curve *a, const km_curve *b, km_morph_method method,
-                      int runs, run_stats *st) {
+static int morph_best(const km_curve *a, const km_curve *b,
+                      km_morph_method method, int runs, run_stats *st) {
   double best = INFINITY, t_end = now() + MIN_SECONDS;
   memset(st, 0, sizeof *st);
   for (int r = 0; r < runs || now() < t_end; r++) {
@@ -137,8 +139,8 @@ static char *read_file(const char *path) {
   if (!f) return NULL;
   char *buf = NULL;
   long n;
-  if (fseek(f, 0, SEEK_END) == 0 && (n = ftell(f)) >= 0 && fseek(f, 0, SEEK_SET) == 0 &&
-      (buf = malloc((size_t)n + 1)) != NULL) {
+  if (fseek(f, 0, SEEK_END) == 0 && (n = ftell(f)) >= 0 &&
+      fseek(f, 0, SEEK_SET) == 0 && (buf = malloc((size_t)n + 1)) != NULL) {
     if (fread(buf, 1, (size_t)n, f) != (size_t)n) {
       free(buf);
       buf = NULL;
@@ -157,8 +159,10 @@ static int json_curve(const cJSON *o, km_curve *c) {
   const cJSON *cp = cJSON_GetObjectItemCaseSensitive(o, "control_points");
   const cJSON *w = cJSON_GetObjectItemCaseSensitive(o, "weights");
   const cJSON *cl = cJSON_GetObjectItemCaseSensitive(o, "closed");
-  if (!cJSON_IsNumber(deg) || !cJSON_IsArray(kn) || !cJSON_IsArray(cp)) return -1;
-  size_t nk = (size_t)cJSON_GetArraySize(kn), n = (size_t)cJSON_GetArraySize(cp);
+  if (!cJSON_IsNumber(deg) || !cJSON_IsArray(kn) || !cJSON_IsArray(cp))
+    return -1;
+  size_t nk = (size_t)cJSON_GetArraySize(kn),
+         n = (size_t)cJSON_GetArraySize(cp);
   double *K = malloc(nk * sizeof *K), *P = malloc(2 * n * sizeof *P);
   double *W = cJSON_IsArray(w) ? malloc(n * sizeof *W) : NULL;
   int rc = -1;
@@ -179,7 +183,8 @@ static int json_curve(const cJSON *o, km_curve *c) {
   }
   km_error err;
   km_curve_init(c);
-  if (km_curve_create(c, deg->valueint, n, K, P, W, cJSON_IsTrue(cl), &err) != KM_OK) {
+  if (km_curve_create(c, deg->valueint, n, K, P, W, cJSON_IsTrue(cl), &err) !=
+      KM_OK) {
     fprintf(stderr, "curve: %s\n", err.message);
     goto done;
   }
@@ -212,14 +217,16 @@ static double flubber_us(const char *results, const char *name, long *points) {
 static int bench_shapes(const char *flubber_path) {
   char *text = read_file(SHAPES_PATH);
   if (!text) {
-    fprintf(stderr, "cannot read %s (run from the repository root)\n", SHAPES_PATH);
+    fprintf(stderr, "cannot read %s (run from the repository root)\n",
+            SHAPES_PATH);
     return -1;
   }
   cJSON *root = cJSON_Parse(text);
   free(text);
   char *flub = flubber_path ? read_file(flubber_path) : NULL;
   if (flubber_path && !flub)
-    fprintf(stderr, "no flubber figures in %s (is node/npm installed?)\n", flubber_path);
+    fprintf(stderr, "no flubber figures in %s (is node/npm installed?)\n",
+            flubber_path);
   const cJSON *pairs = cJSON_GetObjectItemCaseSensitive(root, "pairs");
   if (!cJSON_IsArray(pairs)) {
     cJSON_Delete(root);
@@ -229,9 +236,9 @@ static int bench_shapes(const char *flubber_path) {
   printf("\nshapes.json pairs: per-frame time = (setup + %d frames) / %d, best "
          "over %g s, default options\n\n",
          FRAMES, FRAMES, MIN_SECONDS);
-  printf("%-18s %5s %5s | %9s %9s %7s %5s | %9s | %9s %6s | %s\n", "pair", "ctl a",
-         "ctl b", "curvature", "setup", "frame", "cross", "linear", "flubber",
-         "points", "kmorph/flubber");
+  printf("%-18s %5s %5s | %9s %9s %7s %5s | %9s | %9s %6s | %s\n", "pair",
+         "ctl a", "ctl b", "curvature", "setup", "frame", "cross", "linear",
+         "flubber", "points", "kmorph/flubber");
   printf("%-18s %5s %5s | %9s %9s %7s %5s | %9s | %9s %6s |\n", "", "", "",
          "us/frame", "us", "ctl pts", "t=.5", "us/frame", "us/frame", "");
   const cJSON *pr;
@@ -239,7 +246,8 @@ static int bench_shapes(const char *flubber_path) {
   cJSON_ArrayForEach(pr, pairs) {
     const cJSON *nm = cJSON_GetObjectItemCaseSensitive(pr, "name");
     km_curve a, b;
-    if (!cJSON_IsString(nm) || json_curve(cJSON_GetObjectItemCaseSensitive(pr, "a"), &a) ||
+    if (!cJSON_IsString(nm) ||
+        json_curve(cJSON_GetObjectItemCaseSensitive(pr, "a"), &a) ||
         json_curve(cJSON_GetObjectItemCaseSensitive(pr, "b"), &b)) {
       rc = -1;
       break;
@@ -255,9 +263,10 @@ static int bench_shapes(const char *flubber_path) {
       double fus = flubber_us(flub, nm->valuestring, &fpts);
       char ratio[32] = "-";
       if (!isnan(fus)) snprintf(ratio, sizeof ratio, "%.1fx", per / fus);
-      printf("%-18s %5zu %5zu | %9.1f %9.1f %7zu %5ld | %9.1f | %9.1f %6ld | %s\n",
-             nm->valuestring, a.n, b.n, per, cv.create_us, cv.frame_points,
-             cv.crossings, lper, fus, fpts, ratio);
+      printf(
+          "%-18s %5zu %5zu | %9.1f %9.1f %7zu %5ld | %9.1f | %9.1f %6ld | %s\n",
+          nm->valuestring, a.n, b.n, per, cv.create_us, cv.frame_points,
+          cv.crossings, lper, fus, fpts, ratio);
     }
     km_curve_free(&a);
     km_curve_free(&b);
@@ -276,7 +285,8 @@ int main(int argc, char **argv) {
   if (make_closed(&a, 197, 1.0, 2, 0.10, 0.0, 0.0) ||
       make_closed(&b, 197, 1.3, 5, 0.15, 0.4, -0.2))
     return 1;
-  printf("two closed cubics, %zu and %zu control points, %d frames (best over %g s):\n",
+  printf("two closed cubics, %zu and %zu control points, %d frames (best over "
+         "%g s):\n",
          a.n, b.n, FRAMES, MIN_SECONDS);
   run_stats cv, ln;
   if (morph_best(&a, &b, KM_METHOD_CURVATURE, 9, &cv) ||
@@ -284,12 +294,12 @@ int main(int argc, char **argv) {
     return 1;
   printf("  %-10s total %9.1f us  (setup %8.1f us, %7.1f us/frame, %zu control "
          "points per frame)\n",
-         "curvature", cv.create_us + cv.frames_us, cv.create_us, cv.frames_us / FRAMES,
-         cv.frame_points);
+         "curvature", cv.create_us + cv.frames_us, cv.create_us,
+         cv.frames_us / FRAMES, cv.frame_points);
   printf("  %-10s total %9.1f us  (setup %8.1f us, %7.1f us/frame, %zu control "
          "points per frame)\n",
-         "linear", ln.create_us + ln.frames_us, ln.create_us, ln.frames_us / FRAMES,
-         ln.frame_points);
+         "linear", ln.create_us + ln.frames_us, ln.create_us,
+         ln.frames_us / FRAMES, ln.frame_points);
   double total = cv.create_us + cv.frames_us;
   printf("  target: curvature morph < 6000 us in total -- %s\n",
          total < 6000 ? "met" : "NOT MET");

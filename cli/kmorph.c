@@ -34,8 +34,7 @@ static char *read_all(FILE *in, size_t max, size_t *len, bool *too_big) {
   size_t cap = 65536, n = 0;
   char *buf = malloc(cap);
   *too_big = false;
-  if (buf == NULL)
-    return NULL;
+  if (buf == NULL) return NULL;
   for (;;) {
     size_t got;
     if (n == cap) {
@@ -54,8 +53,7 @@ static char *read_all(FILE *in, size_t max, size_t *len, bool *too_big) {
     }
     got = fread(buf + n, 1, cap - n, in);
     n += got;
-    if (got == 0)
-      break;
+    if (got == 0) break;
     if (n > max) {
       *too_big = true;
       break;
@@ -67,8 +65,7 @@ static char *read_all(FILE *in, size_t max, size_t *len, bool *too_big) {
 
 static void indent(FILE *out, int depth) {
   fputc('\n', out);
-  for (int i = 0; i < depth; i++)
-    fputs("  ", out);
+  for (int i = 0; i < depth; i++) fputs("  ", out);
 }
 
 /* Re-indent compact JSON (the api layer prints it without whitespace).
@@ -109,11 +106,8 @@ static void print_pretty(FILE *out, const char *s, size_t n) {
       fputc(c, out);
       indent(out, depth);
       break;
-    case ':':
-      fputs(": ", out);
-      break;
-    default:
-      fputc(c, out);
+    case ':': fputs(": ", out); break;
+    default: fputc(c, out);
     }
   }
 }
@@ -181,8 +175,8 @@ int main(int argc, char **argv) {
   free(body);
   status = res.status;
   if (res.body != NULL) {
-    bool json = res.content_type != NULL &&
-                strstr(res.content_type, "json") != NULL;
+    bool json =
+        res.content_type != NULL && strstr(res.content_type, "json") != NULL;
     if (pretty && json)
       print_pretty(stdout, res.body, res.length);
     else

@@ -26,7 +26,9 @@ static void install_cjson_hooks(void) {
   cJSON_InitHooks(&hooks);
 }
 
-void api__init(void) { pthread_once(&cjson_hooks_once, install_cjson_hooks); }
+void api__init(void) {
+  pthread_once(&cjson_hooks_once, install_cjson_hooks);
+}
 #endif
 
 void api_config_default(api_config *cfg) {
@@ -48,8 +50,7 @@ void api_response_init(api_response *r) {
 }
 
 void api_response_free(api_response *r) {
-  if (r == NULL)
-    return;
+  if (r == NULL) return;
   km__free(r->body);
   api_response_init(r);
 }
@@ -90,18 +91,15 @@ static const char *default_title(api_status status) {
  * a client header and must not smuggle bytes into the body or the logs. */
 static bool sane_request_id(const char *id) {
   size_t n = 0;
-  if (id == NULL || *id == '\0')
-    return false;
+  if (id == NULL || *id == '\0') return false;
   for (; id[n] != '\0'; n++)
-    if (n >= 200 || id[n] < 0x21 || id[n] > 0x7e)
-      return false;
+    if (n >= 200 || id[n] < 0x21 || id[n] > 0x7e) return false;
   return true;
 }
 
 /* Last resort when cJSON cannot allocate: a fixed body, still valid JSON. */
 static void problem_fallback(api_response *out, api_status status) {
-  static const char fmt[] =
-      "{\"type\":\"%s\",\"title\":\"%s\",\"status\":%d}";
+  static const char fmt[] = "{\"type\":\"%s\",\"title\":\"%s\",\"status\":%d}";
   char buf[256];
   int n = snprintf(buf, sizeof buf, fmt, default_type(status),
                    default_title(status), status);
@@ -126,10 +124,8 @@ void api_problem(api_response *out, api_status status, const char *type,
   api__init();
   root = cJSON_CreateObject();
   ok = root != NULL;
-  if (type == NULL)
-    type = default_type(status);
-  if (title == NULL)
-    title = default_title(status);
+  if (type == NULL) type = default_type(status);
+  if (title == NULL) title = default_title(status);
   ok = ok && cJSON_AddStringToObject(root, "type", type) != NULL;
   ok = ok && cJSON_AddStringToObject(root, "title", title) != NULL;
   ok = ok && cJSON_AddNumberToObject(root, "status", status) != NULL;
@@ -172,8 +168,7 @@ void api__ctx_init(api_ctx *ctx, const api_config *cfg) {
 
 bool api__fail(api_ctx *ctx, api_status status, const char *type,
                const char *title, const char *pointer, const char *message) {
-  if (ctx->status != 0)
-    return false;
+  if (ctx->status != 0) return false;
   ctx->status = status;
   ctx->type = type != NULL ? type : default_type(status);
   ctx->title = title != NULL ? title : default_title(status);
@@ -194,12 +189,10 @@ bool api__fail(api_ctx *ctx, api_status status, const char *type,
 }
 
 bool api__failf(api_ctx *ctx, api_status status, const char *type,
-                const char *title, const char *pointer, const char *fmt,
-                ...) {
+                const char *title, const char *pointer, const char *fmt, ...) {
   char msg[API_TEXT_MAX];
   va_list ap;
-  if (ctx->status != 0)
-    return false;
+  if (ctx->status != 0) return false;
   va_start(ap, fmt);
   vsnprintf(msg, sizeof msg, fmt, ap);
   va_end(ap);
@@ -209,13 +202,12 @@ bool api__failf(api_ctx *ctx, api_status status, const char *type,
 bool api__invalid(api_ctx *ctx, const char *pointer, const char *fmt, ...) {
   char msg[API_TEXT_MAX];
   va_list ap;
-  if (ctx->status != 0)
-    return false;
+  if (ctx->status != 0) return false;
   va_start(ap, fmt);
   vsnprintf(msg, sizeof msg, fmt, ap);
   va_end(ap);
-  return api__fail(ctx, 422, API_P_INVALID_REQUEST, "Invalid request",
-                   pointer, msg);
+  return api__fail(ctx, 422, API_P_INVALID_REQUEST, "Invalid request", pointer,
+                   msg);
 }
 
 bool api__oom(api_ctx *ctx) {
@@ -236,8 +228,7 @@ void api__ctx_problem(const api_ctx *ctx, api_response *out,
   api_status status = ctx->status != 0 ? ctx->status : 500;
   api_problem(out, status, ctx->type, ctx->title,
               ctx->status != 0 ? ctx->detail : "unknown failure",
-              ctx->has_pointer ? ctx->pointer : NULL, ctx->message,
-              request_id);
+              ctx->has_pointer ? ctx->pointer : NULL, ctx->message, request_id);
 }
 
 api_status api__respond_json(api_ctx *ctx, cJSON *root, api_status status,
@@ -270,16 +261,13 @@ api_status api_handle(const api_config *cfg, const api_request *req,
   api_response_init(out);
   api__ctx_init(&ctx, cfg);
   switch (req->route) {
-  case API_ROUTE_SIGNATURE:
-    return api__route_signature(&ctx, req, out);
-  case API_ROUTE_RECONSTRUCT:
-    return api__route_reconstruct(&ctx, req, out);
+  case API_ROUTE_SIGNATURE: return api__route_signature(&ctx, req, out);
+  case API_ROUTE_RECONSTRUCT: return api__route_reconstruct(&ctx, req, out);
   case API_ROUTE_MORPH: {
     api_morph_plan *plan = NULL;
     api_status st =
         api_morph_prepare(cfg, req, cfg->max_frames_sync, &plan, out);
-    if (st != API_STEP_DONE)
-      return st;
+    if (st != API_STEP_DONE) return st;
     /* frames under the request's stop; a stopped or failed one is
      * reported by api_morph_result */
     for (size_t i = 0; req->stop != NULL && i < api_morph_frame_count(plan);
@@ -292,8 +280,8 @@ api_status api_handle(const api_config *cfg, const api_request *req,
     return st;
   }
   default:
-    api_problem(out, 404, API_P_NOT_FOUND, "Not found", "unknown route",
-                NULL, NULL, req->request_id);
+    api_problem(out, 404, API_P_NOT_FOUND, "Not found", "unknown route", NULL,
+                NULL, req->request_id);
     return out->status;
   }
 }

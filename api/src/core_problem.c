@@ -25,8 +25,8 @@ static const char *field_name(km_field f, api_kind kind) {
   case KM_FIELD_KAPPA_COEFFICIENTS: return "kappa/coefficients";
   case KM_FIELD_KAPPA_DEGREE: return "kappa/degree";
   case KM_FIELD_CORNERS: return "corners";
-  case KM_FIELD_POINTS: return kind == API_KIND_CURVE ? "control_points"
-                                                       : "points";
+  case KM_FIELD_POINTS:
+    return kind == API_KIND_CURVE ? "control_points" : "points";
   default: return NULL;
   }
 }
@@ -42,15 +42,13 @@ static problem_kind problem_of(km_status st, api_kind kind) {
   switch (st) {
   case KM_ETURNING:
   case KM_EMIXED:
-    return (problem_kind){422, API_P_NOT_MORPHABLE,
-                          "Curves cannot be morphed"};
+    return (problem_kind){422, API_P_NOT_MORPHABLE, "Curves cannot be morphed"};
   case KM_EMATCH:
     return (problem_kind){422, API_P_INVALID_REQUEST, "Invalid request"};
   case KM_ENOCONVERGE:
     return (problem_kind){422, API_P_NO_CONVERGE,
                           "Computation did not converge"};
-  case KM_ELIMIT:
-    return (problem_kind){422, API_P_LIMIT, "Limit exceeded"};
+  case KM_ELIMIT: return (problem_kind){422, API_P_LIMIT, "Limit exceeded"};
   case KM_ECANCELLED:
     return (problem_kind){503, "/problems/cancelled", "Cancelled"};
   case KM_EINVAL:
@@ -64,13 +62,11 @@ static problem_kind problem_of(km_status st, api_kind kind) {
   case KM_EDEGENERATE:
   case KM_ECUSP:
     if (kind == API_KIND_SIGNATURE)
-      return (problem_kind){422, API_P_INVALID_SIGNATURE,
-                            "Invalid signature"};
+      return (problem_kind){422, API_P_INVALID_SIGNATURE, "Invalid signature"};
     if (kind == API_KIND_REQUEST)
       return (problem_kind){422, API_P_INVALID_REQUEST, "Invalid request"};
     return (problem_kind){422, API_P_INVALID_CURVE, "Invalid curve"};
-  default:
-    return (problem_kind){500, API_P_INTERNAL, "Internal error"};
+  default: return (problem_kind){500, API_P_INTERNAL, "Internal error"};
   }
 }
 
@@ -109,9 +105,9 @@ static void fault_pointer(char *p, const km_error *err, const char *base,
  * message. */
 static void fault_message(char *msg, km_status st, const km_error *err,
                           api_kind kind) {
-  const char *text =
-      err != NULL && err->message[0] != '\0' ? err->message
-                                              : km_status_message(st);
+  const char *text = err != NULL && err->message[0] != '\0'
+                         ? err->message
+                         : km_status_message(st);
   if (err != NULL && err->message[0] == '\0' && isfinite(err->param) &&
       (st == KM_ECUSP || st == KM_EDEGENERATE || st == KM_ENOCONVERGE))
     snprintf(msg, API_TEXT_MAX, "%s (at %s %.17g)", text,
@@ -125,8 +121,7 @@ bool api__core_fail(api_ctx *ctx, km_status st, const km_error *err,
                     const char *base, api_kind kind) {
   char p[API_POINTER_MAX], msg[API_TEXT_MAX];
   problem_kind pk;
-  if (st == KM_ENOMEM)
-    return api__oom(ctx);
+  if (st == KM_ENOMEM) return api__oom(ctx);
   pk = problem_of(st, kind);
   fault_pointer(p, err, base, kind);
   fault_message(msg, st, err, kind);

@@ -26,8 +26,7 @@ void api__input_init(api_input *in) {
 }
 
 void api__input_free(api_input *in) {
-  if (in == NULL)
-    return;
+  if (in == NULL) return;
   km_curve_free(&in->curve);
   km_signature_free(&in->sig);
   for (size_t i = 0; in->contours != NULL && i < in->ncontours; i++)
@@ -39,8 +38,7 @@ void api__input_free(api_input *in) {
 
 size_t api__max_contours(const api_config *cfg) {
   size_t m = cfg->max_contours;
-  if (m == 0)
-    return KM_SHAPE_DEFAULT_MAX_CONTOURS;
+  if (m == 0) return KM_SHAPE_DEFAULT_MAX_CONTOURS;
   return m > KM_SHAPE_MAX_CONTOURS ? KM_SHAPE_MAX_CONTOURS : m;
 }
 
@@ -55,11 +53,9 @@ void api__contour_ptr(char *buf, const api_input *in, const char *ptr,
   api__ptr_idx(buf, p, i);
 }
 
-void api__contour_where(char *buf, size_t cap, const api_input *in,
-                        size_t i) {
+void api__contour_where(char *buf, size_t cap, const api_input *in, size_t i) {
   if (in->offsets != NULL)
-    snprintf(buf, cap, "subpath %zu (at offset %zu of d)", i,
-             in->offsets[i]);
+    snprintf(buf, cap, "subpath %zu (at offset %zu of d)", i, in->offsets[i]);
   else
     snprintf(buf, cap, "contour %zu", i);
 }
@@ -70,7 +66,6 @@ bool api__refuse_shape(api_ctx *ctx, const char *ptr) {
                       "one curve");
 }
 
-
 /* The optional "weights" of a curve of n control points at ptr: one per
  * point, each > 0. *w (the caller frees it) stays NULL when they are
  * absent or null. */
@@ -79,8 +74,7 @@ static bool read_weights(api_ctx *ctx, const cJSON *v, const char *ptr,
   char p[API_POINTER_MAX];
   size_t nw = 0;
   const cJSON *jw = cJSON_GetObjectItemCaseSensitive(v, "weights");
-  if (jw == NULL || cJSON_IsNull(jw))
-    return true;
+  if (jw == NULL || cJSON_IsNull(jw)) return true;
   api__ptr_key(p, ptr, "weights");
   if (!api__num_array(ctx, jw, p, ctx->cfg->max_control_points, w, &nw))
     return false;
@@ -107,12 +101,10 @@ static bool read_closed(api_ctx *ctx, const cJSON *v, const char *ptr,
   double span = 0;
   if (!api__member_bool(ctx, v, ptr, "closed", false, closed, NULL))
     return false;
-  if (!*closed)
-    return true;
+  if (!*closed) return true;
   /* Scale-relative, so that rounding in a client's output does not turn
    * a closed curve into an error; the core has the final word. */
-  for (size_t i = 0; i < 2 * n; i++)
-    span = fmax(span, fabs(cp[i]));
+  for (size_t i = 0; i < 2 * n; i++) span = fmax(span, fabs(cp[i]));
   if (hypot(cp[0] - cp[2 * n - 2], cp[1] - cp[2 * n - 1]) >
       1e-12 * fmax(span, 1.0)) {
     api__ptr_key(p, ptr, "closed");
@@ -148,8 +140,7 @@ static bool parse_bspline(api_ctx *ctx, const cJSON *v, const char *ptr,
                degree, degree + 1, n);
     goto done;
   }
-  if (!api__read_knots(ctx, v, ptr, n, degree, API_KIND_CURVE, &knots,
-                       &nk) ||
+  if (!api__read_knots(ctx, v, ptr, n, degree, API_KIND_CURVE, &knots, &nk) ||
       !read_weights(ctx, v, ptr, n, &w) ||
       !read_closed(ctx, v, ptr, cp, n, &closed))
     goto done;
@@ -175,8 +166,7 @@ static bool parse_points(api_ctx *ctx, const cJSON *v, const char *ptr,
   const cJSON *jp;
   km_error err;
   km_status st;
-  if ((jp = api__require(ctx, v, ptr, "points")) == NULL)
-    return false;
+  if ((jp = api__require(ctx, v, ptr, "points")) == NULL) return false;
   api__ptr_key(p, ptr, "points");
   if (!api__point_array(ctx, jp, p, ctx->cfg->max_control_points, &pts, &n))
     return false;
@@ -184,15 +174,14 @@ static bool parse_points(api_ctx *ctx, const cJSON *v, const char *ptr,
     api__invalid(ctx, p, "needs at least 2 points");
     goto done;
   }
-  if (!api__member_bool(ctx, v, ptr, "closed", false, &closed, NULL))
-    goto done;
+  if (!api__member_bool(ctx, v, ptr, "closed", false, &closed, NULL)) goto done;
   {
     /* fitted within half the tolerance (the request's, else the default
      * 1e-5 of the length) so the rest of the work keeps the other half */
     double len = 0.0;
     for (size_t i = 1; i < n; i++)
-      len += hypot(pts[2 * i] - pts[2 * i - 2],
-                   pts[2 * i + 1] - pts[2 * i - 1]);
+      len +=
+          hypot(pts[2 * i] - pts[2 * i - 2], pts[2 * i + 1] - pts[2 * i - 1]);
     double fit_tol = 0.5 * (tol > 0 ? tol : 1e-5 * len);
     st = km_curve_fit_points(out, pts, n, closed, fit_tol, &err);
   }
@@ -210,8 +199,7 @@ done:
 static bool check_closed(api_ctx *ctx, const api_input *in, const char *ptr,
                          size_t i) {
   char p[API_POINTER_MAX], where[96];
-  if (in->contours[i].closed)
-    return true;
+  if (in->contours[i].closed) return true;
   api__contour_ptr(p, in, ptr, i);
   api__contour_where(where, sizeof where, in, i);
   return api__failf(ctx, 422, API_P_INVALID_CURVE, "Invalid curve", p,
@@ -221,29 +209,25 @@ static bool check_closed(api_ctx *ctx, const api_input *in, const char *ptr,
 }
 
 /* The subpaths of d: one is the curve itself, several a shape. */
-static bool parse_svg(api_ctx *ctx, const cJSON *v, const char *ptr,
-                      double tol, api_input *out) {
+static bool parse_svg(api_ctx *ctx, const cJSON *v, const char *ptr, double tol,
+                      api_input *out) {
   char p[API_POINTER_MAX];
   char msg[API_TEXT_MAX];
   const cJSON *jd;
   size_t off = 0, n = 0, *offs = NULL, points = 0;
   km_curve *subs = NULL;
   km_status st;
-  if ((jd = api__require(ctx, v, ptr, "d")) == NULL)
-    return false;
+  if ((jd = api__require(ctx, v, ptr, "d")) == NULL) return false;
   api__ptr_key(p, ptr, "d");
   if (!cJSON_IsString(jd))
-    return api__invalid(ctx, p, "must be a string, not %s",
-                        api__type_name(jd));
+    return api__invalid(ctx, p, "must be a string, not %s", api__type_name(jd));
   msg[0] = '\0';
   /* Without a request tolerance nothing is known of the drawing's scale
    * yet; a tiny absolute tolerance only lets exact repairs happen. */
   st = api_svg_parse_subpaths(jd->valuestring, strlen(jd->valuestring),
-                              tol > 0 ? tol : 1e-9,
-                              api__max_contours(ctx->cfg), &subs, &offs, &n,
-                              &off, msg, sizeof msg);
-  if (st == KM_ENOMEM)
-    return api__oom(ctx);
+                              tol > 0 ? tol : 1e-9, api__max_contours(ctx->cfg),
+                              &subs, &offs, &n, &off, msg, sizeof msg);
+  if (st == KM_ENOMEM) return api__oom(ctx);
   if (st == KM_ELIMIT)
     return api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded", p,
                       "too many subpaths at offset %zu: %s", off, msg);
@@ -251,8 +235,7 @@ static bool parse_svg(api_ctx *ctx, const cJSON *v, const char *ptr,
     return api__failf(ctx, 422, API_P_INVALID_CURVE, "Invalid curve", p,
                       "invalid path data at offset %zu: %s", off,
                       msg[0] != '\0' ? msg : km_status_message(st));
-  for (size_t i = 0; i < n; i++)
-    points += subs[i].n;
+  for (size_t i = 0; i < n; i++) points += subs[i].n;
   if (n == 1) {
     out->curve = subs[0];
     km__free(subs);
@@ -268,8 +251,7 @@ static bool parse_svg(api_ctx *ctx, const cJSON *v, const char *ptr,
                       "the path makes %zu control points; the limit is %zu",
                       points, ctx->cfg->max_control_points);
   for (size_t i = 0; i < out->ncontours; i++)
-    if (!check_closed(ctx, out, ptr, i))
-      return false;
+    if (!check_closed(ctx, out, ptr, i)) return false;
   return true;
 }
 
@@ -316,8 +298,7 @@ static bool parse_shape(api_ctx *ctx, const cJSON *v, const char *ptr,
     api__input_free(&c);
     out->ncontours = ++i;
     points += out->contours[i - 1].n;
-    if (!check_closed(ctx, out, ptr, i - 1))
-      return false;
+    if (!check_closed(ctx, out, ptr, i - 1)) return false;
     if (points > ctx->cfg->max_control_points)
       return api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded", q,
                         "the contours up to this one have %zu control "
@@ -327,15 +308,14 @@ static bool parse_shape(api_ctx *ctx, const cJSON *v, const char *ptr,
   return true;
 }
 
-bool api__parse_curve(api_ctx *ctx, const cJSON *v, const char *ptr,
-                      double tol, api_input *out) {
-  static const char *const types[] = {"bspline", "points", "signature",
-                                      "svg", "shape"};
+bool api__parse_curve(api_ctx *ctx, const cJSON *v, const char *ptr, double tol,
+                      api_input *out) {
+  static const char *const types[] = {"bspline", "points", "signature", "svg",
+                                      "shape"};
   int type = -1;
   bool present = false;
   char p[API_POINTER_MAX];
-  if (v == NULL)
-    return api__invalid(ctx, ptr, "is required");
+  if (v == NULL) return api__invalid(ctx, ptr, "is required");
   if (!cJSON_IsObject(v))
     return api__invalid(ctx, ptr, "must be a curve object, not %s",
                         api__type_name(v));
@@ -349,35 +329,29 @@ bool api__parse_curve(api_ctx *ctx, const cJSON *v, const char *ptr,
   }
   switch (type) {
   case 0:
-    if (!parse_bspline(ctx, v, ptr, &out->curve))
-      return false;
+    if (!parse_bspline(ctx, v, ptr, &out->curve)) return false;
     out->kind = API_KIND_CURVE;
     break;
   case 1:
-    if (!parse_points(ctx, v, ptr, tol, &out->curve))
-      return false;
+    if (!parse_points(ctx, v, ptr, tol, &out->curve)) return false;
     out->kind = API_KIND_POINTS;
     break;
   case 2: {
     const cJSON *js = api__require(ctx, v, ptr, "signature");
-    if (js == NULL)
-      return false;
+    if (js == NULL) return false;
     api__ptr_key(p, ptr, "signature");
-    if (!api__parse_signature(ctx, js, p, &out->sig))
-      return false;
+    if (!api__parse_signature(ctx, js, p, &out->sig)) return false;
     out->is_signature = true;
     out->kind = API_KIND_SIGNATURE;
     out->length = out->sig.length;
     return true;
   }
   case 3:
-    if (!parse_svg(ctx, v, ptr, tol, out))
-      return false;
+    if (!parse_svg(ctx, v, ptr, tol, out)) return false;
     out->kind = API_KIND_SVG;
     break;
   default:
-    if (!parse_shape(ctx, v, ptr, tol, out))
-      return false;
+    if (!parse_shape(ctx, v, ptr, tol, out)) return false;
     out->kind = API_KIND_CURVE;
     break;
   }

@@ -112,20 +112,16 @@ static inline bool api__stopped(api_ctx *ctx) {
 
 /* The value of the hexadecimal digit c, or -1 when c is none. */
 static inline int api__hexval(int c) {
-  if (c >= '0' && c <= '9')
-    return c - '0';
-  if (c >= 'a' && c <= 'f')
-    return c - 'a' + 10;
-  if (c >= 'A' && c <= 'F')
-    return c - 'A' + 10;
+  if (c >= '0' && c <= '9') return c - '0';
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
   return -1;
 }
 
 /* A request's stop as the core takes it; NULL when it has none. */
 static inline const km_stop *api__km_stop(const api_request *req,
                                           km_stop *buf) {
-  if (req->stop == NULL)
-    return NULL;
+  if (req->stop == NULL) return NULL;
   buf->requested = req->stop;
   buf->ctx = req->stop_ctx;
   return buf;
@@ -142,8 +138,7 @@ static inline const km_stop *api__km_stop(const api_request *req,
 size_t api__path_numbers(size_t n, int degree, bool hermite);
 /* Bytes a curve takes in the JSON answer, at most: n control points of
  * the given degree (weights if rational), plus its "svg_d" when asked. */
-size_t api__curve_json_bytes(size_t n, int degree, bool rational,
-                             bool svg_d);
+size_t api__curve_json_bytes(size_t n, int degree, bool rational, bool svg_d);
 /* The same bound for a signature as api__signature_json prints it. */
 size_t api__signature_json_bytes(const km_signature *sig);
 
@@ -224,21 +219,19 @@ bool api__member_int(api_ctx *ctx, const cJSON *obj, const char *base,
                      const char *key, bool required, long lo, long hi,
                      long *out, bool *present);
 bool api__member_bool(api_ctx *ctx, const cJSON *obj, const char *base,
-                      const char *key, bool required, bool *out,
-                      bool *present);
+                      const char *key, bool required, bool *out, bool *present);
 /* A string member that must be one of names[0..n); *out = its index. */
 bool api__member_enum(api_ctx *ctx, const cJSON *obj, const char *base,
                       const char *key, const char *const *names, size_t n,
                       int *out, bool *present);
 /* An array of finite numbers (length 1..max); *out malloc'd, caller frees. */
-bool api__num_array(api_ctx *ctx, const cJSON *v, const char *ptr,
-                    size_t max, double **out, size_t *n);
+bool api__num_array(api_ctx *ctx, const cJSON *v, const char *ptr, size_t max,
+                    double **out, size_t *n);
 /* An array of [x, y] pairs (length 1..max) into 2n doubles; malloc'd. */
-bool api__point_array(api_ctx *ctx, const cJSON *v, const char *ptr,
-                      size_t max, double **out, size_t *n);
+bool api__point_array(api_ctx *ctx, const cJSON *v, const char *ptr, size_t max,
+                      double **out, size_t *n);
 /* A single [x, y]. */
-bool api__point(api_ctx *ctx, const cJSON *v, const char *ptr,
-                double out[2]);
+bool api__point(api_ctx *ctx, const cJSON *v, const char *ptr, double out[2]);
 /* Member must exist (422 "is required" otherwise). */
 const cJSON *api__require(api_ctx *ctx, const cJSON *obj, const char *base,
                           const char *key);
@@ -250,8 +243,8 @@ const char *api__type_name(const cJSON *v);
  * decreasing, the problem naming the knot at fault; *knots malloc'd,
  * caller frees. */
 bool api__read_knots(api_ctx *ctx, const cJSON *obj, const char *base,
-                     size_t ncoef, long degree, api_kind kind,
-                     double **knots, size_t *nk);
+                     size_t ncoef, long degree, api_kind kind, double **knots,
+                     size_t *nk);
 
 /* ---- curves and signatures from JSON ---- */
 
@@ -267,8 +260,8 @@ typedef struct api_input {
   double length; /* arc length of the input (all contours of a shape) */
   bool is_shape;
   size_t ncontours;
-  km_curve *contours;  /* is_shape: ncontours closed curves */
-  size_t *offsets;     /* svg shapes: each subpath's offset in d; else NULL */
+  km_curve *contours; /* is_shape: ncontours closed curves */
+  size_t *offsets;    /* svg shapes: each subpath's offset in d; else NULL */
   km_fill_rule fill;
 } api_input;
 
@@ -280,16 +273,15 @@ void api__input_free(api_input *in);
  * A shape (out->is_shape) comes back with every contour closed and at
  * most cfg->max_contours of them; callers that take no shapes refuse it
  * with api__refuse_shape. */
-bool api__parse_curve(api_ctx *ctx, const cJSON *v, const char *ptr,
-                      double tol, api_input *out);
+bool api__parse_curve(api_ctx *ctx, const cJSON *v, const char *ptr, double tol,
+                      api_input *out);
 /* The pointer naming contour i of a shape input at ptr: "<ptr>/contours/i"
  * for a JSON shape, "<ptr>/d" for SVG (whose messages give the subpath's
  * offset, api__contour_where). */
 void api__contour_ptr(char *buf, const api_input *in, const char *ptr,
                       size_t i);
 /* "contour i" or "subpath i (at offset N of d)" for messages. */
-void api__contour_where(char *buf, size_t cap, const api_input *in,
-                        size_t i);
+void api__contour_where(char *buf, size_t cap, const api_input *in, size_t i);
 /* 422 at ptr: a shape where only one curve is taken. */
 bool api__refuse_shape(api_ctx *ctx, const char *ptr);
 /* The contours limit of a context (its default for 0). */
@@ -318,8 +310,7 @@ bool api__add_item(api_ctx *ctx, cJSON *obj, const char *key, cJSON *item);
 cJSON *api__number(double v);
 cJSON *api__num_array_json(api_ctx *ctx, const double *v, size_t n,
                            size_t stride);
-cJSON *api__curve_json(api_ctx *ctx, const km_curve *c, bool svg_d,
-                       double tol);
+cJSON *api__curve_json(api_ctx *ctx, const km_curve *c, bool svg_d, double tol);
 cJSON *api__signature_json(api_ctx *ctx, const km_signature *sig);
 
 /* Render root into a 2xx JSON response; takes ownership of root. */

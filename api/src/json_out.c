@@ -23,8 +23,7 @@ cJSON *api__number(double v) {
   char buf[40];
   for (int digits = 15; digits <= 17; digits++) {
     snprintf(buf, sizeof buf, "%.*g", digits, v);
-    if (digits == 17 || strtod(buf, NULL) == v)
-      break;
+    if (digits == 17 || strtod(buf, NULL) == v) break;
   }
   return cJSON_CreateRaw(buf);
 }
@@ -32,14 +31,11 @@ cJSON *api__number(double v) {
 /* [x, y] */
 static cJSON *pair(const double *v) {
   cJSON *a = cJSON_CreateArray(), *x, *y;
-  if (a == NULL)
-    return NULL;
+  if (a == NULL) return NULL;
   x = api__number(v[0]);
-  if (x != NULL)
-    cJSON_AddItemToArray(a, x);
+  if (x != NULL) cJSON_AddItemToArray(a, x);
   y = api__number(v[1]);
-  if (y != NULL)
-    cJSON_AddItemToArray(a, y);
+  if (y != NULL) cJSON_AddItemToArray(a, y);
   if (x == NULL || y == NULL) {
     cJSON_Delete(a);
     return NULL;
@@ -48,8 +44,8 @@ static cJSON *pair(const double *v) {
 }
 
 static bool nonfinite(api_ctx *ctx, const char *what) {
-  return api__failf(ctx, 422, API_P_NO_CONVERGE,
-                    "Computation did not converge", NULL,
+  return api__failf(ctx, 422, API_P_NO_CONVERGE, "Computation did not converge",
+                    NULL,
                     "the computation produced a non-finite %s; try another "
                     "tolerance or simpler input",
                     what);
@@ -57,18 +53,15 @@ static bool nonfinite(api_ctx *ctx, const char *what) {
 
 bool api__add_item(api_ctx *ctx, cJSON *obj, const char *key, cJSON *item) {
   /* cJSON copies the key, and when that copy fails the item stays ours */
-  if (cJSON_AddItemToObject(obj, key, item))
-    return true;
+  if (cJSON_AddItemToObject(obj, key, item)) return true;
   cJSON_Delete(item);
   return api__oom(ctx);
 }
 
 bool api__add_num(api_ctx *ctx, cJSON *obj, const char *key, double v) {
-  if (!isfinite(v))
-    return nonfinite(ctx, key);
+  if (!isfinite(v)) return nonfinite(ctx, key);
   cJSON *n = api__number(v);
-  if (n == NULL)
-    return api__oom(ctx);
+  if (n == NULL) return api__oom(ctx);
   return api__add_item(ctx, obj, key, n);
 }
 
@@ -83,12 +76,10 @@ cJSON *api__num_array_json(api_ctx *ctx, const double *v, size_t n,
   for (size_t i = 0; i < n; i++) {
     cJSON *e;
     if (stride == 1) {
-      if (!isfinite(v[i]))
-        goto nonfinite_value;
+      if (!isfinite(v[i])) goto nonfinite_value;
       e = api__number(v[i]);
     } else {
-      if (!isfinite(v[2 * i]) || !isfinite(v[2 * i + 1]))
-        goto nonfinite_value;
+      if (!isfinite(v[2 * i]) || !isfinite(v[2 * i + 1])) goto nonfinite_value;
       e = pair(&v[2 * i]);
     }
     if (e == NULL) {
@@ -108,8 +99,7 @@ nonfinite_value:
 static bool add_array(api_ctx *ctx, cJSON *obj, const char *key,
                       const double *v, size_t n, size_t stride) {
   cJSON *a = api__num_array_json(ctx, v, n, stride);
-  if (a == NULL)
-    return false;
+  if (a == NULL) return false;
   return api__add_item(ctx, obj, key, a);
 }
 
@@ -125,15 +115,13 @@ cJSON *api__curve_json(api_ctx *ctx, const km_curve *c, bool svg_d,
       !add_array(ctx, o, "knots", c->knots, c->n + (size_t)c->degree + 1, 1) ||
       !add_array(ctx, o, "control_points", c->cp, c->n, 2))
     goto fail;
-  if (c->w != NULL && !add_array(ctx, o, "weights", c->w, c->n, 1))
-    goto fail;
+  if (c->w != NULL && !add_array(ctx, o, "weights", c->w, c->n, 1)) goto fail;
   if (cJSON_AddBoolToObject(o, "closed", c->closed) == NULL) {
     api__oom(ctx);
     goto fail;
   }
   length = km_curve_length(c);
-  if (!api__add_num(ctx, o, "length", length))
-    goto fail;
+  if (!api__add_num(ctx, o, "length", length)) goto fail;
   if (svg_d) {
     /* Default tolerance as everywhere: 1e-5 of the curve's length. */
     char *d = api_svg_path_d(c, tol > 0 ? tol : 1e-5 * length, NULL);
@@ -147,8 +135,7 @@ cJSON *api__curve_json(api_ctx *ctx, const km_curve *c, bool svg_d,
       api__oom(ctx);
       goto fail;
     }
-    if (!api__add_item(ctx, o, "svg_d", s))
-      goto fail;
+    if (!api__add_item(ctx, o, "svg_d", s)) goto fail;
   }
   return o;
 fail:
@@ -163,8 +150,7 @@ cJSON *api__signature_json(api_ctx *ctx, const km_signature *sig) {
     api__oom(ctx);
     return NULL;
   }
-  if (!api__add_num(ctx, o, "length", sig->length))
-    goto fail;
+  if (!api__add_num(ctx, o, "length", sig->length)) goto fail;
   start = cJSON_AddObjectToObject(o, "start");
   if (start == NULL) {
     api__oom(ctx);
@@ -180,11 +166,9 @@ cJSON *api__signature_json(api_ctx *ctx, const km_signature *sig) {
       api__oom(ctx);
       goto fail;
     }
-    if (!api__add_item(ctx, start, "point", pt))
-      goto fail;
+    if (!api__add_item(ctx, start, "point", pt)) goto fail;
   }
-  if (!api__add_num(ctx, start, "angle", sig->angle))
-    goto fail;
+  if (!api__add_num(ctx, start, "angle", sig->angle)) goto fail;
   kappa = cJSON_AddObjectToObject(o, "kappa");
   if (kappa == NULL) {
     api__oom(ctx);
@@ -193,8 +177,7 @@ cJSON *api__signature_json(api_ctx *ctx, const km_signature *sig) {
   if (!api__add_num(ctx, kappa, "degree", sig->kappa.degree) ||
       !add_array(ctx, kappa, "knots", sig->kappa.knots,
                  sig->kappa.n + (size_t)sig->kappa.degree + 1, 1) ||
-      !add_array(ctx, kappa, "coefficients", sig->kappa.coef, sig->kappa.n,
-                 1))
+      !add_array(ctx, kappa, "coefficients", sig->kappa.coef, sig->kappa.n, 1))
     goto fail;
   corners = cJSON_AddArrayToObject(o, "corners");
   if (corners == NULL) {
@@ -212,8 +195,7 @@ cJSON *api__signature_json(api_ctx *ctx, const km_signature *sig) {
         !api__add_num(ctx, c, "turn", sig->corners[i].turn))
       goto fail;
   }
-  if (!api__add_num(ctx, o, "turning", sig->turning))
-    goto fail;
+  if (!api__add_num(ctx, o, "turning", sig->turning)) goto fail;
   if (cJSON_AddBoolToObject(o, "closed", sig->closed) == NULL) {
     api__oom(ctx);
     goto fail;
@@ -233,19 +215,15 @@ fail:
  * until within the tolerance). Other curves (linear frames) have a span
  * per control point. */
 size_t api__path_numbers(size_t n, int degree, bool hermite) {
-  if (hermite)
-    return (degree <= 3 ? 3 : 8) * n + 2;
+  if (hermite) return (degree <= 3 ? 3 : 8) * n + 2;
   return (degree <= 3 ? 6 : 24) * n + 2;
 }
 
-size_t api__curve_json_bytes(size_t n, int degree, bool rational,
-                             bool svg_d) {
+size_t api__curve_json_bytes(size_t n, int degree, bool rational, bool svg_d) {
   size_t knots = n + (size_t)degree + 1;
-  size_t b = 128 +
-             API_JSON_NUM_BYTES * (knots + 2 * n + (rational ? n : 0)) +
-             3 * n;
-  if (svg_d)
-    b += 16 + API_SVG_NUM_BYTES * api__path_numbers(n, degree, false);
+  size_t b =
+      128 + API_JSON_NUM_BYTES * (knots + 2 * n + (rational ? n : 0)) + 3 * n;
+  if (svg_d) b += 16 + API_SVG_NUM_BYTES * api__path_numbers(n, degree, false);
   return b;
 }
 

@@ -37,10 +37,8 @@
  * degree + 1), weights, samples, times. */
 static size_t longest_array(const api_config *cfg) {
   size_t m = cfg->max_control_points + 32;
-  if (cfg->max_samples > m)
-    m = cfg->max_samples;
-  if (cfg->max_frames_job > m)
-    m = cfg->max_frames_job;
+  if (cfg->max_samples > m) m = cfg->max_samples;
+  if (cfg->max_frames_job > m) m = cfg->max_frames_job;
   return m;
 }
 
@@ -57,8 +55,7 @@ cJSON *api__parse_body(api_ctx *ctx, const char *body, size_t length) {
                ctx->cfg->max_body_bytes);
     return NULL;
   }
-  if (body == NULL)
-    length = 0;
+  if (body == NULL) length = 0;
   if (!api__json_scan(ctx, body, length, longest_array(ctx->cfg), &need))
     return NULL;
   if (need > api__tree_budget(length)) {
@@ -70,8 +67,7 @@ cJSON *api__parse_body(api_ctx *ctx, const char *body, size_t length) {
                length, need, API_TREE_FACTOR);
     return NULL;
   }
-  if ((root = api__json_build(ctx, body, length)) == NULL)
-    return NULL;
+  if ((root = api__json_build(ctx, body, length)) == NULL) return NULL;
   if (!cJSON_IsObject(root)) {
     cJSON_Delete(root);
     api__invalid(ctx, "", "the request body must be a JSON object");

@@ -46,8 +46,7 @@ static inline size_t api__pack_bytes(size_t count, size_t width) {
 
 static inline const unsigned char *api__skip_ws(const unsigned char *p,
                                                 const unsigned char *end) {
-  while (p < end && (*p == ' ' || *p == '\t' || *p == '\n' || *p == '\r'))
-    p++;
+  while (p < end && (*p == ' ' || *p == '\t' || *p == '\n' || *p == '\r')) p++;
   return p;
 }
 

@@ -17,18 +17,12 @@
 #include "km/alloc.h"
 
 const char *api__type_name(const cJSON *v) {
-  if (v == NULL)
-    return "nothing";
-  if (cJSON_IsNull(v))
-    return "null";
-  if (cJSON_IsBool(v))
-    return "a boolean";
-  if (cJSON_IsNumber(v))
-    return "a number";
-  if (cJSON_IsString(v))
-    return "a string";
-  if (cJSON_IsArray(v))
-    return "an array";
+  if (v == NULL) return "nothing";
+  if (cJSON_IsNull(v)) return "null";
+  if (cJSON_IsBool(v)) return "a boolean";
+  if (cJSON_IsNumber(v)) return "a number";
+  if (cJSON_IsString(v)) return "a string";
+  if (cJSON_IsArray(v)) return "an array";
   return "an object";
 }
 
@@ -61,8 +55,7 @@ bool api__member_num(api_ctx *ctx, const cJSON *obj, const char *base,
                      bool *present) {
   const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
   char p[API_POINTER_MAX];
-  if (present != NULL)
-    *present = v != NULL;
+  if (present != NULL) *present = v != NULL;
   if (v == NULL)
     return required ? api__require(ctx, obj, base, key) != NULL : true;
   api__ptr_key(p, base, key);
@@ -75,15 +68,12 @@ bool api__member_int(api_ctx *ctx, const cJSON *obj, const char *base,
   const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
   char p[API_POINTER_MAX];
   double d = 0.0; /* set by api__num; -O3 cannot see it */
-  if (present != NULL)
-    *present = v != NULL;
+  if (present != NULL) *present = v != NULL;
   if (v == NULL)
     return required ? api__require(ctx, obj, base, key) != NULL : true;
   api__ptr_key(p, base, key);
-  if (!api__num(ctx, v, p, &d))
-    return false;
-  if (d != floor(d))
-    return api__invalid(ctx, p, "must be an integer");
+  if (!api__num(ctx, v, p, &d)) return false;
+  if (d != floor(d)) return api__invalid(ctx, p, "must be an integer");
   if (d < (double)lo || d > (double)hi)
     return api__invalid(ctx, p, "must be between %ld and %ld", lo, hi);
   *out = (long)d;
@@ -95,8 +85,7 @@ bool api__member_bool(api_ctx *ctx, const cJSON *obj, const char *base,
                       bool *present) {
   const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
   char p[API_POINTER_MAX];
-  if (present != NULL)
-    *present = v != NULL;
+  if (present != NULL) *present = v != NULL;
   if (v == NULL)
     return required ? api__require(ctx, obj, base, key) != NULL : true;
   api__ptr_key(p, base, key);
@@ -113,10 +102,8 @@ bool api__member_enum(api_ctx *ctx, const cJSON *obj, const char *base,
   char p[API_POINTER_MAX];
   char list[API_TEXT_MAX];
   size_t used = 0;
-  if (present != NULL)
-    *present = v != NULL;
-  if (v == NULL)
-    return true;
+  if (present != NULL) *present = v != NULL;
+  if (v == NULL) return true;
   api__ptr_key(p, base, key);
   if (cJSON_IsString(v)) {
     for (size_t i = 0; i < n; i++) {
@@ -130,8 +117,7 @@ bool api__member_enum(api_ctx *ctx, const cJSON *obj, const char *base,
   for (size_t i = 0; i < n && used < sizeof list; i++) {
     int w = snprintf(list + used, sizeof list - used, "%s\"%s\"",
                      i == 0 ? "" : (i + 1 == n ? " or " : ", "), names[i]);
-    if (w < 0)
-      break;
+    if (w < 0) break;
     used += (size_t)w;
   }
   return api__invalid(ctx, p, "must be one of %s", list);
@@ -146,8 +132,7 @@ static bool check_count(api_ctx *ctx, const cJSON *v, const char *ptr,
     return api__invalid(ctx, ptr, "must be an array, not %s",
                         api__type_name(v));
   size = api__array_len(v);
-  if (size == 0)
-    return api__invalid(ctx, ptr, "must not be empty");
+  if (size == 0) return api__invalid(ctx, ptr, "must not be empty");
   if (size > max)
     return api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded", ptr,
                       "has %zu elements; the limit is %zu", size, max);
@@ -162,8 +147,7 @@ void api__elems_start(api_elems *it, const cJSON *a) {
 }
 
 void api__elems_next(api_elems *it) {
-  if (it->item != NULL)
-    it->item = it->item->next;
+  if (it->item != NULL) it->item = it->item->next;
   it->index++;
 }
 
@@ -181,8 +165,7 @@ bool api__elems_num(api_ctx *ctx, const api_elems *it, const char *ptr,
                     double *out) {
   char p[API_POINTER_MAX];
   api__ptr_idx(p, ptr, it->index);
-  if (it->packed == NULL)
-    return api__num(ctx, it->item, p, out);
+  if (it->packed == NULL) return api__num(ctx, it->item, p, out);
   if (it->width > 0)
     return api__invalid(ctx, p, "must be a number, not an array");
   return packed_num(ctx, it, it->index, p, out);
@@ -192,27 +175,22 @@ bool api__elems_point(api_ctx *ctx, const api_elems *it, const char *ptr,
                       double out[2]) {
   char p[API_POINTER_MAX], q[API_POINTER_MAX];
   api__ptr_idx(p, ptr, it->index);
-  if (it->packed == NULL)
-    return api__point(ctx, it->item, p, out);
-  if (it->width != 2)
-    return api__invalid(ctx, p, "must be a point [x, y]");
+  if (it->packed == NULL) return api__point(ctx, it->item, p, out);
+  if (it->width != 2) return api__invalid(ctx, p, "must be a point [x, y]");
   api__ptr_idx(q, p, 0);
-  if (!packed_num(ctx, it, 2 * it->index, q, &out[0]))
-    return false;
+  if (!packed_num(ctx, it, 2 * it->index, q, &out[0])) return false;
   api__ptr_idx(q, p, 1);
   return packed_num(ctx, it, 2 * it->index + 1, q, &out[1]);
 }
 
-bool api__num_array(api_ctx *ctx, const cJSON *v, const char *ptr,
-                    size_t max, double **out, size_t *n) {
+bool api__num_array(api_ctx *ctx, const cJSON *v, const char *ptr, size_t max,
+                    double **out, size_t *n) {
   size_t count;
   double *a;
   api_elems it;
-  if (!check_count(ctx, v, ptr, max, &count))
-    return false;
+  if (!check_count(ctx, v, ptr, max, &count)) return false;
   a = km__malloc(count * sizeof *a);
-  if (a == NULL)
-    return api__oom(ctx);
+  if (a == NULL) return api__oom(ctx);
   api__elems_start(&it, v);
   for (size_t i = 0; i < count; i++, api__elems_next(&it)) {
     if (!api__elems_num(ctx, &it, ptr, &a[i])) {
@@ -225,28 +203,24 @@ bool api__num_array(api_ctx *ctx, const cJSON *v, const char *ptr,
   return true;
 }
 
-bool api__point(api_ctx *ctx, const cJSON *v, const char *ptr,
-                double out[2]) {
+bool api__point(api_ctx *ctx, const cJSON *v, const char *ptr, double out[2]) {
   api_elems it;
   if (!cJSON_IsArray(v) || api__array_len(v) != 2)
     return api__invalid(ctx, ptr, "must be a point [x, y]");
   api__elems_start(&it, v);
-  if (!api__elems_num(ctx, &it, ptr, &out[0]))
-    return false;
+  if (!api__elems_num(ctx, &it, ptr, &out[0])) return false;
   api__elems_next(&it);
   return api__elems_num(ctx, &it, ptr, &out[1]);
 }
 
-bool api__point_array(api_ctx *ctx, const cJSON *v, const char *ptr,
-                      size_t max, double **out, size_t *n) {
+bool api__point_array(api_ctx *ctx, const cJSON *v, const char *ptr, size_t max,
+                      double **out, size_t *n) {
   size_t count;
   double *a;
   api_elems it;
-  if (!check_count(ctx, v, ptr, max, &count))
-    return false;
+  if (!check_count(ctx, v, ptr, max, &count)) return false;
   a = km__malloc(2 * count * sizeof *a);
-  if (a == NULL)
-    return api__oom(ctx);
+  if (a == NULL) return api__oom(ctx);
   api__elems_start(&it, v);
   for (size_t i = 0; i < count; i++, api__elems_next(&it)) {
     if (!api__elems_point(ctx, &it, ptr, &a[2 * i])) {
@@ -265,19 +239,17 @@ bool api__point_array(api_ctx *ctx, const cJSON *v, const char *ptr,
  * pointer of the first bad knot never depends on how the core happens to
  * order its own checks. */
 bool api__read_knots(api_ctx *ctx, const cJSON *obj, const char *base,
-                     size_t ncoef, long degree, api_kind kind,
-                     double **knots, size_t *nk) {
+                     size_t ncoef, long degree, api_kind kind, double **knots,
+                     size_t *nk) {
   char p[API_POINTER_MAX];
   const bool sig = kind == API_KIND_SIGNATURE;
   const char *what = sig ? "coefficients" : "control_points";
   const char *type = sig ? API_P_INVALID_SIGNATURE : API_P_INVALID_CURVE;
   const char *title = sig ? "Invalid signature" : "Invalid curve";
   const cJSON *jk = api__require(ctx, obj, base, "knots");
-  if (jk == NULL)
-    return false;
+  if (jk == NULL) return false;
   api__ptr_key(p, base, "knots");
-  if (!api__num_array(ctx, jk, p, ctx->cfg->max_control_points + 64, knots,
-                      nk))
+  if (!api__num_array(ctx, jk, p, ctx->cfg->max_control_points + 64, knots, nk))
     return false;
   if (*nk != ncoef + (size_t)degree + 1)
     return api__failf(ctx, 422, type, title, p,
@@ -317,8 +289,7 @@ bool api__parse_include(api_ctx *ctx, const cJSON *root, bool allow_animate,
   char p[API_POINTER_MAX];
   inc->svg_d = false;
   inc->animate_d = false;
-  if (v == NULL)
-    return true;
+  if (v == NULL) return true;
   if (!cJSON_IsArray(v))
     return api__invalid(ctx, "/include", "must be an array of strings");
   n = api__array_len(v);
@@ -333,9 +304,9 @@ bool api__parse_include(api_ctx *ctx, const cJSON *root, bool allow_animate,
              strcmp(e->valuestring, "animate_d") == 0)
       inc->animate_d = true;
     else
-      return api__invalid(ctx, p, allow_animate
-                                      ? "must be \"svg_d\" or \"animate_d\""
-                                      : "must be \"svg_d\"");
+      return api__invalid(ctx, p,
+                          allow_animate ? "must be \"svg_d\" or \"animate_d\""
+                                        : "must be \"svg_d\"");
   }
   return true;
 }

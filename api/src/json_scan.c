@@ -15,19 +15,20 @@ typedef struct scan {
   size_t depth, max_depth;
   const char *error; /* static message, NULL while fine */
   bool too_deep;
-  size_t max_array;  /* no array in a valid request is longer */
+  size_t max_array; /* no array in a valid request is longer */
   bool too_long;
-  size_t cost;       /* heap bytes of the tree built so far */
-  size_t transient;  /* the largest buffer held only while building */
+  size_t cost;      /* heap bytes of the tree built so far */
+  size_t transient; /* the largest buffer held only while building */
 } scan;
 
 static bool scan_fail(scan *s, const char *msg) {
-  if (s->error == NULL)
-    s->error = msg;
+  if (s->error == NULL) s->error = msg;
   return false;
 }
 
-static void scan_ws(scan *s) { s->p = api__skip_ws(s->p, s->end); }
+static void scan_ws(scan *s) {
+  s->p = api__skip_ws(s->p, s->end);
+}
 
 static bool scan_lit(scan *s, const char *lit) {
   size_t n = strlen(lit);
@@ -38,17 +39,14 @@ static bool scan_lit(scan *s, const char *lit) {
 }
 
 static bool scan_digits(scan *s) {
-  if (s->p >= s->end || !isdigit(*s->p))
-    return scan_fail(s, "digit expected");
-  while (s->p < s->end && isdigit(*s->p))
-    s->p++;
+  if (s->p >= s->end || !isdigit(*s->p)) return scan_fail(s, "digit expected");
+  while (s->p < s->end && isdigit(*s->p)) s->p++;
   return true;
 }
 
 static bool scan_number(scan *s) {
   const unsigned char *from = s->p;
-  if (s->p < s->end && *s->p == '-')
-    s->p++;
+  if (s->p < s->end && *s->p == '-') s->p++;
   if (s->p < s->end && *s->p == '0') {
     s->p++;
   } else if (!scan_digits(s)) {
@@ -56,15 +54,12 @@ static bool scan_number(scan *s) {
   }
   if (s->p < s->end && *s->p == '.') {
     s->p++;
-    if (!scan_digits(s))
-      return false;
+    if (!scan_digits(s)) return false;
   }
   if (s->p < s->end && (*s->p == 'e' || *s->p == 'E')) {
     s->p++;
-    if (s->p < s->end && (*s->p == '+' || *s->p == '-'))
-      s->p++;
-    if (!scan_digits(s))
-      return false;
+    if (s->p < s->end && (*s->p == '+' || *s->p == '-')) s->p++;
+    if (!scan_digits(s)) return false;
   }
   /* the builder copies a long token to a buffer of its own for strtod */
   if ((size_t)(s->p - from) >= 64 &&
@@ -94,11 +89,9 @@ static bool scan_utf8(scan *s) {
   } else {
     return scan_fail(s, "invalid UTF-8");
   }
-  if ((size_t)(s->end - s->p) < len)
-    return scan_fail(s, "invalid UTF-8");
+  if ((size_t)(s->end - s->p) < len) return scan_fail(s, "invalid UTF-8");
   for (size_t i = 1; i < len; i++) {
-    if ((s->p[i] & 0xc0) != 0x80)
-      return scan_fail(s, "invalid UTF-8");
+    if ((s->p[i] & 0xc0) != 0x80) return scan_fail(s, "invalid UTF-8");
     cp = (cp << 6) | (s->p[i] & 0x3fu);
   }
   if ((len == 3 && (cp < 0x800 || (cp >= 0xd800 && cp <= 0xdfff))) ||
@@ -123,12 +116,10 @@ static bool scan_escape(scan *s) {
   if (c == 'u') {
     unsigned cp;
     s->p++;
-    if (!scan_hex4(s, &cp))
-      return false;
+    if (!scan_hex4(s, &cp)) return false;
     /* Only whole characters: a high surrogate must be followed by a low
      * one, and NUL would cut the C string short. */
-    if (cp == 0)
-      return scan_fail(s, "\\u0000 is not accepted in strings");
+    if (cp == 0) return scan_fail(s, "\\u0000 is not accepted in strings");
     if (cp >= 0xdc00 && cp <= 0xdfff)
       return scan_fail(s, "lone low surrogate in \\u escape");
     if (cp >= 0xd800 && cp <= 0xdbff) {
@@ -136,8 +127,7 @@ static bool scan_escape(scan *s) {
       if ((size_t)(s->end - s->p) < 2 || s->p[0] != '\\' || s->p[1] != 'u')
         return scan_fail(s, "lone high surrogate in \\u escape");
       s->p += 2;
-      if (!scan_hex4(s, &lo))
-        return false;
+      if (!scan_hex4(s, &lo)) return false;
       if (lo < 0xdc00 || lo > 0xdfff)
         return scan_fail(s, "lone high surrogate in \\u escape");
     }
@@ -160,18 +150,14 @@ static bool scan_string(scan *s) {
       s->p++;
       return true;
     }
-    if (c < 0x20)
-      return scan_fail(s, "control character in string");
+    if (c < 0x20) return scan_fail(s, "control character in string");
     if (c == '\\') {
       s->p++;
-      if (s->p >= s->end)
-        break;
-      if (!scan_escape(s))
-        return false;
+      if (s->p >= s->end) break;
+      if (!scan_escape(s)) return false;
       continue;
     }
-    if (!scan_utf8(s))
-      return false;
+    if (!scan_utf8(s)) return false;
   }
   return scan_fail(s, "unterminated string");
 }
@@ -185,15 +171,12 @@ static bool scan_entry(scan *s, bool object, bool *more) {
     scan_ws(s);
     if (s->p >= s->end || *s->p != '"')
       return scan_fail(s, "object key (a string) expected");
-    if (!scan_string(s))
-      return false;
+    if (!scan_string(s)) return false;
     scan_ws(s);
-    if (s->p >= s->end || *s->p != ':')
-      return scan_fail(s, "':' expected");
+    if (s->p >= s->end || *s->p != ':') return scan_fail(s, "':' expected");
     s->p++;
   }
-  if (!scan_value(s))
-    return false;
+  if (!scan_value(s)) return false;
   scan_ws(s);
   if (s->p < s->end && (*s->p == ',' || *s->p == close)) {
     *more = *s->p++ == ',';
@@ -222,10 +205,8 @@ static bool scan_container(scan *s, unsigned char close, bool object) {
       s->too_long = true;
       return scan_fail(s, "array too long");
     }
-    if (object)
-      count++;
-    if (!scan_entry(s, object, &more))
-      return false;
+    if (object) count++;
+    if (!scan_entry(s, object, &more)) return false;
   }
   s->depth--;
   if (!object && api__pack_shape(open, s->p, &rows, &width)) {
@@ -242,8 +223,7 @@ static bool scan_container(scan *s, unsigned char close, bool object) {
 
 static bool scan_value(scan *s) {
   scan_ws(s);
-  if (s->p >= s->end)
-    return scan_fail(s, "value expected");
+  if (s->p >= s->end) return scan_fail(s, "value expected");
   switch (*s->p) {
   case '{': return scan_container(s, '}', true);
   case '[': return scan_container(s, ']', false);
@@ -257,8 +237,7 @@ static bool scan_value(scan *s) {
   case 'f': return scan_lit(s, "false");
   case 'n': return scan_lit(s, "null");
   default:
-    if (*s->p == '-' || isdigit(*s->p))
-      return scan_number(s);
+    if (*s->p == '-' || isdigit(*s->p)) return scan_number(s);
     return scan_fail(s, "value expected");
   }
 }
@@ -273,8 +252,7 @@ size_t api__json_member_offset(const unsigned char *start,
   s.end = end;
   s.max_depth = SIZE_MAX;
   s.max_array = SIZE_MAX;
-  for (size_t i = 0; i < index && more; i++)
-    scan_entry(&s, true, &more);
+  for (size_t i = 0; i < index && more; i++) scan_entry(&s, true, &more);
   scan_ws(&s);
   return (size_t)(s.p - start);
 }
@@ -288,16 +266,13 @@ bool api__json_scan(api_ctx *ctx, const char *body, size_t length,
   s->max_depth = ctx->cfg->max_json_depth;
   s->max_array = max_array;
   /* A UTF-8 byte order mark is tolerated, as cJSON does. */
-  if (length >= 3 && memcmp(s->p, "\xef\xbb\xbf", 3) == 0)
-    s->p += 3;
+  if (length >= 3 && memcmp(s->p, "\xef\xbb\xbf", 3) == 0) s->p += 3;
   if (scan_value(s)) {
     scan_ws(s);
-    if (s->p != s->end)
-      scan_fail(s, "unexpected data after the JSON value");
+    if (s->p != s->end) scan_fail(s, "unexpected data after the JSON value");
   }
   *need = s->cost + s->transient;
-  if (s->error == NULL)
-    return true;
+  if (s->error == NULL) return true;
   if (s->too_long)
     return api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded", NULL,
                       "an array holds more than %zu elements (at byte %zu)",

@@ -22,8 +22,7 @@
 /* ------------------------------------------------------- packed arrays */
 
 size_t api__array_len(const cJSON *a) {
-  if (!cJSON_IsArray(a))
-    return 0;
+  if (!cJSON_IsArray(a)) return 0;
   if ((a->type & API_PACKED) != 0)
     return ((const api_pack *)(const void *)a->valuestring)->count;
   return (size_t)cJSON_GetArraySize(a);
@@ -31,11 +30,9 @@ size_t api__array_len(const cJSON *a) {
 
 const double *api__array_packed(const cJSON *a, size_t *width) {
   const api_pack *pk;
-  if (!cJSON_IsArray(a) || (a->type & API_PACKED) == 0)
-    return NULL;
+  if (!cJSON_IsArray(a) || (a->type & API_PACKED) == 0) return NULL;
   pk = (const api_pack *)(const void *)a->valuestring;
-  if (width != NULL)
-    *width = pk->width;
+  if (width != NULL) *width = pk->width;
   return pk->v;
 }
 
@@ -49,23 +46,18 @@ bool api__pack_shape(const unsigned char *p, const unsigned char *end,
   for (;;) {
     size_t k = 0;
     if (rows) {
-      if (p >= end || *p != '[')
-        return false;
+      if (p >= end || *p != '[') return false;
       p = api__skip_ws(p + 1, end);
     }
     do {
-      if (p < end && *p == ',')
-        p = api__skip_ws(p + 1, end);
-      if (p >= end || !(*p == '-' || isdigit(*p)))
-        return false;
-      while (p < end && api__number_char(*p))
-        p++;
+      if (p < end && *p == ',') p = api__skip_ws(p + 1, end);
+      if (p >= end || !(*p == '-' || isdigit(*p))) return false;
+      while (p < end && api__number_char(*p)) p++;
       p = api__skip_ws(p, end);
       k++;
     } while (rows && p < end && *p == ',');
     if (rows) {
-      if (k > API_PACK_WIDTH_MAX || (n > 0 && k != w))
-        return false;
+      if (k > API_PACK_WIDTH_MAX || (n > 0 && k != w)) return false;
       w = k;
       p = api__skip_ws(p + 1, end); /* the row's ']' */
     }
@@ -100,12 +92,13 @@ typedef struct build {
   char dup_detail[API_TEXT_MAX];
 } build;
 
-static void build_ws(build *b) { b->p = api__skip_ws(b->p, b->end); }
+static void build_ws(build *b) {
+  b->p = api__skip_ws(b->p, b->end);
+}
 
 static unsigned build_hex4(build *b) {
   unsigned cp = 0;
-  for (int i = 0; i < 4; i++)
-    cp = (cp << 4) | (unsigned)api__hexval(*b->p++);
+  for (int i = 0; i < 4; i++) cp = (cp << 4) | (unsigned)api__hexval(*b->p++);
   return cp;
 }
 
@@ -140,11 +133,9 @@ static char *build_string(build *b) {
   const unsigned char *q = ++b->p;
   size_t n = 0;
   unsigned char *o;
-  while (*q != '"')
-    q += *q == '\\' ? 2 : 1;
+  while (*q != '"') q += *q == '\\' ? 2 : 1;
   o = cJSON_malloc((size_t)(q - b->p) + 1);
-  if (o == NULL)
-    return NULL;
+  if (o == NULL) return NULL;
   while (*b->p != '"') {
     unsigned char c = *b->p++;
     if (c != '\\') {
@@ -181,17 +172,14 @@ static bool build_double(build *b, double *out) {
   const unsigned char *from = b->p;
   char small[64], *text = small;
   size_t n;
-  while (b->p < b->end && api__number_char(*b->p))
-    b->p++;
+  while (b->p < b->end && api__number_char(*b->p)) b->p++;
   n = (size_t)(b->p - from);
   /* strtod needs a terminator, which the body need not have */
-  if (n >= sizeof small && (text = cJSON_malloc(n + 1)) == NULL)
-    return false;
+  if (n >= sizeof small && (text = cJSON_malloc(n + 1)) == NULL) return false;
   memcpy(text, from, n);
   text[n] = '\0';
   *out = strtod(text, NULL);
-  if (text != small)
-    cJSON_free(text);
+  if (text != small) cJSON_free(text);
   return true;
 }
 
@@ -200,19 +188,16 @@ static cJSON *build_packed(build *b, size_t count, size_t width) {
   api_pack *pk = cJSON_malloc(api__pack_bytes(count, width));
   cJSON *c = pk != NULL ? cJSON_CreateArray() : NULL;
   size_t k = 0;
-  if (c == NULL)
-    goto fail;
+  if (c == NULL) goto fail;
   pk->count = count;
   pk->width = width;
   b->p++; /* '[' */
   for (size_t i = 0; i < count; i++) {
     build_ws(b);
-    if (width > 0)
-      b->p++; /* the row's '[' */
+    if (width > 0) b->p++; /* the row's '[' */
     for (size_t j = 0; j < (width > 0 ? width : 1); j++) {
       build_ws(b);
-      if (!build_double(b, &pk->v[k++]))
-        goto fail;
+      if (!build_double(b, &pk->v[k++])) goto fail;
       build_ws(b);
       b->p++; /* ',' or the row's ']' */
     }
@@ -232,17 +217,14 @@ fail:
 
 /* Append s to buf[*len..cap) as far as it fits. */
 static void append(char *buf, size_t cap, size_t *len, const char *s) {
-  while (*s != '\0' && *len + 1 < cap)
-    buf[(*len)++] = *s++;
+  while (*s != '\0' && *len + 1 < cap) buf[(*len)++] = *s++;
   buf[*len] = '\0';
 }
 
 /* The RFC 6901 pointer of the value f leads into (the root: ""). */
-static void frame_pointer(const frame *f, char *buf, size_t cap,
-                          size_t *len) {
+static void frame_pointer(const frame *f, char *buf, size_t cap, size_t *len) {
   char idx[24];
-  if (f == NULL)
-    return;
+  if (f == NULL) return;
   frame_pointer(f->up, buf, cap, len);
   append(buf, cap, len, "/");
   if (f->key == NULL) {
@@ -251,21 +233,21 @@ static void frame_pointer(const frame *f, char *buf, size_t cap,
     return;
   }
   for (const char *k = f->key; *k != '\0'; k++)
-    append(buf, cap, len, *k == '~' ? "~0" : *k == '/' ? "~1"
-                                                       : (char[]){*k, 0});
+    append(buf, cap, len,
+           *k == '~'   ? "~0"
+           : *k == '/' ? "~1"
+                       : (char[]){*k, 0});
 }
 
 /* Cut s (of *len bytes) back to whole UTF-8 characters. */
 static void trim_utf8(char *s, size_t len) {
   size_t i = len;
-  while (i > 0 && ((unsigned char)s[i - 1] & 0xc0) == 0x80)
-    i--;
+  while (i > 0 && ((unsigned char)s[i - 1] & 0xc0) == 0x80) i--;
   if (i > 0 && (unsigned char)s[i - 1] >= 0xc0) {
     size_t need = (unsigned char)s[i - 1] >= 0xf0   ? 4
                   : (unsigned char)s[i - 1] >= 0xe0 ? 3
                                                     : 2;
-    if (len - (i - 1) < need)
-      s[i - 1] = '\0';
+    if (len - (i - 1) < need) s[i - 1] = '\0';
   }
 }
 
@@ -288,8 +270,7 @@ static void dup_fail(build *b, const char *key, const frame *up,
 static int member_cmp(const void *pa, const void *pb) {
   const api_member *a = pa, *b = pb;
   int c = strcmp(a->key, b->key);
-  if (c != 0)
-    return c;
+  if (c != 0) return c;
   return (a->index > b->index) - (a->index < b->index);
 }
 
@@ -318,8 +299,7 @@ static bool unique_members(build *b, const cJSON *obj, size_t n,
   if (key != NULL)
     dup_fail(b, key, up,
              api__json_member_offset(b->start, b->end, open, first));
-  if (m != stack)
-    cJSON_free(m);
+  if (m != stack) cJSON_free(m);
   return key == NULL;
 }
 
@@ -345,8 +325,7 @@ static cJSON *build_container(build *b, bool object, const frame *up) {
     cJSON *v;
     if (object) {
       build_ws(b);
-      if ((me.key = key = build_string(b)) == NULL)
-        goto fail;
+      if ((me.key = key = build_string(b)) == NULL) goto fail;
       build_ws(b);
       b->p++; /* ':' */
     }
@@ -358,8 +337,7 @@ static cJSON *build_container(build *b, bool object, const frame *up) {
     cJSON_AddItemToArray(c, v);
     me.index++;
     build_ws(b);
-    if (*b->p++ == ',')
-      continue;
+    if (*b->p++ == ',') continue;
     break; /* '}' or ']' */
   }
   if (object && me.index > 1 && !unique_members(b, c, me.index, open, up))
@@ -403,8 +381,7 @@ cJSON *api__json_build(api_ctx *ctx, const char *body, size_t length) {
   b.start = (const unsigned char *)(body != NULL ? body : "");
   b.end = b.start + length;
   b.p = b.start;
-  if (length >= 3 && memcmp(b.p, "\xef\xbb\xbf", 3) == 0)
-    b.p += 3;
+  if (length >= 3 && memcmp(b.p, "\xef\xbb\xbf", 3) == 0) b.p += 3;
   root = build_value(&b, NULL);
   if (root == NULL) {
     if (b.dup)

@@ -13,8 +13,7 @@
 #include "morph_plan.h"
 
 void api_morph_plan_free(api_morph_plan *plan) {
-  if (plan == NULL)
-    return;
+  if (plan == NULL) return;
   km_morph_free(plan->morph);
   km_shape_morph_free(plan->smorph);
   km_shape_free(&plan->sfrom);
@@ -41,8 +40,7 @@ static bool plan_new(api_ctx *ctx, const api_config *cfg,
                      const char *request_id, api_morph_plan **out) {
   api_morph_plan *pl = km__calloc(1, sizeof *pl);
   *out = pl;
-  if (pl == NULL)
-    return api__oom(ctx);
+  if (pl == NULL) return api__oom(ctx);
   pl->cfg = *cfg;
   api__input_init(&pl->from);
   api__input_init(&pl->to);
@@ -50,16 +48,15 @@ static bool plan_new(api_ctx *ctx, const api_config *cfg,
   km_shape_init(&pl->sto);
   if (request_id != NULL) {
     size_t n = strlen(request_id);
-    if ((pl->request_id = km__malloc(n + 1)) == NULL)
-      return api__oom(ctx);
+    if ((pl->request_id = km__malloc(n + 1)) == NULL) return api__oom(ctx);
     memcpy(pl->request_id, request_id, n + 1);
   }
   return true;
 }
 
 /* The request's body parsed and read into pl; the tree is not kept. */
-static bool plan_read(api_ctx *ctx, const api_request *req,
-                      size_t max_frames, api_morph_plan *pl) {
+static bool plan_read(api_ctx *ctx, const api_request *req, size_t max_frames,
+                      api_morph_plan *pl) {
   cJSON *root;
   bool ok;
   if (req->route != API_ROUTE_MORPH)
@@ -77,13 +74,10 @@ static bool input_signature(api_ctx *ctx, api_input *in, const char *ptr,
                             double tol, const km_stop *stop) {
   km_error err;
   km_status st;
-  if (in->is_signature)
-    return true;
+  if (in->is_signature) return true;
   st = km_signature_compute_until(&in->curve, tol, stop, &in->sig, &err);
-  if (st == KM_ECANCELLED)
-    return api__stopped(ctx);
-  if (st != KM_OK)
-    return api__core_fail(ctx, st, &err, ptr, in->kind);
+  if (st == KM_ECANCELLED) return api__stopped(ctx);
+  if (st != KM_OK) return api__core_fail(ctx, st, &err, ptr, in->kind);
   return true;
 }
 
@@ -97,18 +91,15 @@ static km_morph_input morph_input(const api_input *in) {
 
 /* The core's plan of the morph from the inputs read into pl, under the
  * request's tolerance (else 1e-5 of the longer input). */
-static bool plan_build(api_ctx *ctx, api_morph_plan *pl,
-                       const km_stop *stop) {
+static bool plan_build(api_ctx *ctx, api_morph_plan *pl, const km_stop *stop) {
   km_morph_input fi, ti;
   km_error err;
   km_status st;
-  if (pl->tol <= 0)
-    pl->tol = 1e-5 * fmax(pl->from.length, pl->to.length);
+  if (pl->tol <= 0) pl->tol = 1e-5 * fmax(pl->from.length, pl->to.length);
   pl->opt.tolerance = pl->tol;
   /* frames are curves of the answer: held to the limit on curves */
   pl->opt.max_points = pl->cfg.max_control_points;
-  if (pl->shapes)
-    return api__shape_build(ctx, pl, stop);
+  if (pl->shapes) return api__shape_build(ctx, pl, stop);
   if (pl->opt.method == KM_METHOD_CURVATURE &&
       (!input_signature(ctx, &pl->from, "/from", pl->tol, stop) ||
        !input_signature(ctx, &pl->to, "/to", pl->tol, stop)))
@@ -119,10 +110,8 @@ static bool plan_build(api_ctx *ctx, api_morph_plan *pl,
   pl->opt.stop = stop;
   st = km_morph_create(&pl->morph, &fi, &ti, &pl->opt, &err);
   pl->opt.stop = NULL;
-  if (st == KM_ECANCELLED)
-    return api__stopped(ctx);
-  if (st != KM_OK)
-    return api__core_fail(ctx, st, &err, "", API_KIND_REQUEST);
+  if (st == KM_ECANCELLED) return api__stopped(ctx);
+  if (st != KM_OK) return api__core_fail(ctx, st, &err, "", API_KIND_REQUEST);
   return true;
 }
 
@@ -143,8 +132,7 @@ api_status api_morph_prepare(const api_config *cfg, const api_request *req,
   api_response_init(error);
   api__ctx_init(&ctx, cfg);
   if (!plan_new(&ctx, cfg, req->request_id, &pl) ||
-      !plan_read(&ctx, req, max_frames, pl) ||
-      !plan_build(&ctx, pl, stop) ||
+      !plan_read(&ctx, req, max_frames, pl) || !plan_build(&ctx, pl, stop) ||
       !(pl->shapes ? api__shape_check_size(&ctx, pl, stop)
                    : api__morph_check_size(&ctx, pl, stop)))
     goto fail;
@@ -180,15 +168,12 @@ api_status api_morph_render_frame_until(api_morph_plan *plan, size_t i,
                                         api_stop_fn stop, void *ctx) {
   api_frame_slot *f;
   km_stop ks = {stop, ctx};
-  if (plan == NULL || i >= plan->nframes)
-    return 404;
+  if (plan == NULL || i >= plan->nframes) return 404;
   f = &plan->frames[i];
-  if (f->state == API_FRAME_DONE)
-    return API_STEP_DONE;
+  if (f->state == API_FRAME_DONE) return API_STEP_DONE;
   if (plan->shapes) {
     api__shape_render(plan, f, stop != NULL ? &ks : NULL);
-    if (f->state == API_FRAME_DONE)
-      return API_STEP_DONE;
+    if (f->state == API_FRAME_DONE) return API_STEP_DONE;
     return f->st == KM_ENOMEM || f->st == KM_ECANCELLED ? 503 : 422;
   }
   km_curve_free(&f->curve);

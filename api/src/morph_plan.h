@@ -34,7 +34,7 @@ typedef struct api_frame_slot {
   api_frame_state state;
   km_curve curve;
   km_frame_metrics metrics;
-  km_signature sig; /* only for curvature plots */
+  km_signature sig;     /* only for curvature plots */
   km_shape_frame shape; /* compound morphs: the frame, in place of curve */
   km_status st;
   km_error err;

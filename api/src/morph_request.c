@@ -47,22 +47,19 @@ _Static_assert(API_SVG_FILMSTRIP == 0 && API_SVG_OVERLAY == 1 &&
 
 static bool ascii_prefix_ci(const char *s, const char *prefix, size_t n) {
   for (size_t i = 0; i < n; i++)
-    if (s[i] == '\0' || tolower((unsigned char)s[i]) != prefix[i])
-      return false;
+    if (s[i] == '\0' || tolower((unsigned char)s[i]) != prefix[i]) return false;
   return true;
 }
 
 /* q value of one media range's parameters ("; q=0.5"); 1 when absent. */
 static double accept_q(const char *p, const char *end) {
   while (p < end) {
-    while (p < end && (*p == ';' || *p == ' ' || *p == '\t'))
-      p++;
+    while (p < end && (*p == ';' || *p == ' ' || *p == '\t')) p++;
     if (end - p >= 2 && (p[0] == 'q' || p[0] == 'Q') && p[1] == '=') {
       double q = strtod(p + 2, NULL);
       return isfinite(q) ? q : 0;
     }
-    while (p < end && *p != ';')
-      p++;
+    while (p < end && *p != ';') p++;
   }
   return 1;
 }
@@ -72,22 +69,17 @@ static double accept_q(const char *p, const char *end) {
 static bool accept_prefers_svg(const char *accept) {
   double q_svg = -1, q_json = -1;
   const char *p = accept;
-  if (accept == NULL)
-    return false;
+  if (accept == NULL) return false;
   while (*p != '\0') {
     const char *end = strchr(p, ',');
     const char *semi;
     size_t n;
-    if (end == NULL)
-      end = p + strlen(p);
-    while (p < end && (*p == ' ' || *p == '\t'))
-      p++;
+    if (end == NULL) end = p + strlen(p);
+    while (p < end && (*p == ' ' || *p == '\t')) p++;
     semi = memchr(p, ';', (size_t)(end - p));
-    if (semi == NULL)
-      semi = end;
+    if (semi == NULL) semi = end;
     n = (size_t)(semi - p);
-    while (n > 0 && (p[n - 1] == ' ' || p[n - 1] == '\t'))
-      n--;
+    while (n > 0 && (p[n - 1] == ' ' || p[n - 1] == '\t')) n--;
     double q = accept_q(semi, end);
     if (n == 13 && ascii_prefix_ci(p, "image/svg+xml", 13))
       q_svg = fmax(q_svg, q);
@@ -99,8 +91,7 @@ static bool accept_prefers_svg(const char *accept) {
   }
   return q_svg > 0 && q_svg > q_json;
 
-/* ------------------------------------------------------------ the options */
-
+  /* ------------------------------------------------------------ the options */
 }
 
 /* A colour is copied into the SVG document: allow only what CSS colour
@@ -111,8 +102,7 @@ static bool parse_colour(api_ctx *ctx, const cJSON *svg, const char *key,
   char p[API_POINTER_MAX];
   const cJSON *v = cJSON_GetObjectItemCaseSensitive(svg, key);
   size_t n;
-  if (v == NULL)
-    return true;
+  if (v == NULL) return true;
   api__ptr_key(p, "/svg", key);
   if (!cJSON_IsString(v))
     return api__invalid(ctx, p, "must be a colour string");
@@ -139,8 +129,7 @@ static bool positive_member(api_ctx *ctx, const cJSON *obj, const char *key,
   double v = 0;
   if (!api__member_num(ctx, obj, "/svg", key, false, &v, &present))
     return false;
-  if (!present)
-    return true;
+  if (!present) return true;
   api__ptr_key(p, "/svg", key);
   if (!(v > 0) || v > max)
     return api__invalid(ctx, p, "must be > 0 and <= %g", max);
@@ -154,8 +143,7 @@ static bool parse_svg_options(api_ctx *ctx, const cJSON *root,
   int layout = 0;
   memset(&pl->svgopt, 0, sizeof pl->svgopt);
   pl->svgopt.layout = API_SVG_FILMSTRIP;
-  if (svg == NULL)
-    return true;
+  if (svg == NULL) return true;
   if (!cJSON_IsObject(svg))
     return api__invalid(ctx, "/svg", "must be an object");
   if (!api__member_enum(ctx, svg, "/svg", "layout", NAMES(layout_names),
@@ -170,20 +158,17 @@ static bool parse_svg_options(api_ctx *ctx, const cJSON *root,
          parse_colour(ctx, svg, "stroke", pl->stroke, &pl->svgopt.stroke) &&
          parse_colour(ctx, svg, "from_color", pl->from_color,
                       &pl->svgopt.from_color) &&
-         parse_colour(ctx, svg, "to_color", pl->to_color,
-                      &pl->svgopt.to_color);
+         parse_colour(ctx, svg, "to_color", pl->to_color, &pl->svgopt.to_color);
 }
 
 /* "matches": "auto" or [[r_from, r_to], ...] strictly increasing in (0,1)
  * on both sides. */
-static bool parse_matches(api_ctx *ctx, const cJSON *root,
-                          api_morph_plan *pl) {
+static bool parse_matches(api_ctx *ctx, const cJSON *root, api_morph_plan *pl) {
   const cJSON *v = cJSON_GetObjectItemCaseSensitive(root, "matches");
   api_elems it;
   char p[API_POINTER_MAX], q[API_POINTER_MAX];
   size_t n, i = 0;
-  if (v == NULL || cJSON_IsNull(v))
-    return true;
+  if (v == NULL || cJSON_IsNull(v)) return true;
   if (cJSON_IsString(v)) {
     if (strcmp(v->valuestring, "auto") != 0)
       return api__invalid(ctx, "/matches",
@@ -197,21 +182,18 @@ static bool parse_matches(api_ctx *ctx, const cJSON *root,
                         "must be \"auto\" or an array of [r_from, r_to] "
                         "pairs");
   n = api__array_len(v);
-  if (n == 0)
-    return true;
+  if (n == 0) return true;
   if (n > pl->cfg.max_control_points)
     return api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded", "/matches",
                       "has %zu pairs; the limit is %zu", n,
                       pl->cfg.max_control_points);
   pl->matches = km__malloc(2 * n * sizeof *pl->matches);
-  if (pl->matches == NULL)
-    return api__oom(ctx);
+  if (pl->matches == NULL) return api__oom(ctx);
   api__elems_start(&it, v);
   for (; i < n; i++, api__elems_next(&it)) {
     double *m = &pl->matches[2 * i];
     api__ptr_idx(p, "/matches", i);
-    if (!api__elems_point(ctx, &it, "/matches", m))
-      return false;
+    if (!api__elems_point(ctx, &it, "/matches", m)) return false;
     for (int k = 0; k < 2; k++) {
       api__ptr_idx(q, p, (size_t)k);
       if (!(m[k] > 0 && m[k] < 1))
@@ -240,8 +222,7 @@ static bool parse_times(api_ctx *ctx, const cJSON *root, size_t max_frames,
   if (jt != NULL) {
     double *t = NULL;
     char p[API_POINTER_MAX];
-    if (!api__num_array(ctx, jt, "/times", max_frames, &t, &n))
-      return false;
+    if (!api__num_array(ctx, jt, "/times", max_frames, &t, &n)) return false;
     for (size_t i = 0; i < n; i++) {
       if (!(t[i] >= 0 && t[i] <= 1)) {
         km__free(t);
@@ -254,8 +235,7 @@ static bool parse_times(api_ctx *ctx, const cJSON *root, size_t max_frames,
       km__free(t);
       return api__oom(ctx);
     }
-    for (size_t i = 0; i < n; i++)
-      pl->frames[i].t = t[i];
+    for (size_t i = 0; i < n; i++) pl->frames[i].t = t[i];
     km__free(t);
     pl->times_given = true;
   } else {
@@ -264,16 +244,14 @@ static bool parse_times(api_ctx *ctx, const cJSON *root, size_t max_frames,
     if (!api__member_int(ctx, root, "", "frames", false, LONG_MIN / 2,
                          LONG_MAX / 2, &frames, &present))
       return false;
-    if (frames < 2)
-      return api__invalid(ctx, "/frames", "must be at least 2");
+    if (frames < 2) return api__invalid(ctx, "/frames", "must be at least 2");
     if ((unsigned long)frames > max_frames)
       return api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded", "/frames",
                         "%ld frames asked for; the limit is %zu", frames,
                         max_frames);
     n = (size_t)frames;
     pl->frames = km__calloc(n, sizeof *pl->frames);
-    if (pl->frames == NULL)
-      return api__oom(ctx);
+    if (pl->frames == NULL) return api__oom(ctx);
     for (size_t i = 0; i < n; i++)
       pl->frames[i].t = i + 1 == n ? 1.0 : (double)i / (double)(n - 1);
   }
@@ -286,8 +264,7 @@ static bool parse_times(api_ctx *ctx, const cJSON *root, size_t max_frames,
   return true;
 }
 
-static bool parse_options(api_ctx *ctx, const cJSON *root,
-                          api_morph_plan *pl) {
+static bool parse_options(api_ctx *ctx, const cJSON *root, api_morph_plan *pl) {
   int method = 0, blend = 0, closure = 0, anchor = 0, orient = 0;
   int format = 0;
   long degree = 3;
@@ -299,22 +276,21 @@ static bool parse_options(api_ctx *ctx, const cJSON *root,
   anchor = (int)pl->opt.anchor;
   orient = (int)pl->opt.orient;
   pl->metrics = true;
-  if (!api__member_enum(ctx, root, "", "method",
-                        NAMES(api__morph_method_names), &method, NULL) ||
+  if (!api__member_enum(ctx, root, "", "method", NAMES(api__morph_method_names),
+                        &method, NULL) ||
       !api__member_enum(ctx, root, "", "blend", NAMES(blend_names), &blend,
                         NULL) ||
       !api__member_enum(ctx, root, "", "closure", NAMES(closure_names),
                         &closure, NULL) ||
-      !api__member_enum(ctx, root, "", "anchor", NAMES(anchor_names),
-                        &anchor, NULL) ||
+      !api__member_enum(ctx, root, "", "anchor", NAMES(anchor_names), &anchor,
+                        NULL) ||
       !api__member_enum(ctx, root, "", "orient", NAMES(orient_names), &orient,
                         NULL) ||
       !api__member_enum(ctx, root, "", "format", NAMES(format_names), &format,
                         &fmt_present) ||
       !api__member_int(ctx, root, "", "degree", false, -1000000, 1000000,
                        &degree, NULL) ||
-      !api__member_bool(ctx, root, "", "metrics", false, &pl->metrics,
-                        NULL) ||
+      !api__member_bool(ctx, root, "", "metrics", false, &pl->metrics, NULL) ||
       !api__parse_include(ctx, root, true, &pl->inc) ||
       !api__parse_tolerance(ctx, root, &pl->tol))
     return false;
@@ -335,14 +311,12 @@ static bool parse_options(api_ctx *ctx, const cJSON *root,
 bool api__morph_read_request(api_ctx *ctx, const cJSON *root,
                              const char *accept, size_t max_frames,
                              api_morph_plan *pl) {
-  if (!parse_options(ctx, root, pl) ||
-      !parse_times(ctx, root, max_frames, pl))
+  if (!parse_options(ctx, root, pl) || !parse_times(ctx, root, max_frames, pl))
     return false;
   if (!pl->svg && cJSON_GetObjectItemCaseSensitive(root, "format") == NULL)
     pl->svg = accept_prefers_svg(accept);
   pl->want_sig = pl->svg && pl->svgopt.layout == API_SVG_CURVATURE_PLOT;
-  return api__parse_curve(ctx,
-                          cJSON_GetObjectItemCaseSensitive(root, "from"),
+  return api__parse_curve(ctx, cJSON_GetObjectItemCaseSensitive(root, "from"),
                           "/from", pl->tol, &pl->from) &&
          api__parse_curve(ctx, cJSON_GetObjectItemCaseSensitive(root, "to"),
                           "/to", pl->tol, &pl->to) &&

@@ -87,18 +87,15 @@ static cJSON *animate_json(api_ctx *ctx, const api_morph_plan *pl) {
 static cJSON *frame_json(api_ctx *ctx, const api_morph_plan *pl,
                          const api_frame_slot *f) {
   cJSON *fo, *c;
-  if (pl->shapes)
-    return api__shape_frame_json(ctx, pl, f);
+  if (pl->shapes) return api__shape_frame_json(ctx, pl, f);
   if ((fo = cJSON_CreateObject()) == NULL) {
     api__oom(ctx);
     return NULL;
   }
-  if (!api__add_num(ctx, fo, "t", f->t))
-    goto fail;
+  if (!api__add_num(ctx, fo, "t", f->t)) goto fail;
   if ((c = api__curve_json(ctx, &f->curve, pl->inc.svg_d, pl->tol)) == NULL)
     goto fail;
-  if (!api__add_item(ctx, fo, "curve", c))
-    goto fail;
+  if (!api__add_item(ctx, fo, "curve", c)) goto fail;
   if (pl->metrics) {
     if ((c = api__metrics_json(ctx, &f->metrics)) == NULL ||
         !api__add_item(ctx, fo, "metrics", c))
@@ -138,11 +135,9 @@ typedef struct text_out {
 static bool text_put(text_out *t, const char *s, size_t n) {
   if (t->len + n + 1 > t->cap) {
     size_t cap = t->cap ? t->cap : 4096;
-    while (cap < t->len + n + 1)
-      cap += cap / 2;
+    while (cap < t->len + n + 1) cap += cap / 2;
     char *p = km__realloc(t->p, cap);
-    if (p == NULL)
-      return false;
+    if (p == NULL) return false;
     t->p = p;
     t->cap = cap;
   }
@@ -156,8 +151,8 @@ static bool text_put(text_out *t, const char *s, size_t n) {
 static bool text_put_item(text_out *t, const char *key, cJSON *item) {
   char *s = item != NULL ? cJSON_PrintUnformatted(item) : NULL;
   cJSON_Delete(item);
-  bool ok = s != NULL && text_put(t, key, strlen(key)) &&
-            text_put(t, s, strlen(s));
+  bool ok =
+      s != NULL && text_put(t, key, strlen(key)) && text_put(t, s, strlen(s));
   km__free(s);
   return ok;
 }
@@ -169,22 +164,18 @@ static bool text_put_item(text_out *t, const char *key, cJSON *item) {
 static api_status result_json(api_ctx *ctx, api_morph_plan *pl,
                               api_response *out) {
   text_out t = {NULL, 0, 0};
-  cJSON *method =
-      cJSON_CreateString(api__morph_method_names[pl->opt.method]);
+  cJSON *method = cJSON_CreateString(api__morph_method_names[pl->opt.method]);
   if (!text_put_item(&t, "{\"method\":", method) ||
       !text_put(&t, ",\"frames\":[", 11))
     goto oom;
   for (size_t i = 0; i < pl->nframes; i++) {
     cJSON *fo = frame_json(ctx, pl, &pl->frames[i]);
-    if (fo == NULL)
-      goto fail;
-    if (!text_put_item(&t, i > 0 ? "," : "", fo))
-      goto oom;
+    if (fo == NULL) goto fail;
+    if (!text_put_item(&t, i > 0 ? "," : "", fo)) goto oom;
   }
   cJSON *item = pl->shapes ? api__shape_pairs_json(ctx, pl)
-                            : matches_used_json(ctx, pl->morph);
-  if (item == NULL)
-    goto fail;
+                           : matches_used_json(ctx, pl->morph);
+  if (item == NULL) goto fail;
   if (!text_put_item(&t,
                      pl->shapes ? "],\"contour_matches_used\":"
                                 : "],\"matches_used\":",
@@ -194,11 +185,9 @@ static api_status result_json(api_ctx *ctx, api_morph_plan *pl,
     if ((item = pl->shapes ? api__shape_animate_json(ctx, pl)
                            : animate_json(ctx, pl)) == NULL)
       goto fail;
-    if (!text_put_item(&t, ",\"animate_d\":", item))
-      goto oom;
+    if (!text_put_item(&t, ",\"animate_d\":", item)) goto oom;
   }
-  if (!text_put(&t, "}", 1))
-    goto oom;
+  if (!text_put(&t, "}", 1)) goto oom;
   out->status = 200;
   out->content_type = API_CT_JSON;
   out->body = t.p;
@@ -217,8 +206,7 @@ fail:
 static char *shape_svg(const api_morph_plan *pl) {
   api_svg_shape_frame *fr = km__malloc(pl->nframes * sizeof *fr);
   char *doc;
-  if (fr == NULL)
-    return NULL;
+  if (fr == NULL) return NULL;
   for (size_t i = 0; i < pl->nframes; i++) {
     fr[i].t = pl->frames[i].t;
     fr[i].shape = &pl->frames[i].shape;
@@ -231,8 +219,7 @@ static char *shape_svg(const api_morph_plan *pl) {
 
 static api_status result_svg(api_ctx *ctx, api_morph_plan *pl,
                              api_response *out) {
-  api_svg_frame *fr = pl->shapes ? NULL
-                                 : km__malloc(pl->nframes * sizeof *fr);
+  api_svg_frame *fr = pl->shapes ? NULL : km__malloc(pl->nframes * sizeof *fr);
   char *doc = pl->shapes ? shape_svg(pl) : NULL;
   if (fr != NULL) {
     for (size_t i = 0; i < pl->nframes; i++) {
@@ -258,8 +245,7 @@ static api_status result_svg(api_ctx *ctx, api_morph_plan *pl,
 /* The problem of frame i, which failed or was stopped: named by its entry
  * of "times", or by the request as a whole, with the frame and its t
  * ahead of the core's message. */
-static void frame_problem(api_ctx *ctx, const api_morph_plan *plan,
-                          size_t i) {
+static void frame_problem(api_ctx *ctx, const api_morph_plan *plan, size_t i) {
   const api_frame_slot *f = &plan->frames[i];
   char base[API_POINTER_MAX], msg[API_TEXT_MAX];
   km_error e = f->err;
@@ -268,8 +254,7 @@ static void frame_problem(api_ctx *ctx, const api_morph_plan *plan,
     return;
   }
   base[0] = '\0';
-  if (plan->times_given)
-    api__ptr_idx(base, "/times", i);
+  if (plan->times_given) api__ptr_idx(base, "/times", i);
   e.field = KM_FIELD_NONE;
   api__core_fail(ctx, f->st, &e, base, API_KIND_REQUEST);
   snprintf(msg, sizeof msg, "frame %zu (t = %.17g): ", i, f->t);
@@ -296,6 +281,5 @@ api_status api_morph_result(api_morph_plan *plan, api_response *out) {
       return out->status;
     }
   }
-  return plan->svg ? result_svg(&ctx, plan, out)
-                   : result_json(&ctx, plan, out);
+  return plan->svg ? result_svg(&ctx, plan, out) : result_json(&ctx, plan, out);
 }

@@ -51,9 +51,8 @@ static bool match_pair(api_ctx *ctx, const api_elems *it, const char *ptr,
                         "must be a pair [i, j] (contour indices, or null "
                         "for an unpaired contour)");
   size_t w = 0;
-  const double *nums =
-      it->packed != NULL ? it->packed + 2 * it->index
-                         : api__array_packed(it->item, &w);
+  const double *nums = it->packed != NULL ? it->packed + 2 * it->index
+                                          : api__array_packed(it->item, &w);
   if (w != 0)
     return api__invalid(ctx, p, "must be a pair [i, j] of contour indices");
   for (int k = 0; k < 2; k++) {
@@ -74,22 +73,20 @@ bool api__shape_read_matches(api_ctx *ctx, const cJSON *root,
   const cJSON *v = cJSON_GetObjectItemCaseSensitive(root, "contour_matches");
   size_t n, max = 2 * api__max_contours(&pl->cfg);
   api_elems it;
-  if (v == NULL || cJSON_IsNull(v))
-    return true;
+  if (v == NULL || cJSON_IsNull(v)) return true;
   if (!cJSON_IsArray(v) || (n = api__array_len(v)) == 0)
     return api__invalid(ctx, "/contour_matches",
                         "must be a non-empty array of [i, j] pairs (null "
                         "for an unpaired contour)");
   if (n > max)
     return api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded",
-                      "/contour_matches", "has %zu pairs; the limit is %zu",
-                      n, max);
+                      "/contour_matches", "has %zu pairs; the limit is %zu", n,
+                      max);
   if ((pl->cmatches = km__malloc(n * sizeof *pl->cmatches)) == NULL)
     return api__oom(ctx);
   api__elems_start(&it, v);
   for (size_t i = 0; i < n; i++) {
-    if (i > 0)
-      api__elems_next(&it);
+    if (i > 0) api__elems_next(&it);
     if (!match_pair(ctx, &it, "/contour_matches", &pl->cmatches[i]))
       return false;
   }
@@ -98,10 +95,8 @@ bool api__shape_read_matches(api_ctx *ctx, const cJSON *root,
 }
 
 /* The single-curve side of a compound morph must be a closed curve. */
-static bool check_single(api_ctx *ctx, const api_input *in,
-                         const char *ptr) {
-  if (in->is_shape)
-    return true;
+static bool check_single(api_ctx *ctx, const api_input *in, const char *ptr) {
+  if (in->is_shape) return true;
   if (in->is_signature)
     return api__invalid(ctx, ptr,
                         "a signature cannot be morphed with a shape: give "
@@ -146,18 +141,16 @@ static bool contour_fail(api_ctx *ctx, const api_input *in, const char *ptr,
                          long i, km_status st, const km_error *err) {
   char p[API_POINTER_MAX], where[96], msg[API_TEXT_MAX];
   km_error e = *err;
-  if (st == KM_ENOMEM)
-    return api__oom(ctx);
-  if (st == KM_ECANCELLED)
-    return api__stopped(ctx);
+  if (st == KM_ENOMEM) return api__oom(ctx);
+  if (st == KM_ECANCELLED) return api__stopped(ctx);
   e.field = KM_FIELD_NONE;
   if (!in->is_shape || i < 0 || (size_t)i >= in->ncontours)
     return api__core_fail(ctx, st, &e, ptr, API_KIND_REQUEST);
   api__contour_ptr(p, in, ptr, (size_t)i);
   api__contour_where(where, sizeof where, in, (size_t)i);
   api__core_fail(ctx, st, &e, p, API_KIND_CURVE);
-  if (ctx->message[0] != '\0' && strncmp(ctx->message, where,
-                                         strlen(where)) != 0) {
+  if (ctx->message[0] != '\0' &&
+      strncmp(ctx->message, where, strlen(where)) != 0) {
     snprintf(msg, sizeof msg, "%s: ", where);
     strncat(msg, ctx->message, sizeof msg - strlen(msg) - 1);
     memcpy(ctx->message, msg, sizeof msg);
@@ -173,8 +166,7 @@ static bool shape_of(api_ctx *ctx, const api_input *in, const char *ptr,
   size_t n = in->is_shape ? in->ncontours : 1;
   km_error err;
   km_status st = km_shape_create(out, c, n, in->fill, &lim, &err);
-  if (st != KM_OK)
-    return contour_fail(ctx, in, ptr, err.index, st, &err);
+  if (st != KM_OK) return contour_fail(ctx, in, ptr, err.index, st, &err);
   return true;
 }
 
@@ -194,8 +186,8 @@ static bool matches_fail(api_ctx *ctx, const api_morph_plan *pl,
 /* A pair's morph failed: name the contour of its from side (its to side
  * when it has none). */
 static bool pair_fail(api_ctx *ctx, const api_morph_plan *pl,
-                      const km_shape_pair *pairs, size_t npairs,
-                      km_status st, const km_error *err) {
+                      const km_shape_pair *pairs, size_t npairs, km_status st,
+                      const km_error *err) {
   if (err->index >= 0 && (size_t)err->index < npairs) {
     const km_shape_pair *pr = &pairs[err->index];
     if (pr->from >= 0)
@@ -216,8 +208,8 @@ bool api__shape_build(api_ctx *ctx, api_morph_plan *pl, const km_stop *stop) {
       !shape_of(ctx, &pl->to, "/to", &pl->cfg, &pl->sto))
     return false;
   if (pl->cmatches != NULL) {
-    st = km_shape_pair_check(&pl->sfrom, &pl->sto, pl->cmatches,
-                             pl->ncmatches, &err);
+    st = km_shape_pair_check(&pl->sfrom, &pl->sto, pl->cmatches, pl->ncmatches,
+                             &err);
     if (st != KM_OK)
       return st == KM_EMATCH ? matches_fail(ctx, pl, &err)
                              : contour_fail(ctx, &pl->from, "", -1, st, &err);
@@ -226,26 +218,24 @@ bool api__shape_build(api_ctx *ctx, api_morph_plan *pl, const km_stop *stop) {
   } else {
     /* paired here, not inside the morph, so that a pair's failure can
      * name its contours */
-    st = km_shape_pair_auto(&pl->sfrom, &pl->sto, NULL, stop, &pairs,
-                            &npairs, &err);
-    if (st != KM_OK)
-      return contour_fail(ctx, &pl->from, "", -1, st, &err);
+    st = km_shape_pair_auto(&pl->sfrom, &pl->sto, NULL, stop, &pairs, &npairs,
+                            &err);
+    if (st != KM_OK) return contour_fail(ctx, &pl->from, "", -1, st, &err);
   }
   km_shape_morph_options_default(&so);
   so.morph = pl->opt;
   so.morph.stop = NULL;
   so.pairs = pairs;
   so.npairs = npairs;
-  st = km_shape_morph_create(&pl->smorph, &pl->sfrom, &pl->sto, &so, stop,
-                             &err);
+  st =
+      km_shape_morph_create(&pl->smorph, &pl->sfrom, &pl->sto, &so, stop, &err);
   if (st == KM_EMATCH && pl->cmatches != NULL)
     matches_fail(ctx, pl, &err);
   else if (st != KM_OK)
     pair_fail(ctx, pl, pairs, npairs, st, &err);
   else
     ok = true;
-  if (pairs != pl->cmatches)
-    km_shape_pairs_free(pairs);
+  if (pairs != pl->cmatches) km_shape_pairs_free(pairs);
   return ok;
 }
 
@@ -253,8 +243,8 @@ void api__shape_render(api_morph_plan *pl, api_frame_slot *f,
                        const km_stop *stop) {
   km_shape_frame_free(&f->shape);
   memset(&f->err, 0, sizeof f->err);
-  f->st = km_shape_morph_frame_until(pl->smorph, f->t, stop, &f->shape,
-                                     &f->err);
+  f->st =
+      km_shape_morph_frame_until(pl->smorph, f->t, stop, &f->shape, &f->err);
   f->state = f->st == KM_OK ? API_FRAME_DONE : API_FRAME_FAILED;
 }
 
@@ -268,13 +258,11 @@ void api__shape_render(api_morph_plan *pl, api_frame_slot *f,
 
 /* Degree and rationality of the frames' curves: the method's degree for
  * curvature morphs, the inputs' highest for linear ones. */
-static void frame_kind(const api_morph_plan *pl, int *degree,
-                       bool *rational) {
+static void frame_kind(const api_morph_plan *pl, int *degree, bool *rational) {
   const km_shape *sh[2] = {&pl->sfrom, &pl->sto};
   *degree = pl->opt.degree;
   *rational = false;
-  if (pl->opt.method != KM_METHOD_LINEAR)
-    return;
+  if (pl->opt.method != KM_METHOD_LINEAR) return;
   *degree = 1;
   for (int k = 0; k < 2; k++)
     for (size_t i = 0; i < sh[k]->ncontours; i++) {
@@ -295,16 +283,14 @@ static km_status slot_points(const api_morph_plan *pl, const km_stop *stop,
   size_t *seen = km__calloc(npairs ? 2 * npairs : 1, sizeof *seen);
   km_shape_frame f;
   km_status st = KM_OK;
-  if (seen == NULL)
-    return KM_ENOMEM;
+  if (seen == NULL) return KM_ENOMEM;
   km_shape_frame_init(&f);
   for (int k = 0; k < 3 && st == KM_OK; k++) {
-    st = km_shape_morph_frame_until(pl->smorph, pl->frames[idx[k]].t, stop,
-                                    &f, err);
+    st = km_shape_morph_frame_until(pl->smorph, pl->frames[idx[k]].t, stop, &f,
+                                    err);
     for (size_t j = 0; st == KM_OK && j < npairs && j < f.ncontours; j++) {
       size_t n = f.present[j] ? f.contours[j].n : 0;
-      if (n == 0)
-        continue;
+      if (n == 0) continue;
       if (seen[2 * j] > 0 && n != points[j])
         seen[2 * j + 1] = 1; /* counts differ */
       points[j] = n > points[j] ? n : points[j];
@@ -332,15 +318,15 @@ static size_t predict_bytes(const api_morph_plan *pl, const size_t *points,
     size_t paths = (pl->inc.svg_d ? 1 : 0) + (pl->inc.animate_d ? 1 : 0);
     size_t numbers = api__path_numbers(points[j], degree, hermite);
     /* an SVG document holds each slot's path once a frame, nothing else */
-    size_t slot = pl->svg ? 64 : SHAPE_SLOT_FIXED +
-                  api__curve_json_bytes(points[j], degree, rational, false);
-    if (pl->svg)
-      paths = 1;
+    size_t slot =
+        pl->svg ? 64
+                : SHAPE_SLOT_FIXED +
+                      api__curve_json_bytes(points[j], degree, rational, false);
+    if (pl->svg) paths = 1;
     if (numbers > (SIZE_MAX / 4 - slot) / (API_SVG_NUM_BYTES + 1))
       return SIZE_MAX;
     slot += paths * (16 + API_SVG_NUM_BYTES * numbers);
-    if (slot > SIZE_MAX / 4 - per)
-      return SIZE_MAX;
+    if (slot > SIZE_MAX / 4 - per) return SIZE_MAX;
     per += slot;
   }
   size_t fixed = SHAPE_DOC_FIXED + (2 * API_JSON_NUM_BYTES + 3) * npairs;
@@ -357,16 +343,14 @@ bool api__shape_check_size(api_ctx *ctx, api_morph_plan *pl,
   km_error err;
   km_status st;
   bool ok = false;
-  if (points == NULL)
-    return api__oom(ctx);
+  if (points == NULL) return api__oom(ctx);
   st = slot_points(pl, stop, npairs, points, &err);
   if (st != KM_OK) {
     contour_fail(ctx, &pl->from, "", -1, st, &err);
     goto done;
   }
   pl->predicted = predict_bytes(pl, points, npairs);
-  for (size_t j = 0; j < npairs; j++)
-    total += points[j];
+  for (size_t j = 0; j < npairs; j++) total += points[j];
   if (limit == 0 || pl->predicted <= limit) {
     ok = true;
     goto done;
@@ -397,8 +381,7 @@ static cJSON *joined_d(api_ctx *ctx, const km_shape_frame *sf, double tol,
   cJSON *s = NULL;
   api__svg_buf_init(&b);
   for (size_t k = 0; k < sf->ncontours; k++) {
-    if (!sf->present[k])
-      continue;
+    if (!sf->present[k]) continue;
     char *d = pieces != NULL
                   ? api_svg_path_d_fixed_z(&sf->contours[k], pieces[k], true)
                   : api_svg_path_d(&sf->contours[k], tol, NULL);
@@ -406,17 +389,14 @@ static cJSON *joined_d(api_ctx *ctx, const km_shape_frame *sf, double tol,
       b.failed = true;
       break;
     }
-    if (b.len > 0)
-      api__svg_buf_put(&b, " ");
+    if (b.len > 0) api__svg_buf_put(&b, " ");
     api__svg_buf_put(&b, d);
     km__free(d);
   }
   char *all = api__svg_buf_take(&b);
-  if (all != NULL)
-    s = cJSON_CreateString(all);
+  if (all != NULL) s = cJSON_CreateString(all);
   km__free(all);
-  if (s == NULL)
-    api__oom(ctx);
+  if (s == NULL) api__oom(ctx);
   return s;
 }
 
@@ -429,8 +409,7 @@ static cJSON *shape_metrics_json(api_ctx *ctx, const km_shape_frame *sf) {
     api__oom(ctx);
     return NULL;
   }
-  if (!api__add_item(ctx, o, "contours", a))
-    goto fail;
+  if (!api__add_item(ctx, o, "contours", a)) goto fail;
   for (size_t k = 0; k < sf->ncontours; k++) {
     m = sf->present[k] ? api__metrics_json(ctx, &sf->metrics[k])
                        : cJSON_CreateNull();
@@ -467,8 +446,7 @@ cJSON *api__shape_frame_json(api_ctx *ctx, const api_morph_plan *pl,
     cJSON_Delete(a);
     goto fail;
   }
-  if (!api__add_item(ctx, fo, "contours", a))
-    goto fail;
+  if (!api__add_item(ctx, fo, "contours", a)) goto fail;
   for (size_t k = 0; k < sf->ncontours; k++) {
     c = sf->present[k] ? api__curve_json(ctx, &sf->contours[k], false, pl->tol)
                        : cJSON_CreateNull();
@@ -499,19 +477,16 @@ cJSON *api__shape_pairs_json(api_ctx *ctx, const api_morph_plan *pl) {
   size_t n = km_shape_morph_pairs(pl->smorph, NULL, 0);
   km_shape_pair *pairs = km__malloc((n ? n : 1) * sizeof *pairs);
   cJSON *a = cJSON_CreateArray();
-  if (pairs == NULL || a == NULL)
-    goto oom;
+  if (pairs == NULL || a == NULL) goto oom;
   n = km_shape_morph_pairs(pl->smorph, pairs, n);
   for (size_t k = 0; k < n; k++) {
     cJSON *pr = cJSON_CreateArray();
     cJSON *i = index_json(pairs[k].from), *j = index_json(pairs[k].to);
-    bool ok = pr != NULL && i != NULL && j != NULL &&
-              cJSON_AddItemToArray(pr, i);
-    if (ok)
-      i = NULL;
+    bool ok =
+        pr != NULL && i != NULL && j != NULL && cJSON_AddItemToArray(pr, i);
+    if (ok) i = NULL;
     ok = ok && cJSON_AddItemToArray(pr, j);
-    if (ok)
-      j = NULL;
+    if (ok) j = NULL;
     ok = ok && cJSON_AddItemToArray(a, pr);
     if (!ok) {
       cJSON_Delete(i);
@@ -533,27 +508,22 @@ cJSON *api__shape_animate_json(api_ctx *ctx, const api_morph_plan *pl) {
   size_t n = km_shape_morph_pairs(pl->smorph, NULL, 0);
   size_t *pieces = km__malloc((n ? n : 1) * sizeof *pieces);
   cJSON *a = NULL, *s;
-  if (pieces == NULL)
-    goto oom;
-  for (size_t k = 0; k < n; k++)
-    pieces[k] = 1;
+  if (pieces == NULL) goto oom;
+  for (size_t k = 0; k < n; k++) pieces[k] = 1;
   /* one piece count per slot, the most any frame needs: then every frame
    * writes a slot with the same commands */
   for (size_t i = 0; i < pl->nframes; i++) {
     const km_shape_frame *sf = &pl->frames[i].shape;
     for (size_t k = 0; k < n && k < sf->ncontours; k++) {
-      if (!sf->present[k])
-        continue;
+      if (!sf->present[k]) continue;
       char *d = api_svg_path_d(&sf->contours[k], pl->tol, NULL);
-      if (d == NULL)
-        goto oom;
+      if (d == NULL) goto oom;
       size_t p = api__count_pieces(d);
       pieces[k] = p > pieces[k] ? p : pieces[k];
       km__free(d);
     }
   }
-  if ((a = cJSON_CreateArray()) == NULL)
-    goto oom;
+  if ((a = cJSON_CreateArray()) == NULL) goto oom;
   for (size_t i = 0; i < pl->nframes; i++) {
     if ((s = joined_d(ctx, &pl->frames[i].shape, pl->tol, pieces)) == NULL)
       goto fail;

@@ -55,20 +55,17 @@ static double frames_extent(const api_morph_plan *pl) {
  * quarter more, as the count moves smoothly with t. */
 static km_status frame_points(const api_morph_plan *pl, const km_stop *stop,
                               size_t *points, km_error *err) {
-  km_frame_parts parts = pl->metrics || pl->want_sig ? KM_FRAME_WITH_METRICS
-                                                     : KM_FRAME_CURVE;
+  km_frame_parts parts =
+      pl->metrics || pl->want_sig ? KM_FRAME_WITH_METRICS : KM_FRAME_CURVE;
   size_t idx[3] = {0, pl->nframes / 2, pl->nframes - 1}, most = 0;
   size_t first = 0, last = 0;
   for (int k = 0; k < 3; k++) {
     size_t n = 0;
-    km_status st = km_morph_frame_points(pl->morph, pl->frames[idx[k]].t,
-                                         parts, stop, &n, err);
-    if (st != KM_OK)
-      return st;
-    if (k == 0)
-      first = n;
-    if (k == 2)
-      last = n;
+    km_status st = km_morph_frame_points(pl->morph, pl->frames[idx[k]].t, parts,
+                                         stop, &n, err);
+    if (st != KM_OK) return st;
+    if (k == 0) first = n;
+    if (k == 2) last = n;
     most = n > most ? n : most;
   }
   /* equal counts at both ends and the middle: a planned (constant) count */
@@ -83,9 +80,8 @@ static size_t predict_bytes(const api_morph_plan *pl, size_t points) {
   bool rational = false;
   size_t per, n = pl->nframes;
   if (pl->opt.method == KM_METHOD_LINEAR) {
-    degree = pl->from.curve.degree > pl->to.curve.degree
-                 ? pl->from.curve.degree
-                 : pl->to.curve.degree;
+    degree = pl->from.curve.degree > pl->to.curve.degree ? pl->from.curve.degree
+                                                         : pl->to.curve.degree;
     rational = pl->from.curve.w != NULL || pl->to.curve.w != NULL;
   }
   bool hermite = pl->opt.method == KM_METHOD_CURVATURE;
@@ -94,16 +90,15 @@ static size_t predict_bytes(const api_morph_plan *pl, size_t points) {
     /* one path a frame, the animation's values repeat every frame's */
     size_t per_path = 64 + PX_NUM_BYTES * numbers;
     per = FRAME_FIXED_BYTES + per_path;
-    if (pl->svgopt.layout == API_SVG_ANIMATE)
-      per += per_path;
+    if (pl->svgopt.layout == API_SVG_ANIMATE) per += per_path;
     if (pl->want_sig) {
       /* kappa samples as svg_curvature_plot.c takes them: a budget per
        * frame shared by the spans of kappa (fewer than the control
        * points), at least three a span, at most 4,002 */
       size_t budget = n > 0 ? 400000 / n : 1600;
       budget = budget > 1600 ? 1600 : budget < 100 ? 100 : budget;
-      size_t samples = budget + points > 3 * points ? budget + points
-                                                    : 3 * points;
+      size_t samples =
+          budget + points > 3 * points ? budget + points : 3 * points;
       samples = samples + 2 > 4002 ? 4002 : samples + 2;
       per += samples * 2 * PX_NUM_BYTES;
     }
@@ -119,8 +114,7 @@ static size_t predict_bytes(const api_morph_plan *pl, size_t points) {
   /* matches_used: at most max_control_points pairs */
   size_t matches = pl->opt.auto_matches ? 64 : pl->opt.nmatches;
   size_t fixed = DOC_FIXED_BYTES + (2 * API_JSON_NUM_BYTES + 3) * matches;
-  if (n > 0 && per > (SIZE_MAX - fixed) / n)
-    return SIZE_MAX;
+  if (n > 0 && per > (SIZE_MAX - fixed) / n) return SIZE_MAX;
   return fixed + per * n;
 }
 
@@ -132,20 +126,16 @@ bool api__morph_check_size(api_ctx *ctx, api_morph_plan *pl,
   size_t points = 0, limit = pl->cfg.max_output_bytes;
   km_error err;
   km_status st = frame_points(pl, stop, &points, &err);
-  if (st == KM_ECANCELLED)
-    return api__stopped(ctx);
-  if (st != KM_OK)
-    return api__core_fail(ctx, st, &err, "", API_KIND_REQUEST);
+  if (st == KM_ECANCELLED) return api__stopped(ctx);
+  if (st != KM_OK) return api__core_fail(ctx, st, &err, "", API_KIND_REQUEST);
   pl->predicted = predict_bytes(pl, points);
-  if (limit == 0 || pl->predicted <= limit)
-    return true;
+  if (limit == 0 || pl->predicted <= limit) return true;
   size_t nframes = pl->nframes;
   pl->nframes = 2;
   bool tol_dominates = predict_bytes(pl, points) > limit;
   pl->nframes = nframes;
   return api__failf(ctx, 422, API_P_LIMIT, "Limit exceeded",
-                    tol_dominates ? "/tolerance"
-                                  : api_morph_frames_pointer(pl),
+                    tol_dominates ? "/tolerance" : api_morph_frames_pointer(pl),
                     "the answer would take up to %zu bytes (%zu frames of "
                     "up to %zu control points); the limit is %zu bytes: "
                     "%s",

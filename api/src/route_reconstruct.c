@@ -29,23 +29,21 @@ static bool read_options(api_ctx *ctx, const cJSON *root, options *o) {
 /* The curve of sig into *curve, within the tolerance, with the bound
  * achieved; the answer's size checked from its control points before it
  * is printed. */
-static bool reconstruct(api_ctx *ctx, const api_request *req,
-                        const options *o, const km_signature *sig,
-                        km_curve *curve, double *bound) {
+static bool reconstruct(api_ctx *ctx, const api_request *req, const options *o,
+                        const km_signature *sig, km_curve *curve,
+                        double *bound) {
   km_error err;
   km_stop stop_buf;
   size_t predicted;
   /* the answer's curve is held to the limit on curves, as inputs are */
-  km_status st = km_reconstruct_until(sig, (int)o->degree, o->tol,
-                                      ctx->cfg->max_control_points,
-                                      api__km_stop(req, &stop_buf), curve,
-                                      bound, &err);
-  if (st == KM_ECANCELLED)
-    return api__stopped(ctx);
+  km_status st = km_reconstruct_until(
+      sig, (int)o->degree, o->tol, ctx->cfg->max_control_points,
+      api__km_stop(req, &stop_buf), curve, bound, &err);
+  if (st == KM_ECANCELLED) return api__stopped(ctx);
   if (st != KM_OK)
     return api__core_fail(ctx, st, &err, "/signature", API_KIND_SIGNATURE);
-  predicted = api__curve_json_bytes(curve->n, curve->degree,
-                                    curve->w != NULL, o->inc.svg_d) +
+  predicted = api__curve_json_bytes(curve->n, curve->degree, curve->w != NULL,
+                                    o->inc.svg_d) +
               64;
   if (ctx->cfg->max_output_bytes == 0 ||
       predicted <= ctx->cfg->max_output_bytes)

@@ -20,8 +20,8 @@ static cJSON *samples_json(api_ctx *ctx, const km_signature *sig, size_t n) {
   }
   for (size_t i = 0; i < n; i++) {
     /* The last sample sits exactly at the end, not at a rounded sum. */
-    double s = i + 1 == n ? sig->length
-                          : sig->length * (double)i / (double)(n - 1);
+    double s =
+        i + 1 == n ? sig->length : sig->length * (double)i / (double)(n - 1);
     v[2 * i] = s;
     v[2 * i + 1] = km_fn_value(&sig->kappa, s);
   }
@@ -42,12 +42,10 @@ static bool signature_of(api_ctx *ctx, const api_request *req,
     *use = &in->sig;
     return true;
   }
-  st = km_signature_compute_until(&in->curve, tol,
-                                  api__km_stop(req, &stop_buf), sig, &err);
-  if (st == KM_ECANCELLED)
-    return api__stopped(ctx);
-  if (st != KM_OK)
-    return api__core_fail(ctx, st, &err, "/curve", in->kind);
+  st = km_signature_compute_until(&in->curve, tol, api__km_stop(req, &stop_buf),
+                                  sig, &err);
+  if (st == KM_ECANCELLED) return api__stopped(ctx);
+  if (st != KM_OK) return api__core_fail(ctx, st, &err, "/curve", in->kind);
   *use = sig;
   return true;
 }
@@ -55,8 +53,7 @@ static bool signature_of(api_ctx *ctx, const api_request *req,
 /* The answer's size from the signature's pieces, before it is printed: a
  * curve of many spans at a tight tolerance answers with many times its
  * own size. samples is 0 when none were asked for. */
-static bool check_size(api_ctx *ctx, const km_signature *use,
-                       size_t samples) {
+static bool check_size(api_ctx *ctx, const km_signature *use, size_t samples) {
   size_t per_sample = 2 * API_JSON_NUM_BYTES + 4;
   size_t sig_bytes = api__signature_json_bytes(use);
   size_t sample_bytes = samples * per_sample;
@@ -110,20 +107,17 @@ static bool shape_signatures(api_ctx *ctx, const api_request *req,
   km_status st;
   size_t i = 0;
   char p[API_POINTER_MAX], where[96], msg[API_TEXT_MAX];
-  st = km_shape_create(shape, in->contours, in->ncontours, in->fill, &lim,
-                       &err);
+  st =
+      km_shape_create(shape, in->contours, in->ncontours, in->fill, &lim, &err);
   if (st == KM_OK)
     for (; i < in->ncontours && st == KM_OK; i++)
       st = km_signature_compute_until(&in->contours[i], tol, stop, &sigs[i],
                                       &err);
   else
     i = err.index >= 0 ? (size_t)err.index + 1 : 1;
-  if (st == KM_OK)
-    return true;
-  if (st == KM_ECANCELLED)
-    return api__stopped(ctx);
-  if (st == KM_ENOMEM)
-    return api__oom(ctx);
+  if (st == KM_OK) return true;
+  if (st == KM_ECANCELLED) return api__stopped(ctx);
+  if (st == KM_ENOMEM) return api__oom(ctx);
   i = i > 0 && i - 1 < in->ncontours ? i - 1 : 0;
   api__contour_ptr(p, in, "/curve", i);
   api__contour_where(where, sizeof where, in, i);
@@ -148,8 +142,7 @@ static cJSON *add_array(api_ctx *ctx, cJSON *res, const char *key) {
 
 /* item appended to a; item consumed either way. */
 static bool append(api_ctx *ctx, cJSON *a, cJSON *item) {
-  if (item != NULL && cJSON_AddItemToArray(a, item))
-    return true;
+  if (item != NULL && cJSON_AddItemToArray(a, item)) return true;
   cJSON_Delete(item);
   return api__oom(ctx);
 }
@@ -186,11 +179,9 @@ static cJSON *shape_answer(api_ctx *ctx, const km_signature *sigs,
   for (size_t i = 0; i < n; i++) {
     if (!append(ctx, js, api__signature_json(ctx, &sigs[i])) ||
         !append(ctx, jr,
-                cJSON_CreateString(shape->role[i] == KM_ROLE_HOLE
-                                       ? "hole"
-                                       : "outer")) ||
-        (samples > 0 &&
-         !append(ctx, jm, samples_json(ctx, &sigs[i], samples))))
+                cJSON_CreateString(shape->role[i] == KM_ROLE_HOLE ? "hole"
+                                                                  : "outer")) ||
+        (samples > 0 && !append(ctx, jm, samples_json(ctx, &sigs[i], samples))))
       goto fail;
   }
   return res;
@@ -210,12 +201,10 @@ static cJSON *shape_route(api_ctx *ctx, const api_request *req,
     api__oom(ctx);
     return NULL;
   }
-  for (size_t i = 0; i < in->ncontours; i++)
-    km_signature_init(&sigs[i]);
+  for (size_t i = 0; i < in->ncontours; i++) km_signature_init(&sigs[i]);
   if (shape_signatures(ctx, req, in, tol, sigs, &shape))
     res = shape_answer(ctx, sigs, &shape, samples);
-  for (size_t i = 0; i < in->ncontours; i++)
-    km_signature_free(&sigs[i]);
+  for (size_t i = 0; i < in->ncontours; i++) km_signature_free(&sigs[i]);
   km__free(sigs);
   km_shape_free(&shape);
   return res;
@@ -233,8 +222,7 @@ api_status api__route_signature(api_ctx *ctx, const api_request *req,
 
   api__input_init(&in);
   km_signature_init(&sig);
-  if (root == NULL ||
-      !api__parse_tolerance(ctx, root, &tol) ||
+  if (root == NULL || !api__parse_tolerance(ctx, root, &tol) ||
       !api__member_int(ctx, root, "", "samples", false, 2,
                        (long)ctx->cfg->max_samples, &samples, NULL) ||
       !api__parse_curve(ctx, cJSON_GetObjectItemCaseSensitive(root, "curve"),

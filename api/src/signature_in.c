@@ -11,8 +11,7 @@ static bool read_start(api_ctx *ctx, const cJSON *v, const char *ptr,
                        double start[2], double *angle) {
   char p[API_POINTER_MAX], q[API_POINTER_MAX];
   const cJSON *js = cJSON_GetObjectItemCaseSensitive(v, "start"), *jpt;
-  if (js == NULL)
-    return true;
+  if (js == NULL) return true;
   api__ptr_key(p, ptr, "start");
   if (!cJSON_IsObject(js))
     return api__invalid(ctx, p, "must be an object, not %s",
@@ -20,8 +19,7 @@ static bool read_start(api_ctx *ctx, const cJSON *v, const char *ptr,
   jpt = cJSON_GetObjectItemCaseSensitive(js, "point");
   if (jpt != NULL) {
     api__ptr_key(q, p, "point");
-    if (!api__point(ctx, jpt, q, start))
-      return false;
+    if (!api__point(ctx, jpt, q, start)) return false;
   }
   return api__member_num(ctx, js, p, "angle", false, angle, NULL);
 }
@@ -39,8 +37,7 @@ static bool read_kappa(api_ctx *ctx, const cJSON *v, const char *ptr,
                        kappa_text *kt) {
   char p[API_POINTER_MAX], q[API_POINTER_MAX];
   const cJSON *jkappa, *jc;
-  if ((jkappa = api__require(ctx, v, ptr, "kappa")) == NULL)
-    return false;
+  if ((jkappa = api__require(ctx, v, ptr, "kappa")) == NULL) return false;
   api__ptr_key(p, ptr, "kappa");
   if (!cJSON_IsObject(jkappa))
     return api__invalid(ctx, p, "must be an object, not %s",
@@ -54,13 +51,12 @@ static bool read_kappa(api_ctx *ctx, const cJSON *v, const char *ptr,
                       &kt->nc))
     return false;
   if (kt->nc < (size_t)kt->degree + 1)
-    return api__failf(ctx, 422, API_P_INVALID_SIGNATURE, "Invalid signature",
-                      q,
+    return api__failf(ctx, 422, API_P_INVALID_SIGNATURE, "Invalid signature", q,
                       "a degree %ld function needs at least %ld "
                       "coefficients",
                       kt->degree, kt->degree + 1);
-  return api__read_knots(ctx, jkappa, p, kt->nc, kt->degree,
-                         API_KIND_SIGNATURE, &kt->knots, &kt->nk);
+  return api__read_knots(ctx, jkappa, p, kt->nc, kt->degree, API_KIND_SIGNATURE,
+                         &kt->knots, &kt->nk);
 }
 
 /* The optional "corners": [{"s", "turn"}, ...]. *corners (the caller
@@ -71,8 +67,7 @@ static bool read_corners(api_ctx *ctx, const cJSON *v, const char *ptr,
   const cJSON *jcorners = cJSON_GetObjectItemCaseSensitive(v, "corners");
   api_elems it;
   size_t n;
-  if (jcorners == NULL || cJSON_IsNull(jcorners))
-    return true;
+  if (jcorners == NULL || cJSON_IsNull(jcorners)) return true;
   api__ptr_key(p, ptr, "corners");
   if (!cJSON_IsArray(jcorners))
     return api__invalid(ctx, p, "must be an array, not %s",
@@ -105,8 +100,7 @@ static bool build_kappa(api_ctx *ctx, const kappa_text *kt, const char *ptr,
   km_error err;
   km_status st =
       km_fn_create(kappa, (int)kt->degree, kt->nc, kt->knots, kt->coef, &err);
-  if (st == KM_OK)
-    return true;
+  if (st == KM_OK) return true;
   /* km_fn_create speaks of its own knots/coefficients: name them under
    * kappa. */
   if (err.field == KM_FIELD_KNOTS)
@@ -134,8 +128,7 @@ bool api__parse_signature(api_ctx *ctx, const cJSON *v, const char *ptr,
   if (!cJSON_IsObject(v))
     return api__invalid(ctx, ptr, "must be an object, not %s",
                         api__type_name(v));
-  if (!api__member_num(ctx, v, ptr, "length", true, &length, NULL))
-    goto done;
+  if (!api__member_num(ctx, v, ptr, "length", true, &length, NULL)) goto done;
   if (!(length > 0)) {
     api__ptr_key(p, ptr, "length");
     api__fail(ctx, 422, API_P_INVALID_SIGNATURE, "Invalid signature", p,
@@ -148,8 +141,8 @@ bool api__parse_signature(api_ctx *ctx, const cJSON *v, const char *ptr,
       !api__member_bool(ctx, v, ptr, "closed", false, &closed, NULL) ||
       !build_kappa(ctx, &kt, ptr, &kappa))
     goto done;
-  st = km_signature_create(out, length, start, angle, &kappa, corners,
-                           ncorners, closed, &err);
+  st = km_signature_create(out, length, start, angle, &kappa, corners, ncorners,
+                           closed, &err);
   if (st != KM_OK) {
     api__core_fail(ctx, st, &err, ptr, API_KIND_SIGNATURE);
     goto done;

@@ -45,8 +45,7 @@ km_status api_svg_parse_path(const char *d, size_t len, double tol,
 km_status api_svg_parse_subpaths(const char *d, size_t len, double tol,
                                  size_t max_subpaths, km_curve **out,
                                  size_t **offsets, size_t *n,
-                                 size_t *err_offset, char *msg,
-                                 size_t msgcap);
+                                 size_t *err_offset, char *msg, size_t msgcap);
 
 /* The curve as an SVG path of cubic Beziers ("M x y C ..." and "Z" if
  * closed), within tol of the curve (degree > 3 and rational curves are
@@ -114,8 +113,7 @@ char *api_svg_shape_document(const api_svg_shape_frame *frames, size_t n,
 
 /* As api_svg_path_d_fixed, with the closing "Z" written when with_z is true
  * whatever c->closed says: frames of one animation must agree on it. */
-char *api_svg_path_d_fixed_z(const km_curve *c, size_t n_pieces,
-                             bool with_z);
+char *api_svg_path_d_fixed_z(const km_curve *c, size_t n_pieces, bool with_z);
 
 /* ---- internal helpers shared by the SVG writers ---- */
 

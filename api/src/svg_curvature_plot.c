@@ -86,7 +86,9 @@ typedef struct plot {
   double pw, ph;
 } plot;
 
-static double px(const plot *p, double u) { return p->ml + u * p->pw; }
+static double px(const plot *p, double u) {
+  return p->ml + u * p->pw;
+}
 
 static double py(const plot *p, double v) {
   return p->mt + (p->hi - v) / (p->hi - p->lo) * p->ph;
@@ -265,8 +267,8 @@ static void plot_axis_labels(api_svg_doc *c, const plot *p) {
 
 /* Corners: tangent jumps as vertical ticks at their s/L from the zero
  * line, up for a left turn, length growing with |turn|. */
-static void plot_corners(api_svg_doc *c, const plot *p,
-                         const km_signature *sg, const char *col) {
+static void plot_corners(api_svg_doc *c, const plot *p, const km_signature *sg,
+                         const char *col) {
   double y0 = py(p, fmin(fmax(0.0, p->lo), p->hi));
   for (size_t k = 0; k < sg->ncorners; k++) {
     double u = sg->corners[k].s / sg->length, turn = sg->corners[k].turn;
@@ -284,8 +286,9 @@ static void plot_corners(api_svg_doc *c, const plot *p,
     api__svg_px(c, px(p, u));
     api__svg_buf_put(&c->b, "\" y2=\"");
     api__svg_px(c, y0 - (turn > 0 ? len : -len));
-    api__svg_buf_printf(&c->b, "\"><title>corner: turn %.6g rad at s/L = "
-                               "%.6g</title></line>\n",
+    api__svg_buf_printf(&c->b,
+                        "\"><title>corner: turn %.6g rad at s/L = "
+                        "%.6g</title></line>\n",
                         turn, u);
   }
 }
@@ -304,7 +307,7 @@ static void plot_curve(api_svg_doc *c, const plot *p, size_t i) {
     double y = p->se[i].y[k];
     if (!isfinite(y)) y = 0;
     y = fmin(fmax(y, p->lo - 0.1 * (p->hi - p->lo)),
-           p->hi + 0.1 * (p->hi - p->lo));
+             p->hi + 0.1 * (p->hi - p->lo));
     if (k) api__svg_buf_put(&c->b, k == 1 ? "L" : " ");
     api__svg_px(c, px(p, p->se[i].x[k]));
     api__svg_buf_put(&c->b, ",");

@@ -245,7 +245,8 @@ void api__svg_ramp_legend(api_svg_doc *c, double x, double y, double w) {
 char *api_svg_morph_document(const api_svg_frame *frames, size_t n,
                              const api_svg_options *opt) {
   api_svg_options o;
-  if (opt) o = *opt;
+  if (opt)
+    o = *opt;
   else {
     memset(&o, 0, sizeof o);
     o.layout = API_SVG_FILMSTRIP;

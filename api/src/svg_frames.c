@@ -22,8 +22,10 @@ void api__svg_filmstrip(api_svg_doc *c, const api_svg_options *o) {
   const double label = 20.0;
   double cw = 160.0, ch = cw * aspect + label;
   if (o->width > 0) cw = o->width / (double)cols;
-  if (o->height > 0) ch = o->height / (double)rows;
-  else if (o->width > 0) ch = cw * aspect + label;
+  if (o->height > 0)
+    ch = o->height / (double)rows;
+  else if (o->width > 0)
+    ch = cw * aspect + label;
   /* Automatic sizes are whole pixels: renderers round them up anyway. */
   c->W = o->width > 0 ? o->width : ceil(cw * (double)cols);
   c->H = o->height > 0 ? o->height : ceil(ch * (double)rows);
@@ -42,9 +44,8 @@ void api__svg_filmstrip(api_svg_doc *c, const api_svg_options *o) {
     api__svg_px(c, fmax(cw - 1, 0));
     api__svg_buf_put(&c->b, "\" height=\"");
     api__svg_px(c, fmax(ch - 1, 0));
-    api__svg_buf_put(&c->b,
-                     "\" fill=\"none\" stroke=\"#d0d0d0\" "
-                     "stroke-width=\"1\"/>\n");
+    api__svg_buf_put(&c->b, "\" fill=\"none\" stroke=\"#d0d0d0\" "
+                            "stroke-width=\"1\"/>\n");
     double ox = x + 4, oy = y + 4;
     double dw = fmax(cw - 8, 1), dh = fmax(ch - label - 8, 1);
     double s = api__svg_fit(&bb, dw, dh, &ox, &oy);
@@ -71,9 +72,8 @@ static double open_panel(api_svg_doc *c, const api_svg_options *o,
   *bb = api__svg_frames_bbox(c);
   double aspect = (bb->y1 - bb->y0) / (bb->x1 - bb->x0);
   double w = o->width > 0 ? o->width : default_width;
-  double h = o->height > 0
-                 ? o->height
-                 : ceil(w * fmin(fmax(aspect, 0.25), 4) + band);
+  double h =
+      o->height > 0 ? o->height : ceil(w * fmin(fmax(aspect, 0.25), 4) + band);
   c->W = w;
   c->H = h;
   char title[80];
@@ -151,8 +151,7 @@ static char **animate_paths(api_svg_doc *c, size_t np, size_t *drawn) {
 /* The animated <path>, drawn as the first frame under the layout's
  * transform until its <animate> starts, which this opens for its dur. */
 static void animate_open(api_svg_doc *c, const api_svg_bbox *bb, double ox,
-                         double oy, double s, const char *first,
-                         double dur) {
+                         double oy, double s, const char *first, double dur) {
   api__svg_buf_put(&c->b, "<path transform=\"translate(");
   api__svg_px(c, ox);
   api__svg_buf_put(&c->b, " ");

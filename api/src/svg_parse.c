@@ -42,7 +42,9 @@ typedef struct parser {
 static bool is_wsp(char c) {
   return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f';
 }
-static bool is_digit(char c) { return c >= '0' && c <= '9'; }
+static bool is_digit(char c) {
+  return c >= '0' && c <= '9';
+}
 
 static km_status fail(parser *ps, size_t off, km_status st, const char *fmt,
                       ...) __attribute__((format(printf, 4, 5)));
@@ -82,8 +84,10 @@ static bool number_ahead(const parser *ps) {
 static const char *found(const parser *ps, char buf[16]) {
   if (ps->pos >= ps->len) return "end of path data";
   unsigned char c = (unsigned char)ps->s[ps->pos];
-  if (c >= 0x21 && c < 0x7f) snprintf(buf, 16, "'%c'", c);
-  else snprintf(buf, 16, "byte 0x%02x", c);
+  if (c >= 0x21 && c < 0x7f)
+    snprintf(buf, 16, "'%c'", c);
+  else
+    snprintf(buf, 16, "byte 0x%02x", c);
   return buf;
 }
 
@@ -105,8 +109,8 @@ static km_status parse_number(parser *ps, const char *what, double *out) {
     if (nint == 0 && nfrac == 0) i = f0 - 1;
   }
   if (nint == 0 && nfrac == 0) {
-    return fail(ps, start, KM_EINVAL, "expected %s (a number), found %s",
-                what, found(ps, fb));
+    return fail(ps, start, KM_EINVAL, "expected %s (a number), found %s", what,
+                found(ps, fb));
   }
   if (i < ps->len && (s[i] == 'e' || s[i] == 'E')) {
     size_t j = i + 1;
@@ -125,8 +129,7 @@ static km_status parse_number(parser *ps, const char *what, double *out) {
   double v = strtod(buf, NULL);
   if (buf != small) km__free(buf);
   if (!isfinite(v))
-    return fail(ps, start, KM_ERANGE, "%s is too large for a double",
-                what);
+    return fail(ps, start, KM_ERANGE, "%s is too large for a double", what);
   ps->pos = i;
   *out = v;
   return KM_OK;
@@ -140,8 +143,8 @@ static km_status parse_flag(parser *ps, const char *what, bool *out) {
     ps->pos++;
     return KM_OK;
   }
-  return fail(ps, ps->pos, KM_EINVAL, "expected %s (0 or 1), found %s",
-              what, found(ps, fb));
+  return fail(ps, ps->pos, KM_EINVAL, "expected %s (0 or 1), found %s", what,
+              found(ps, fb));
 }
 
 /* Read n numbers separated by comma-wsp?; names[i] says what each is. */
@@ -184,12 +187,12 @@ static double extent_of(const km_path *p) {
  * subpath's start, the last control point and command (for S and T). */
 typedef struct pen {
   km_path path;
-  char prev;             /* previous command, for S and T reflection */
-  bool drawn;            /* a drawing command (or Z) was seen */
-  bool done;             /* Z seen: further drawing is a second subpath */
-  double cx, cy;         /* current point */
-  double sx, sy;         /* subpath start */
-  double lcx, lcy;       /* last control point (S, T) */
+  char prev;       /* previous command, for S and T reflection */
+  bool drawn;      /* a drawing command (or Z) was seen */
+  bool done;       /* Z seen: further drawing is a second subpath */
+  double cx, cy;   /* current point */
+  double sx, sy;   /* subpath start */
+  double lcx, lcy; /* last control point (S, T) */
 } pen;
 
 static km_status finish_subpath(parser *ps, pen *pn);
@@ -254,8 +257,7 @@ static km_status move_to(parser *ps, pen *pn, double ox, double oy,
   if (pn->drawn && ps->multi) {
     /* The subpath so far is finished; this moveto starts the next one,
      * relative to where the last one ended (its start, after a Z). */
-    if ((st = finish_subpath(ps, pn)) != KM_OK)
-      return st;
+    if ((st = finish_subpath(ps, pn)) != KM_OK) return st;
     ps->cur_off = cmd_off;
   } else if (pn->drawn) {
     /* Only a trailing moveto that draws nothing is tolerated. */
@@ -278,8 +280,7 @@ static km_status move_to(parser *ps, pen *pn, double ox, double oy,
 }
 
 /* L, H or V's argument set. */
-static km_status line_to(parser *ps, pen *pn, char up, double ox,
-                         double oy) {
+static km_status line_to(parser *ps, pen *pn, char up, double ox, double oy) {
   double v[2];
   km_error e;
   km_status st;
@@ -300,8 +301,7 @@ static km_status line_to(parser *ps, pen *pn, char up, double ox,
 }
 
 /* C or S's argument set. */
-static km_status cubic_to(parser *ps, pen *pn, char up, double ox,
-                          double oy) {
+static km_status cubic_to(parser *ps, pen *pn, char up, double ox, double oy) {
   double v[6], x1 = pn->cx, y1 = pn->cy;
   km_error e;
   km_status st;
@@ -323,14 +323,13 @@ static km_status cubic_to(parser *ps, pen *pn, char up, double ox,
   pn->lcy = oy + v[3];
   pn->cx = ox + v[4];
   pn->cy = oy + v[5];
-  st = km_path_cubic_to(&pn->path, x1, y1, pn->lcx, pn->lcy, pn->cx, pn->cy,
-                        &e);
+  st =
+      km_path_cubic_to(&pn->path, x1, y1, pn->lcx, pn->lcy, pn->cx, pn->cy, &e);
   return st ? geom_fail(ps, arg_off, st, &e) : KM_OK;
 }
 
 /* Q or T's argument set. */
-static km_status quad_to(parser *ps, pen *pn, char up, double ox,
-                         double oy) {
+static km_status quad_to(parser *ps, pen *pn, char up, double ox, double oy) {
   double v[4];
   km_error e;
   km_status st;
@@ -385,8 +384,8 @@ static km_status arc_to(parser *ps, pen *pn, double ox, double oy) {
   if (st) return st;
   pn->cx = ox + v[3];
   pn->cy = oy + v[4];
-  st = km_path_arc_to(&pn->path, v[0], v[1], v[2], large, sweep, pn->cx,
-                      pn->cy, &e);
+  st = km_path_arc_to(&pn->path, v[0], v[1], v[2], large, sweep, pn->cx, pn->cy,
+                      &e);
   return st ? geom_fail(ps, arg_off, st, &e) : KM_OK;
 }
 
@@ -400,8 +399,7 @@ static km_status argument_set(parser *ps, pen *pn, char up, bool rel,
     /* Drawing after a Z without a moveto starts a subpath at the last
      * one's start (SVG 1.1, 8.3.3). */
     km_error e;
-    if ((st = finish_subpath(ps, pn)) != KM_OK)
-      return st;
+    if ((st = finish_subpath(ps, pn)) != KM_OK) return st;
     ps->cur_off = first ? cmd_off : arg_off;
     if ((st = km_path_move_to(&pn->path, pn->cx, pn->cy, &e)) != KM_OK)
       return geom_fail(ps, ps->cur_off, st, &e);
@@ -478,8 +476,8 @@ static km_status finish_subpath(parser *ps, pen *pn) {
   km_status st;
   if (ps->nsub == ps->maxsub)
     return fail(ps, ps->cur_off, KM_ELIMIT,
-                "subpath %zu is one past the limit of %zu subpaths",
-                ps->nsub, ps->maxsub);
+                "subpath %zu is one past the limit of %zu subpaths", ps->nsub,
+                ps->maxsub);
   if (ps->nsub == ps->capsub) {
     size_t cap = ps->capsub ? 2 * ps->capsub : 4;
     km_curve *c2 = km__realloc(ps->subs, cap * sizeof *c2);
@@ -494,12 +492,10 @@ static km_status finish_subpath(parser *ps, pen *pn) {
   }
   if ((st = to_curve(ps, pn, ps->tol, &c)) != KM_OK) {
     /* A path of one subpath fails as api_svg_parse_path would. */
-    if (ps->nsub == 0 && ps->pos >= ps->len)
-      return st;
+    if (ps->nsub == 0 && ps->pos >= ps->len) return st;
     if (st == KM_EDEGENERATE)
       return fail(ps, ps->cur_off, st,
-                  "subpath %zu has zero length (it draws nothing)",
-                  ps->nsub);
+                  "subpath %zu has zero length (it draws nothing)", ps->nsub);
     ps->err_off = ps->cur_off;
     return st;
   }
@@ -514,10 +510,12 @@ static km_status finish_subpath(parser *ps, pen *pn) {
 km_status api_svg_parse_subpaths(const char *d, size_t len, double tol,
                                  size_t max_subpaths, km_curve **out,
                                  size_t **offsets, size_t *n,
-                                 size_t *err_offset, char *msg,
-                                 size_t msgcap) {
-  parser ps = {.s = d ? d : "", .len = d ? len : 0, .msg = msg,
-               .msgcap = msgcap, .multi = true};
+                                 size_t *err_offset, char *msg, size_t msgcap) {
+  parser ps = {.s = d ? d : "",
+               .len = d ? len : 0,
+               .msg = msg,
+               .msgcap = msgcap,
+               .multi = true};
   pen pn = {.prev = 0};
   km_status st;
   char fb[16];
@@ -565,8 +563,8 @@ cleanup:
 km_status api_svg_parse_path(const char *d, size_t len, double tol,
                              km_curve *out, size_t *err_offset, char *msg,
                              size_t msgcap) {
-  parser ps = {.s = d ? d : "", .len = d ? len : 0, .msg = msg,
-               .msgcap = msgcap};
+  parser ps = {
+      .s = d ? d : "", .len = d ? len : 0, .msg = msg, .msgcap = msgcap};
   pen pn = {.prev = 0};
   km_status st;
   char fb[16];

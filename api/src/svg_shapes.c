@@ -34,8 +34,7 @@ static api_svg_bbox shapes_bbox(const api_svg_shape_frame *f, size_t n) {
     }
   }
   double w = bb.x1 - bb.x0, h = bb.y1 - bb.y0, m = fmax(w, h);
-  if (!(m > 0))
-    m = 1;
+  if (!(m > 0)) m = 1;
   /* a flat box gets some height so the scale stays finite */
   double px = 0.05 * m + (w < 1e-3 * m ? 0.5e-3 * m : 0);
   double py = 0.05 * m + (h < 1e-3 * m ? 0.5e-3 * m : 0);
@@ -70,15 +69,13 @@ static void draw_shape(api_svg_doc *c, const km_shape_frame *sf, double ox,
   api__svg_buf_num(&c->b, c->sw / s, 1e-3 * c->sw / s, NULL);
   api__svg_buf_put(&c->b, "\" stroke-linejoin=\"round\" d=\"");
   for (size_t k = 0, drawn = 0; k < sf->ncontours; k++) {
-    if (!sf->present[k])
-      continue;
+    if (!sf->present[k]) continue;
     char *d = api_svg_path_d(&sf->contours[k], 0.05 / s, NULL);
     if (d == NULL) {
       c->b.failed = true;
       return;
     }
-    if (drawn++ > 0)
-      api__svg_buf_put(&c->b, " ");
+    if (drawn++ > 0) api__svg_buf_put(&c->b, " ");
     api__svg_buf_put(&c->b, d);
     km__free(d);
   }
@@ -102,10 +99,9 @@ static void cell(api_svg_doc *c, const api_svg_shape_frame *f, size_t i,
   api__svg_buf_put(&c->b, "\" fill=\"none\" stroke=\"#d0d0d0\" "
                           "stroke-width=\"1\"/>\n");
   double ox = x + 4, oy = y + 4;
-  double s = api__svg_fit(bb, fmax(cw - 8, 1), fmax(ch - label - 8, 1), &ox,
-                          &oy);
-  if (f[i].shape != NULL)
-    draw_shape(c, f[i].shape, ox, oy, s, bb, rule);
+  double s =
+      api__svg_fit(bb, fmax(cw - 8, 1), fmax(ch - label - 8, 1), &ox, &oy);
+  if (f[i].shape != NULL) draw_shape(c, f[i].shape, ox, oy, s, bb, rule);
   api__svg_buf_put(&c->b, "<text x=\"");
   api__svg_px(c, x + 0.5 * cw);
   api__svg_buf_put(&c->b, "\" y=\"");
@@ -128,8 +124,7 @@ char *api_svg_shape_document(const api_svg_shape_frame *frames, size_t n,
   memset(&c, 0, sizeof c);
   api__svg_buf_init(&c.b);
   c.n = frames != NULL ? n : 0;
-  c.sw = o->stroke_width > 0 && o->stroke_width < 1e3 ? o->stroke_width
-                                                        : 1.5;
+  c.sw = o->stroke_width > 0 && o->stroke_width < 1e3 ? o->stroke_width : 1.5;
   c.stroke = o->stroke != NULL ? o->stroke : "#1a1a1a";
   api_svg_bbox bb = shapes_bbox(frames, c.n);
   double aspect = fmin(fmax((bb.y1 - bb.y0) / (bb.x1 - bb.x0), 0.25), 4);
@@ -137,8 +132,7 @@ char *api_svg_shape_document(const api_svg_shape_frame *frames, size_t n,
   size_t cols = (size_t)ceil(sqrt(1.6 * (double)cnt / aspect));
   cols = cols < 1 ? 1 : cols > cnt ? cnt : cols;
   size_t rows = (cnt + cols - 1) / cols;
-  double cw = o->width > 0 && o->width <= 1e5 ? o->width / (double)cols
-                                              : 160.0;
+  double cw = o->width > 0 && o->width <= 1e5 ? o->width / (double)cols : 160.0;
   double ch = o->height > 0 && o->height <= 1e5 ? o->height / (double)rows
                                                 : cw * aspect + 20.0;
   c.W = ceil(cw * (double)cols);
@@ -146,8 +140,7 @@ char *api_svg_shape_document(const api_svg_shape_frame *frames, size_t n,
   snprintf(title, sizeof title, "kmorph filmstrip of %zu frames of shapes",
            c.n);
   api__svg_doc_open(&c, title);
-  for (size_t i = 0; i < c.n; i++)
-    cell(&c, frames, i, cols, cw, ch, &bb);
+  for (size_t i = 0; i < c.n; i++) cell(&c, frames, i, cols, cw, ch, &bb);
   api__svg_buf_put(&c.b, "</svg>\n");
   return api__svg_buf_take(&c.b);
 }

@@ -28,7 +28,9 @@
 
 /* ---- string buffer ---------------------------------------------------- */
 
-void api__svg_buf_init(api_svg_buf *b) { memset(b, 0, sizeof *b); }
+void api__svg_buf_init(api_svg_buf *b) {
+  memset(b, 0, sizeof *b);
+}
 
 void api__svg_buf_free(api_svg_buf *b) {
   km__free(b->s);
@@ -127,8 +129,10 @@ static void trim_exp(char *s) {
     e = z;
   }
   char *src = e + 1, *dst = e + 1;
-  if (*src == '+') src++;
-  else if (*src == '-') *dst++ = *src++;
+  if (*src == '+')
+    src++;
+  else if (*src == '-')
+    *dst++ = *src++;
   while (*src == '0' && src[1]) src++;
   memmove(dst, src, strlen(src) + 1);
 }
@@ -218,8 +222,9 @@ static bool extract_spans(const km_curve *c, spans *out) {
   double alphas[KM_MAX_DEGREE + 1];
   size_t m = n + (size_t)p; /* last knot index */
   size_t a = (size_t)p, b = (size_t)p + 1, nb = 0;
-#define PW(i, k) ((k) < 2 ? c->cp[2 * (i) + (k)] * (c->w ? c->w[i] : 1.0) \
-                          : (c->w ? c->w[i] : 1.0))
+#define PW(i, k)                                                               \
+  ((k) < 2 ? c->cp[2 * (i) + (k)] * (c->w ? c->w[i] : 1.0)                     \
+           : (c->w ? c->w[i] : 1.0))
 #define Q(s, i) q[(s) * (size_t)(p + 1) + (size_t)(i)]
   for (int i = 0; i <= p; i++)
     for (int k = 0; k < 3; k++) Q(0, i)[k] = PW((size_t)i, k);
@@ -327,8 +332,7 @@ static double hermite(const double (*h)[3], int d, double cub[4][2]) {
 }
 
 /* Split a homogeneous Bezier at u = 1/2 (de Casteljau). */
-static void halve(const double (*h)[3], int d, double (*l)[3],
-                  double (*r)[3]) {
+static void halve(const double (*h)[3], int d, double (*l)[3], double (*r)[3]) {
   double t[KM_MAX_DEGREE + 1][3];
   for (int i = 0; i <= d; i++)
     for (int k = 0; k < 3; k++) t[i][k] = h[i][k];
@@ -383,8 +387,8 @@ static void approx_span(writer *w, const double (*h)[3], int d, int depth,
                         double parent) {
   double cub[4][2];
   double bnd = hermite(h, d, cub);
-  if (bnd > w->target && depth < MAX_HALVINGS &&
-      w->pieces < MAX_OUT_PIECES && bnd < 0.5 * parent) {
+  if (bnd > w->target && depth < MAX_HALVINGS && w->pieces < MAX_OUT_PIECES &&
+      bnd < 0.5 * parent) {
     double l[KM_MAX_DEGREE + 1][3], r[KM_MAX_DEGREE + 1][3];
     halve(h, d, l, r);
     approx_span(w, (const double(*)[3])l, d, depth + 1, bnd);
@@ -450,8 +454,8 @@ char *api_svg_path_d(const km_curve *c, double tol, double *err_bound) {
  * needs n inversions on curves of 10^5 spans, so the spans' lengths are
  * integrated once here and inverted within one span. */
 
-static const double GL_X[8] = {0.96028985649753623, 0.79666647741362674,
-                               0.52553240991632899, 0.18343464249564980,
+static const double GL_X[8] = {0.96028985649753623,  0.79666647741362674,
+                               0.52553240991632899,  0.18343464249564980,
                                -0.18343464249564980, -0.52553240991632899,
                                -0.79666647741362674, -0.96028985649753623};
 static const double GL_W[8] = {0.10122853629037626, 0.22238103445337447,
@@ -528,8 +532,10 @@ static bool uniform_params(const km_curve *c, size_t n, double *t) {
     for (int it = 0; it < 60; it++) {
       double f = len_between(c, a, x, tol) - target;
       if (fabs(f) <= 1e-12 * L) break;
-      if (f > 0) hi = x;
-      else lo = x;
+      if (f > 0)
+        hi = x;
+      else
+        lo = x;
       double sp = speed(c, x);
       double nx = sp > 0 ? x - f / sp : 0.5 * (lo + hi);
       if (!(nx > lo && nx < hi)) nx = 0.5 * (lo + hi);
@@ -542,8 +548,7 @@ static bool uniform_params(const km_curve *c, size_t n, double *t) {
   return true;
 }
 
-char *api_svg_path_d_fixed_z(const km_curve *c, size_t n_pieces,
-                             bool with_z) {
+char *api_svg_path_d_fixed_z(const km_curve *c, size_t n_pieces, bool with_z) {
   if (!c || c->n == 0 || !c->cp || !c->knots) return NULL;
   if (n_pieces < 1) n_pieces = 1;
   double *ts = km__malloc((n_pieces + 1) * sizeof *ts);

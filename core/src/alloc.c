@@ -12,12 +12,20 @@
 
 #include <stdlib.h>
 
-void *km__malloc(size_t n) { return malloc(n); }
+void *km__malloc(size_t n) {
+  return malloc(n);
+}
 
-void *km__calloc(size_t count, size_t size) { return calloc(count, size); }
+void *km__calloc(size_t count, size_t size) {
+  return calloc(count, size);
+}
 
-void *km__realloc(void *p, size_t n) { return realloc(p, n); }
+void *km__realloc(void *p, size_t n) {
+  return realloc(p, n);
+}
 
-void km__free(void *p) { free(p); }
+void km__free(void *p) {
+  free(p);
+}
 
 #endif

@@ -31,8 +31,8 @@ double km__length_adaptive(const km_curve *c, double a, double b,
  * fast evaluation of position and first derivative inside the span. */
 typedef struct km__bspan {
   int degree;
-  double a, b;                          /* parameter interval */
-  double h[KM__BSPAN_MAX][3];           /* homogeneous control points */
+  double a, b;                /* parameter interval */
+  double h[KM__BSPAN_MAX][3]; /* homogeneous control points */
   bool rational;
 } km__bspan;
 /* Fill sp with span [knots[i], knots[i+1]] of c (a non-empty span). */
@@ -42,8 +42,8 @@ void km__bspan_make(km__bspan *sp, const km_curve *c, size_t i);
  * (1 without weights): the derivative carries km__bspan_noise times that
  * of rounding, which near a small weight beside a large one is many times
  * the polynomial share. */
-void km__bspan_eval(const km__bspan *sp, double t, double pos[2],
-                    double der[2], double *wf);
+void km__bspan_eval(const km__bspan *sp, double t, double pos[2], double der[2],
+                    double *wf);
 /* The same in the span's variable u = (t - a) / (b - a) in [0, 1]. */
 void km__bspan_eval_u(const km__bspan *sp, double u, double pos[2],
                       double der_u[2]);
@@ -68,8 +68,8 @@ size_t km__find_span(const km_curve *c, double t, int side);
 /* km_curve_transform on c itself (a valid curve): rotation about the
  * origin by rot, then translation; KM_ERANGE past KM_MAX_COORDINATE (c is
  * then partly moved). */
-km_status km__curve_transform_in_place(struct km_curve *c, double rot, double tx,
-                                      double ty, km_error *err);
+km_status km__curve_transform_in_place(struct km_curve *c, double rot,
+                                       double tx, double ty, km_error *err);
 
 /* km_curve_self_intersections with the caller's poll: -1 also when
  * stopped (then poll->stopped). */

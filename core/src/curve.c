@@ -40,7 +40,9 @@ km_status km__curve_alloc(km_curve *c, int degree, size_t n, bool rational) {
   return KM_OK;
 }
 
-static bool bad_number(double v) { return !isfinite(v); }
+static bool bad_number(double v) {
+  return !isfinite(v);
+}
 
 /* ---- the checks of km_curve_create, in the order their errors are
  * reported: control points, knot values, the clamped ends and interior
@@ -53,8 +55,8 @@ static km_status check_points(const double *cp, size_t n, km_error *err) {
         return km__fail(err, KM_ENONFINITE, KM_FIELD_CONTROL_POINTS, (long)i,
                         NAN, "control point %zu is not finite", i);
       if (fabs(v) > KM_MAX_COORDINATE)
-        return km__fail(err, KM_ERANGE, KM_FIELD_CONTROL_POINTS, (long)i,
-                        NAN, "control point %zu exceeds %g in magnitude", i,
+        return km__fail(err, KM_ERANGE, KM_FIELD_CONTROL_POINTS, (long)i, NAN,
+                        "control point %zu exceeds %g in magnitude", i,
                         KM_MAX_COORDINATE);
     }
   }
@@ -69,8 +71,7 @@ static km_status check_knot_values(const double *knots, size_t nk,
                       "knot %zu is not finite", i);
     if (fabs(knots[i]) > KM_MAX_COORDINATE)
       return km__fail(err, KM_ERANGE, KM_FIELD_KNOTS, (long)i, NAN,
-                      "knot %zu exceeds %g in magnitude", i,
-                      KM_MAX_COORDINATE);
+                      "knot %zu exceeds %g in magnitude", i, KM_MAX_COORDINATE);
     if (i > 0 && knots[i] < knots[i - 1])
       return km__fail(err, KM_EKNOTS, KM_FIELD_KNOTS, (long)i, NAN,
                       "knot vector decreases at index %zu", i);
@@ -89,8 +90,8 @@ static km_status check_clamped(const double *knots, size_t n, int degree,
                       "be equal",
                       degree + 1);
     if (knots[nk - 1 - (size_t)i] != knots[nk - 1])
-      return km__fail(err, KM_EKNOTS, KM_FIELD_KNOTS, (long)(nk - 1 - (size_t)i),
-                      NAN,
+      return km__fail(err, KM_EKNOTS, KM_FIELD_KNOTS,
+                      (long)(nk - 1 - (size_t)i), NAN,
                       "knot vector is not clamped: the last %d knots must be "
                       "equal",
                       degree + 1);
@@ -134,7 +135,8 @@ static km_status check_weights(const double *w, size_t n, km_error *err) {
     if (bad_number(w[i]))
       return km__fail(err, KM_ENONFINITE, KM_FIELD_WEIGHTS, (long)i, NAN,
                       "weight %zu is not finite", i);
-    if (!(w[i] > 0) || w[i] > KM_MAX_COORDINATE || w[i] < 1.0 / KM_MAX_COORDINATE)
+    if (!(w[i] > 0) || w[i] > KM_MAX_COORDINATE ||
+        w[i] < 1.0 / KM_MAX_COORDINATE)
       return km__fail(err, KM_EWEIGHT, KM_FIELD_WEIGHTS, (long)i, NAN,
                       "weight %zu must be positive and within [1e-15, "
                       "1e15]",

@@ -27,7 +27,8 @@ static double speed_of_curve(const void *ctx, double t) {
 
 static double gl16(km__scalar_fn f, const void *ctx, double a, double b) {
   double m = 0.5 * (a + b), h = 0.5 * (b - a), sum = 0.0;
-  for (int k = 0; k < 16; k++) sum += km__gl16_w[k] * f(ctx, m + h * km__gl16_x[k]);
+  for (int k = 0; k < 16; k++)
+    sum += km__gl16_w[k] * f(ctx, m + h * km__gl16_x[k]);
   return sum * h;
 }
 

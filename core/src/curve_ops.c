@@ -100,9 +100,9 @@ km_status km_curve_split(const km_curve *c, double t, km_curve *left,
   double t0, t1;
   km_curve_domain(c, &t0, &t1);
   if (!(t > t0 && t < t1))
-    return km__fail(err, isfinite(t) ? KM_ERANGE : KM_ENONFINITE,
-                    KM_FIELD_NONE, -1, t,
-                    "split parameter %g is not inside (%g, %g)", t, t0, t1);
+    return km__fail(err, isfinite(t) ? KM_ERANGE : KM_ENONFINITE, KM_FIELD_NONE,
+                    -1, t, "split parameter %g is not inside (%g, %g)", t, t0,
+                    t1);
   km_curve ins, l, r;
   km_curve_init(&ins);
   km_curve_init(&l);
@@ -123,7 +123,8 @@ km_status km_curve_split(const km_curve *c, double t, km_curve *left,
   l.knots[f + (size_t)p] = t;
   memcpy(l.cp, ins.cp, 2 * nl * sizeof(double));
   r.knots[0] = t;
-  memcpy(r.knots + 1, ins.knots + f, (ins.n + (size_t)p + 1 - f) * sizeof(double));
+  memcpy(r.knots + 1, ins.knots + f,
+         (ins.n + (size_t)p + 1 - f) * sizeof(double));
   memcpy(r.cp, ins.cp + 2 * (f - 1), 2 * nr * sizeof(double));
   if (rat) {
     memcpy(l.w, ins.w, nl * sizeof(double));
@@ -169,8 +170,7 @@ km_status km_curve_reverse(km_curve *out, const km_curve *c, km_error *err) {
 
 /* Bezier extraction: every interior knot raised to multiplicity degree.
  * Returns KM_OK, KM_EINVAL, KM_ENOMEM; out owned by the caller. */
-km_status km_curve_to_bezier(km_curve *out, const km_curve *c,
-                             km_error *err) {
+km_status km_curve_to_bezier(km_curve *out, const km_curve *c, km_error *err) {
   km__hcurve h, q;
   km__h_init(&h);
   km__h_init(&q);
@@ -256,7 +256,7 @@ km_status km_curve_reparam(km_curve *out, const km_curve *c, double t0,
  * KM_EINVAL, KM_ENONFINITE, KM_ERANGE (a point beyond KM_MAX_COORDINATE,
  * err->index names it), KM_ENOMEM; out owned by the caller. */
 km_status km__curve_transform_in_place(km_curve *c, double rot, double tx,
-                                      double ty, km_error *err) {
+                                       double ty, km_error *err) {
   if (!isfinite(rot) || !isfinite(tx) || !isfinite(ty))
     return km__fail(err, KM_ENONFINITE, KM_FIELD_NONE, -1, NAN,
                     "rotation and translation must be finite");

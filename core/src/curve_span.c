@@ -36,7 +36,8 @@ void km__bspan_make(km__bspan *sp, const km_curve *c, size_t i) {
         double lo = U[i - (size_t)p + (size_t)j];
         double hi = U[i + 1 + (size_t)j - (size_t)r];
         double al = (u - lo) / (hi - lo);
-        for (int q = 0; q < 3; q++) d[j][q] = (1.0 - al) * d[j - 1][q] + al * d[j][q];
+        for (int q = 0; q < 3; q++)
+          d[j][q] = (1.0 - al) * d[j - 1][q] + al * d[j][q];
       }
     }
     for (int q = 0; q < 3; q++) sp->h[k][q] = d[p][q];
@@ -132,8 +133,8 @@ void km__bspan_eval_u(const km__bspan *sp, double u, double pos[2],
   eval_u(sp, u, pos, der_u, NULL);
 }
 
-void km__bspan_eval(const km__bspan *sp, double t, double pos[2],
-                    double der[2], double *wf) {
+void km__bspan_eval(const km__bspan *sp, double t, double pos[2], double der[2],
+                    double *wf) {
   double len = sp->b - sp->a;
   eval_u(sp, (t - sp->a) / len, pos, der, wf);
   der[0] /= len;
@@ -224,8 +225,7 @@ static double span_gl16(span_quad *q, double a, double b, double *noise) {
     for (int k = 1; k < 16; k++)
       slope = fmax(slope, fabs(v[k] - v[k - 1]) /
                               (h * (km__gl16_x[k - 1] - km__gl16_x[k])));
-    *noise = (q->unit * fmaxn +
-              slope * DBL_EPSILON * fmax(fabs(a), fabs(b))) *
+    *noise = (q->unit * fmaxn + slope * DBL_EPSILON * fmax(fabs(a), fabs(b))) *
              (b - a);
     return sum * h;
   }
@@ -354,8 +354,8 @@ static void add_break(part_search *ps, double u) {
 
 /* The part [a, b] (weights: whether w counts): true where it needs no
  * break inside */
-static bool find_breaks(part_search *ps, const part *pt, bool weights,
-                        double a, double b, int depth) {
+static bool find_breaks(part_search *ps, const part *pt, bool weights, double a,
+                        double b, int depth) {
   double big, wlo = 1.0, whi = 1.0;
   if (weights) {
     wlo = whi = pt->w[0];
@@ -394,8 +394,8 @@ static bool find_breaks(part_search *ps, const part *pt, bool weights,
 
 /* The breaks of (u0, u1), in order, down to parts no longer than tiny,
  * where N's coefficients below floor are rounding: ps->out[0 .. ps->n). */
-static void span_breaks(const km__bspan *sp, double u0, double u1,
-                        double floor, double tiny, part_search *ps) {
+static void span_breaks(const km__bspan *sp, double u0, double u1, double floor,
+                        double tiny, part_search *ps) {
   int p = sp->degree;
   part whole, pt;
   ps->n = 0;
@@ -420,7 +420,8 @@ static void span_breaks(const km__bspan *sp, double u0, double u1,
     int d = ps->dn = 2 * p - 1;
     for (int k = 0; k <= d; k++) whole.x[k] = whole.y[k] = 0.0;
     for (int i = 0; i < p; i++) {
-      double dax = p * (A[i + 1][0] - A[i][0]), day = p * (A[i + 1][1] - A[i][1]);
+      double dax = p * (A[i + 1][0] - A[i][0]),
+             day = p * (A[i + 1][1] - A[i][1]);
       double dw = p * (w[i + 1] - w[i]);
       for (int j = 0; j <= p; j++) {
         double f = km__binomial[p - 1][i] * km__binomial[p][j] /
@@ -468,8 +469,8 @@ double km__bspan_length_counted(const km__bspan *sp, double u0, double u1,
     double b = i < ps.n ? ps.out[i] : u1, wn;
     if (!(b > a)) continue;
     double whole = span_gl16(&q, a, b, &wn);
-    len += span_rec(&q, a, b, whole, wn, tol * ((b - a) / (u1 - u0)), 0,
-                    &budget);
+    len +=
+        span_rec(&q, a, b, whole, wn, tol * ((b - a) / (u1 - u0)), 0, &budget);
     a = b;
   }
   if (evals) *evals += q.evals;

@@ -28,18 +28,18 @@
 typedef struct fit_work {
   const double *pts; /* n points: the caller's, or ext */
   size_t n;
-  bool seam;         /* a closed loop: the control points beside the seam
+  bool seam; /* a closed loop: the control points beside the seam
                         are tied (P[m-2] = 2 P0 - P1) */
   double *ext, *u, *U, *newk, *cp, *A, *rhs;
-  double total;      /* chord length of the points */
-  size_t nint;       /* interior knots */
+  double total; /* chord length of the points */
+  size_t nint;  /* interior knots */
   double interior[FIT_MAX_CP];
 } fit_work;
 
 /* The points as an open run (a loop back to its first point) and their
  * chord-length parameters in [0, 1] (not normalised when total is 0). */
-static km_status prepare(fit_work *fw, const double *pts, size_t n,
-                         bool closed, km_error *err) {
+static km_status prepare(fit_work *fw, const double *pts, size_t n, bool closed,
+                         km_error *err) {
   if (closed) {
     fw->ext = km__malloc(2 * (n + 1) * sizeof(double));
     if (!fw->ext) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
@@ -56,7 +56,8 @@ static km_status prepare(fit_work *fw, const double *pts, size_t n,
   if (!u) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   u[0] = 0.0;
   for (size_t i = 1; i < n; i++)
-    u[i] = u[i - 1] + hypot(pts[2 * i] - pts[2 * i - 2], pts[2 * i + 1] - pts[2 * i - 1]);
+    u[i] = u[i - 1] +
+           hypot(pts[2 * i] - pts[2 * i - 2], pts[2 * i + 1] - pts[2 * i - 1]);
   fw->total = u[n - 1];
   if (!(fw->total > 0)) return KM_OK;
   for (size_t i = 0; i < n; i++) u[i] /= fw->total;
@@ -85,8 +86,8 @@ static bool correct_params(fit_work *fw, size_t ncp) {
       km_curve_eval(&tmp, t, 2, d);
       double ex = d[0][0] - pts[2 * i], ey = d[0][1] - pts[2 * i + 1];
       double f = ex * d[1][0] + ey * d[1][1];
-      double fp = d[1][0] * d[1][0] + d[1][1] * d[1][1] + ex * d[2][0] +
-                  ey * d[2][1];
+      double fp =
+          d[1][0] * d[1][0] + d[1][1] * d[1][1] + ex * d[2][0] + ey * d[2][1];
       if (!(fp > 0)) break;
       t -= f / fp;
     }
@@ -227,7 +228,8 @@ static km_status fit_rounds(fit_work *fw, double tol, bool closed,
   for (;;) {
     size_t ncp = fw->nint + 4; /* unknowns: inner points, less a tied one */
     size_t nu = ncp - 2 - (fw->seam ? 1 : 0);
-    if (ncp >= fw->n || ncp > FIT_MAX_CP) return KM_OK; /* interpolation is as small */
+    if (ncp >= fw->n || ncp > FIT_MAX_CP)
+      return KM_OK; /* interpolation is as small */
     for (int k = 0; k < 4; k++) {
       fw->U[k] = 0.0;
       fw->U[ncp + (size_t)k] = 1.0;

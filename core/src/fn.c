@@ -46,11 +46,11 @@ km_status km_fn_create(km_fn *out, int degree, size_t n, const double *knots,
   size_t nk = n + (size_t)degree + 1;
   for (size_t i = 0; i < n; i++) {
     if (!isfinite(coef[i]))
-      return km__fail(err, KM_ENONFINITE, KM_FIELD_KAPPA_COEFFICIENTS,
-                      (long)i, NAN, "coefficient %zu is not finite", i);
+      return km__fail(err, KM_ENONFINITE, KM_FIELD_KAPPA_COEFFICIENTS, (long)i,
+                      NAN, "coefficient %zu is not finite", i);
     if (fabs(coef[i]) > KM_MAX_COORDINATE)
-      return km__fail(err, KM_ERANGE, KM_FIELD_KAPPA_COEFFICIENTS, (long)i,
-                      NAN, "coefficient %zu exceeds %g in magnitude", i,
+      return km__fail(err, KM_ERANGE, KM_FIELD_KAPPA_COEFFICIENTS, (long)i, NAN,
+                      "coefficient %zu exceeds %g in magnitude", i,
                       KM_MAX_COORDINATE);
   }
   for (size_t i = 0; i < nk; i++) {
@@ -59,8 +59,7 @@ km_status km_fn_create(km_fn *out, int degree, size_t n, const double *knots,
                       "knot %zu is not finite", i);
     if (fabs(knots[i]) > KM_MAX_COORDINATE)
       return km__fail(err, KM_ERANGE, KM_FIELD_KAPPA_KNOTS, (long)i, NAN,
-                      "knot %zu exceeds %g in magnitude", i,
-                      KM_MAX_COORDINATE);
+                      "knot %zu exceeds %g in magnitude", i, KM_MAX_COORDINATE);
     if (i > 0 && knots[i] < knots[i - 1])
       return km__fail(err, KM_EKNOTS, KM_FIELD_KAPPA_KNOTS, (long)i, NAN,
                       "knot vector decreases at index %zu", i);
@@ -178,9 +177,9 @@ km_status km_fn_antiderivative(km_fn *out, const km_fn *f, double c0,
   r.knots[nk + 1] = f->knots[nk - 1];
   r.coef[0] = c0;
   for (size_t j = 1; j <= f->n; j++)
-    r.coef[j] = r.coef[j - 1] + f->coef[j - 1] *
-                                    (f->knots[j + (size_t)p] - f->knots[j - 1]) /
-                                    (p + 1);
+    r.coef[j] =
+        r.coef[j - 1] +
+        f->coef[j - 1] * (f->knots[j + (size_t)p] - f->knots[j - 1]) / (p + 1);
   *out = r;
   return KM_OK;
 }
@@ -207,8 +206,8 @@ double km_fn_abs_bound(const km_fn *f, double x0, double x1) {
     double lo = fmax(a, x0), hi = fmin(b, x1);
     if (hi < lo || (hi == lo && !(x0 == x1))) continue;
     double h = b - a;
-    km__bern_restrict(pp.c + i * (size_t)(d + 1), d, (lo - a) / h,
-                      (hi - a) / h, c);
+    km__bern_restrict(pp.c + i * (size_t)(d + 1), d, (lo - a) / h, (hi - a) / h,
+                      c);
     m = fmax(m, km__bern_abs_bound(c, d));
   }
   km__pp_free(&pp);
@@ -298,8 +297,7 @@ double km_fn_integral_sq(const km_fn *f) {
 
 /* Coefficients of the piece of p covering [r0, r1] (normalised r over p's
  * domain), elevated to degree e. */
-static void piece_on(const km_pp *p, double r0, double r1, int e,
-                     double *out) {
+static void piece_on(const km_pp *p, double r0, double r1, int e, double *out) {
   double a = p->x[0], b = p->x[p->m], L = b - a;
   double x0 = a + r0 * L, x1 = a + r1 * L;
   size_t i = km__pp_find(p, 0.5 * (x0 + x1));
@@ -308,8 +306,7 @@ static void piece_on(const km_pp *p, double r0, double r1, int e,
   if (u0 < 0) u0 = 0;
   if (u1 > 1) u1 = 1;
   double tmp[FN_MAX_DEGREE + 2];
-  km__bern_restrict(p->c + i * (size_t)(p->degree + 1), p->degree, u0, u1,
-                    tmp);
+  km__bern_restrict(p->c + i * (size_t)(p->degree + 1), p->degree, u0, u1, tmp);
   km__bern_elevate(tmp, p->degree, e, out);
 }
 

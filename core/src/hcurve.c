@@ -20,8 +20,9 @@
 #include "km/curve.h"
 #include "km/limits.h"
 
-
-void km__h_init(km__hcurve *h) { memset(h, 0, sizeof *h); }
+void km__h_init(km__hcurve *h) {
+  memset(h, 0, sizeof *h);
+}
 
 void km__h_free(km__hcurve *h) {
   if (!h) return;
@@ -309,4 +310,3 @@ cleanup:
   km__free(mult);
   return st;
 }
-

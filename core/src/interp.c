@@ -83,8 +83,7 @@ cleanup:
  * indices mod n, n >= 3, strictly diagonally dominant. r is overwritten with
  * the solution; work holds 5n doubles. */
 static void cyclic_solve(const double *sub, const double *dia,
-                         const double *sup, double *r, size_t n,
-                         double *work) {
+                         const double *sup, double *r, size_t n, double *work) {
   double *bb = work, *cprime = work + n, *z = work + 2 * n;
   double *zr = work + 3 * n; /* 2n: the (x, y) pair solutions */
   double gamma = -dia[0];
@@ -124,7 +123,8 @@ static void cyclic_solve(const double *sub, const double *dia,
   }
   double den = 1.0 + z[0] + beta * z[n - 1] / gamma;
   for (int col = 0; col < 2; col++) {
-    double fact = (zr[(size_t)col] + beta * zr[2 * (n - 1) + (size_t)col] / gamma) / den;
+    double fact =
+        (zr[(size_t)col] + beta * zr[2 * (n - 1) + (size_t)col] / gamma) / den;
     for (size_t i = 0; i < n; i++)
       r[2 * i + (size_t)col] = zr[2 * i + (size_t)col] - fact * z[i];
   }
@@ -133,9 +133,8 @@ static void cyclic_solve(const double *sub, const double *dia,
 /* Closed, N >= 3 distinct points (no repeat of the first): periodic C2. h
  * holds the N parameter spans (summing to 1), u the N+1 breaks. cp gets
  * N + 3 points, T the N + 7 knots. */
-static km_status solve_closed(const double *Q, const double *h,
-                              const double *u, size_t N, double *T,
-                              double *cp) {
+static km_status solve_closed(const double *Q, const double *h, const double *u,
+                              size_t N, double *T, double *cp) {
   double *buf = km__malloc(N * 10 * sizeof(double));
   if (!buf) return KM_ENOMEM;
   double *sub = buf, *dia = buf + N, *sup = buf + 2 * N, *D = buf + 3 * N;
@@ -163,7 +162,8 @@ static km_status solve_closed(const double *Q, const double *h,
     cp[(size_t)c] = Q[(size_t)c];
     cp[2 * last + (size_t)c] = Q[(size_t)c];
     cp[2 + (size_t)c] = Q[(size_t)c] + h[0] * D[(size_t)c] / 3.0;
-    cp[2 * (last - 1) + (size_t)c] = Q[(size_t)c] - h[N - 1] * D[(size_t)c] / 3.0;
+    cp[2 * (last - 1) + (size_t)c] =
+        Q[(size_t)c] - h[N - 1] * D[(size_t)c] / 3.0;
   }
   for (size_t i = 1; i < N; i++) {
     /* de Boor point P[i+1], blossom at (u[i-1], u[i], u[i+1]) */
@@ -174,7 +174,8 @@ static km_status solve_closed(const double *Q, const double *h,
         /* from span i: b1 = Q_i + h_i D_i / 3, b2 = Q_{i+1} - h_i D_{i+1} / 3 */
         size_t ip1 = (i + 1) % N;
         double b1 = qi + h[i] * di / 3.0;
-        double b2 = Q[2 * ip1 + (size_t)c] - h[i] * D[2 * ip1 + (size_t)c] / 3.0;
+        double b2 =
+            Q[2 * ip1 + (size_t)c] - h[i] * D[2 * ip1 + (size_t)c] / 3.0;
         v = b1 + (h[i - 1] / h[i]) * (b1 - b2);
       } else {
         /* from span i-1: b1 = Q_{i-1} + h_{i-1} D_{i-1} / 3, b2 = Q_i -
@@ -273,8 +274,7 @@ static km_status chord_breaks(const double *Q, size_t N, size_t nspan,
 
 /* One cubic piece through N = 2 or 3 points: the segment (uniform speed)
  * or the parabola through three points, degree-elevated. */
-static void one_piece(const double *Q, const double *u, size_t N,
-                      km_curve *c) {
+static void one_piece(const double *Q, const double *u, size_t N, km_curve *c) {
   for (int j = 0; j < 4; j++) {
     c->knots[j] = 0.0;
     c->knots[4 + j] = 1.0;

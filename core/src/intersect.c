@@ -62,8 +62,8 @@
 
 typedef struct seg {
   size_t piece;
-  double u0, u1;      /* local parameter range within the piece */
-  double h[MAXC][3];  /* homogeneous Bezier points of the sub-curve */
+  double u0, u1;     /* local parameter range within the piece */
+  double h[MAXC][3]; /* homogeneous Bezier points of the sub-curve */
   double xmin, xmax, ymin, ymax;
 } seg;
 
@@ -119,8 +119,7 @@ static void split_half(const seg *s, int p, seg *l, seg *r) {
   }
   for (int k = 1; k <= p; k++) {
     for (int i = 0; i <= p - k; i++)
-      for (int c = 0; c < 3; c++)
-        tmp[i][c] = 0.5 * (tmp[i][c] + tmp[i + 1][c]);
+      for (int c = 0; c < 3; c++) tmp[i][c] = 0.5 * (tmp[i][c] + tmp[i + 1][c]);
     for (int c = 0; c < 3; c++) {
       l->h[k][c] = tmp[0][c];
       r->h[p - k][c] = tmp[p - k][c];
@@ -169,7 +168,8 @@ static void collect(ctx *x, const seg *s, int depth) {
    * that rounding wiggles every control polygon, however small) and up to
    * a tenth of the tolerance: a sub-curve monotone but for steps back of
    * that size can only loop within it, below what the count resolves */
-  double eps = fmax(fmax(1e-15 * x->size, 64 * DBL_EPSILON * x->mag), 0.1 * x->tol);
+  double eps =
+      fmax(fmax(1e-15 * x->size, 64 * DBL_EPSILON * x->mag), 0.1 * x->tol);
   if (depth >= MONO_DEPTH || x->nseg >= MAX_SEGS || monotone(s, x->p, eps)) {
     push_seg(x, s);
     return;
@@ -201,7 +201,8 @@ static void eval_piece(const ctx *x, size_t k, double u, double P[2],
                        double D[2]) {
   int p = x->p;
   double tmp[MAXC][3];
-  memcpy(tmp, x->bz->pw + k * (size_t)p * 3, (size_t)(p + 1) * 3 * sizeof(double));
+  memcpy(tmp, x->bz->pw + k * (size_t)p * 3,
+         (size_t)(p + 1) * 3 * sizeof(double));
   double d[3] = {0, 0, 0};
   for (int lvl = 1; lvl <= p; lvl++) {
     if (lvl == p)
@@ -438,8 +439,7 @@ long km_curve_self_intersections(const km_curve *c, double tol) {
 }
 
 km_status km_curve_self_intersections_until(const km_curve *c, double tol,
-                                            const km_stop *stop,
-                                            long *count) {
+                                            const km_stop *stop, long *count) {
   km__poll poll;
   km__poll_init(&poll, stop);
   long n = km__self_intersections(c, tol, &poll);
@@ -484,7 +484,8 @@ static void sweep_pairs(ctx *x, seg **order) {
   long sweep_left = SWEEP_BUDGET;
   for (size_t i = 0; i < x->nseg && !x->oom; i++) {
     /* past every bound nothing more can be found */
-    if (x->pairs_left <= 0 && (x->seeds_left <= 0 || x->newton_left <= 0)) break;
+    if (x->pairs_left <= 0 && (x->seeds_left <= 0 || x->newton_left <= 0))
+      break;
     for (size_t j = i + 1; j < x->nseg && !x->oom && sweep_left-- > 0; j++) {
       if ((j & 15) == 0 && (x->oom = km__poll_stop(x->poll, 4))) break;
       if (order[j]->xmin > order[i]->xmax + x->margin) break;
@@ -524,7 +525,8 @@ long km__self_intersections(const km_curve *c, double tol, km__poll *poll) {
     s.piece = k;
     s.u0 = 0;
     s.u1 = 1;
-    memcpy(s.h, bz.pw + k * (size_t)p * 3, (size_t)(p + 1) * 3 * sizeof(double));
+    memcpy(s.h, bz.pw + k * (size_t)p * 3,
+           (size_t)(p + 1) * 3 * sizeof(double));
     seg_bbox(&s, p);
     collect(&x, &s, 0);
   }

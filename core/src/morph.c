@@ -85,7 +85,8 @@ static km_status corners_close(const km_morph *m, bool *close) {
  * chosen here, once. */
 static km_status plan_frames(km_morph *m, km_error *err) {
   const km__input *a = &m->in[0], *b = &m->in[1];
-  km_closure how = m->opt.closure == KM_CLOSURE_AUTO ? KM_CLOSURE_LSQ : m->opt.closure;
+  km_closure how =
+      m->opt.closure == KM_CLOSURE_AUTO ? KM_CLOSURE_LSQ : m->opt.closure;
   bool lsq = m->closed && how == KM_CLOSURE_LSQ;
   if (m->opt.method != KM_METHOD_CURVATURE) return KM_OK;
   if (m->opt.blend != KM_BLEND_TURNING || m->nk != 2 || m->opt.degree != 3) {
@@ -103,8 +104,8 @@ static km_status plan_frames(km_morph *m, km_error *err) {
   size_t max_pieces = 0;
   if (m->opt.max_points > 0)
     max_pieces = m->opt.max_points >= 4 ? (m->opt.max_points - 2) / 2 : 1;
-  km_status st = km__frame_plan_build(&m->plan, tp, len, ang, m->closed,
-                                      m->tol, max_pieces, m->poll, err);
+  km_status st = km__frame_plan_build(&m->plan, tp, len, ang, m->closed, m->tol,
+                                      max_pieces, m->poll, err);
   if (st == KM_ELIMIT && max_pieces > 0)
     return km__fail(err, KM_ELIMIT, KM_FIELD_TOLERANCE, -1, NAN,
                     "the frames need more than %zu control points at this "
@@ -145,8 +146,9 @@ static km_status morph_shifted(const km_morph *base, double dshift,
   m->kmax = base->kmax;
   m->ra = km__malloc(2 * sizeof(double));
   m->rb = km__malloc(2 * sizeof(double));
-  km_status st = m->ra && m->rb ? KM_OK
-                                : km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  km_status st = m->ra && m->rb
+                     ? KM_OK
+                     : km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   if (!st) {
     m->ra[0] = m->rb[0] = 0.0;
     m->ra[1] = m->rb[1] = 1.0;
@@ -155,7 +157,8 @@ static km_status morph_shifted(const km_morph *base, double dshift,
   }
   if (!st) st = km__input_copy(&m->in[1], &base->in[1], err);
   if (!st)
-    st = km__input_rotate_start(&m->in[1], dshift * m->in[1].sig.length, poll, err);
+    st = km__input_rotate_start(&m->in[1], dshift * m->in[1].sig.length, poll,
+                                err);
   if (!st) st = plan_frames(m, err);
   if (st) {
     km_morph_free(m);
@@ -237,7 +240,8 @@ static km_status set_correspondence(km_morph *m, const km_morph_options *opt,
   }
   m->ra = km__malloc((nm + 2) * sizeof(double));
   m->rb = km__malloc((nm + 2) * sizeof(double));
-  if (!m->ra || !m->rb) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  if (!m->ra || !m->rb)
+    return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   m->ra[0] = m->rb[0] = 0.0;
   for (size_t i = 0; i < nm; i++) {
     double x = pairs[2 * i], y = pairs[2 * i + 1];
@@ -273,13 +277,15 @@ static km_status create_impl(km_morph **out, const km_morph_input *from,
   if (!st) st = set_correspondence(m, opt, err);
   if (!st && opt->method == KM_METHOD_LINEAR) {
     st = km__input_ensure_curve(a, 0.1 * m->tol, opt->max_points, poll, err);
-    if (!st) st = km__input_ensure_curve(b, 0.1 * m->tol, opt->max_points, poll, err);
+    if (!st)
+      st = km__input_ensure_curve(b, 0.1 * m->tol, opt->max_points, poll, err);
     if (!st)
       st = km_curve_make_compatible(&a->curve, &b->curve, &m->lin[0],
                                     &m->lin[1], err);
   }
   if (st) goto fail;
-  m->kmax = fmax(km_signature_max_abs_kappa(&a->sig), km_signature_max_abs_kappa(&b->sig));
+  m->kmax = fmax(km_signature_max_abs_kappa(&a->sig),
+                 km_signature_max_abs_kappa(&b->sig));
   st = plan_frames(m, err);
   if (st) goto fail;
   *out = m;
@@ -336,8 +342,8 @@ static km_status pick_start(km_morph **mp, const double *cand, size_t ncand,
   for (size_t i = 1; st == KM_OK && i < ncand && pick == SIZE_MAX; i++) {
     km_morph *alt = NULL;
     double d = cand[i] - cand[0];
-    km_status sst = morph_shifted(alts[0], d < 0 ? d + 1.0 : d, poll, &alt,
-                                  NULL);
+    km_status sst =
+        morph_shifted(alts[0], d < 0 ? d + 1.0 : d, poll, &alt, NULL);
     if (sst == KM_ENOMEM || sst == KM_ECANCELLED) {
       st = sst;
       break;
@@ -364,8 +370,8 @@ static km_status pick_start(km_morph **mp, const double *cand, size_t ncand,
 }
 
 km_status km_morph_create(km_morph **out, const km_morph_input *from,
-                          const km_morph_input *to,
-                          const km_morph_options *opt, km_error *err) {
+                          const km_morph_input *to, const km_morph_options *opt,
+                          km_error *err) {
   double cand[KM__SHIFT_CANDIDATES];
   size_t ncand = 0;
   km_morph *m = NULL;
@@ -412,15 +418,16 @@ static km_status planned_frame(const km_morph *m, double t, km_closure how,
   size_t nb = km__frame_plan_pieces(m->plan) + 1;
   double *buf = km__malloc(2 * nb * sizeof(double));
   if (!buf) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
-  double (*P)[2] = (double (*)[2])buf;
+  double(*P)[2] = (double(*)[2])buf;
   km_curve f;
   km_curve_init(&f);
-  km_status st = km__frame_plan_curve(m->plan, t, (1 - t) * phia + t * phib,
-                                      how == KM_CLOSURE_LSQ, &f, buf, poll, err);
+  km_status st =
+      km__frame_plan_curve(m->plan, t, (1 - t) * phia + t * phib,
+                           how == KM_CLOSURE_LSQ, &f, buf, poll, err);
   if (st) goto done;
   if (m->closed && !f.closed && how != KM_CLOSURE_NONE)
     km__close_polygon(&f, how == KM_CLOSURE_LSQ ? KM_CLOSURE_C0 : how);
-  km__place_planned(m, t, (const double (*)[2])P, nb, &rot, T);
+  km__place_planned(m, t, (const double(*)[2])P, nb, &rot, T);
   st = km__curve_transform_in_place(&f, rot, T[0], T[1], err);
   if (!st) {
     *out = f;
@@ -438,9 +445,8 @@ km_status km_morph_frame(const km_morph *m, double t, km_curve *out,
   return frame_impl(m, t, NULL, out, metrics, sig_out, err);
 }
 
-km_status km_morph_frame_until(const km_morph *m, double t,
-                               const km_stop *stop, km_curve *out,
-                               km_frame_metrics *metrics,
+km_status km_morph_frame_until(const km_morph *m, double t, const km_stop *stop,
+                               km_curve *out, km_frame_metrics *metrics,
                                km_signature *sig_out, km_error *err) {
   km__poll poll;
   km__poll_init(&poll, stop);
@@ -453,13 +459,15 @@ km_status km_morph_frame_until(const km_morph *m, double t,
 static km_status frame_signature(const km_morph *m, double t, km__poll *poll,
                                  km_signature *out, double *gap,
                                  km_error *err) {
-  km_closure how = m->opt.closure == KM_CLOSURE_AUTO ? KM_CLOSURE_LSQ : m->opt.closure;
+  km_closure how =
+      m->opt.closure == KM_CLOSURE_AUTO ? KM_CLOSURE_LSQ : m->opt.closure;
   km_signature blended;
   km_signature_init(&blended);
   double g = 0.0;
   km_status st = km__blend_signature(m, t, &blended, err);
   /* the blend is linear in the pieces: a few units each */
-  if (!st && km__poll_stop(poll, 4 * (long)blended.kappa.n)) st = km__stopped(err);
+  if (!st && km__poll_stop(poll, 4 * (long)blended.kappa.n))
+    st = km__stopped(err);
   if (!st && m->closed && how == KM_CLOSURE_LSQ) {
     /* the closure measures the gap itself (its first residual) */
     st = km__close_within_bound(m, &blended, out, &g, poll, err);
@@ -517,7 +525,8 @@ static km_status frame_impl(const km_morph *m, double t, km__poll *poll,
                     "time %g is outside [0, 1]", t);
   if (m->opt.method == KM_METHOD_LINEAR)
     return km__linear_frame(m, t, out, metrics, sig_out, poll, err);
-  km_closure how = m->opt.closure == KM_CLOSURE_AUTO ? KM_CLOSURE_LSQ : m->opt.closure;
+  km_closure how =
+      m->opt.closure == KM_CLOSURE_AUTO ? KM_CLOSURE_LSQ : m->opt.closure;
   if (m->plan && !metrics && !sig_out)
     return planned_frame(m, t, how, poll, out, err);
   km_signature sig;
@@ -581,4 +590,3 @@ km_status km_morph_frame_points(const km_morph *m, double t,
   if (!st) *points = n;
   return st;
 }
-

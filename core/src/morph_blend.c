@@ -63,7 +63,7 @@ static km_status corner_push(corner_list *cl, double s, double turn) {
  * which is computed by interpolation at Chebyshev points. */
 
 typedef struct quad_map {
-  double x0, h;      /* frame interval [x0, x0 + h] */
+  double x0, h;        /* frame interval [x0, x0 + h] */
   double a0, al0, al1; /* s_a(x0), alpha at both ends */
 } quad_map;
 
@@ -207,18 +207,21 @@ static km_status smooth_map_make(const km_morph *m, double t, smooth_map *sm) {
   sm->nq = 2 * K;
   double *buf = sm->buf = km__malloc((6 * K + 1) * sizeof(double));
   if (!buf) return KM_ENOMEM;
-  double *rho = sm->rho = buf, *len = sm->len = buf + K, *S = sm->S = buf + 2 * K;
+  double *rho = sm->rho = buf, *len = sm->len = buf + K,
+         *S = sm->S = buf + 2 * K;
   sm->nl = buf + 3 * K + 1;
   sm->nr = buf + 4 * K + 1;
   sm->mid = buf + 5 * K + 1;
   S[0] = 0.0;
   for (size_t k = 0; k < K; k++) {
-    double la = (m->ra[k + 1] - m->ra[k]) * La, lb = (m->rb[k + 1] - m->rb[k]) * Lb;
+    double la = (m->ra[k + 1] - m->ra[k]) * La,
+           lb = (m->rb[k + 1] - m->rb[k]) * Lb;
     len[k] = (1 - t) * la + t * lb;
     rho[k] = la / len[k];
     S[k + 1] = S[k] + len[k];
   }
-  km_status st = smooth_nodes(rho, len, K, m->closed, t, sm->nl, sm->nr, sm->mid);
+  km_status st =
+      smooth_nodes(rho, len, K, m->closed, t, sm->nl, sm->nr, sm->mid);
   if (st) return st;
   quad_map *qm = sm->qm = km__malloc(2 * K * sizeof *qm);
   if (!qm) return KM_ENOMEM;
@@ -260,7 +263,8 @@ static km_status smooth_breaks(const km_morph *m, double t,
   for (size_t i = 1; i < b->kappa.m; i++) {
     double y = b->kappa.x[i];
     for (size_t q = 0; q < nq; q++) {
-      double y0 = sb_of(&qm[q], qm[q].x0, t), y1 = sb_of(&qm[q], qm[q].x0 + qm[q].h, t);
+      double y0 = sb_of(&qm[q], qm[q].x0, t),
+             y1 = sb_of(&qm[q], qm[q].x0 + qm[q].h, t);
       if (y > y0 && y < y1) {
         br[nb++] = qm_inv_b(&qm[q], y, t);
         break;
@@ -305,7 +309,7 @@ static km_status smooth_pieces(const km_morph *m, double t,
       double ka = km__pp_eval(&a->kappa, fmin(fmax(sa, 0.0), La));
       double kb = km__pp_eval(&b->kappa, fmin(fmax(sb, 0.0), Lb));
       v[j] = m->opt.blend == KM_BLEND_PAPER ? (1 - t) * ka + t * kb
-                                             : (1 - t) * ka * al + t * kb * be;
+                                            : (1 - t) * ka * al + t * kb * be;
     }
     if (!bern_interp(u, v, dd)) return KM_ENOCONVERGE;
     memcpy(o->c + i * (size_t)(dd + 1), v, (size_t)(dd + 1) * sizeof(double));
@@ -350,7 +354,8 @@ static km_status smooth_corners(const km_morph *m, double t,
         /* the delta scales with dx/ds of that input */
         size_t k = 0;
         while (k + 1 < sm->nq && x > qm[k].x0 + qm[k].h) k++;
-        double al = qm[k].al0 + (qm[k].al1 - qm[k].al0) * (x - qm[k].x0) / qm[k].h;
+        double al =
+            qm[k].al0 + (qm[k].al1 - qm[k].al0) * (x - qm[k].x0) / qm[k].h;
         double be = (1 - (1 - t) * al) / t;
         turn /= w ? be : al;
         if (turn >= KM_PI) turn = KM_PI - 1e-9;
@@ -411,11 +416,12 @@ static km_status slice_or_point(km_pp *out, const km_pp *p, double x0,
 
 /* The blended curvature on segment k of frame t, over [S, S + l] of the
  * frame (l > 0), under the piecewise-linear correspondence. */
-static km_status blend_segment(const km_morph *m, double t, size_t k,
-                               double S, double l, km_pp *out) {
+static km_status blend_segment(const km_morph *m, double t, size_t k, double S,
+                               double l, km_pp *out) {
   const km__input *a = &m->in[0], *b = &m->in[1];
   double La = a->sig.length, Lb = b->sig.length;
-  double la = (m->ra[k + 1] - m->ra[k]) * La, lb = (m->rb[k + 1] - m->rb[k]) * Lb;
+  double la = (m->ra[k + 1] - m->ra[k]) * La,
+         lb = (m->rb[k + 1] - m->rb[k]) * Lb;
   double wa = 1 - t, wb = t;
   if (m->opt.blend != KM_BLEND_PAPER) {
     wa = (1 - t) * la / l;
@@ -424,8 +430,10 @@ static km_status blend_segment(const km_morph *m, double t, size_t k,
   km_pp sa, sb;
   km__pp_init(&sa);
   km__pp_init(&sb);
-  km_status st = slice_or_point(&sa, &a->kappa, m->ra[k] * La, m->ra[k + 1] * La);
-  if (!st) st = slice_or_point(&sb, &b->kappa, m->rb[k] * Lb, m->rb[k + 1] * Lb);
+  km_status st =
+      slice_or_point(&sa, &a->kappa, m->ra[k] * La, m->ra[k + 1] * La);
+  if (!st)
+    st = slice_or_point(&sb, &b->kappa, m->rb[k] * Lb, m->rb[k + 1] * Lb);
   if (!st) st = km__pp_blend(out, &sa, wa, &sb, wb, S, S + l);
   km__pp_free(&sa);
   km__pp_free(&sb);
@@ -448,7 +456,8 @@ static void drop_short_pieces(km_pp *p, double h) {
   for (size_t i = 0; i < p->m; i++) {
     if (!(p->x[i + 1] - p->x[i] > h)) continue;
     p->x[q] = q == 0 ? p->x[0] : p->x[i];
-    if (q != i) memmove(p->c + q * stride, p->c + i * stride, stride * sizeof(double));
+    if (q != i)
+      memmove(p->c + q * stride, p->c + i * stride, stride * sizeof(double));
     q++;
   }
   if (q == 0) q = 1; /* all short (a frame of rounding's length) */
@@ -462,18 +471,20 @@ static void drop_short_pieces(km_pp *p, double h) {
 static km_status segment_corners(const km_morph *m, double t, size_t k,
                                  double S, double l, double la, double lb,
                                  bool point, corner_list *cl) {
-  double cwa = m->opt.blend == KM_BLEND_PAPER ? (1 - t) * corner_scale(l, la) : (1 - t);
+  double cwa =
+      m->opt.blend == KM_BLEND_PAPER ? (1 - t) * corner_scale(l, la) : (1 - t);
   double cwb = m->opt.blend == KM_BLEND_PAPER ? t * corner_scale(l, lb) : t;
   km_status st = KM_OK;
   for (int w = 0; w < 2 && !st; w++) {
     const km__input *in = &m->in[w];
-    double L = in->sig.length, r0 = w ? m->rb[k] : m->ra[k], r1 = w ? m->rb[k + 1] : m->ra[k + 1];
+    double L = in->sig.length, r0 = w ? m->rb[k] : m->ra[k],
+           r1 = w ? m->rb[k + 1] : m->ra[k + 1];
     double cw = w ? cwb : cwa;
     if (cw == 0) continue;
     for (size_t i = 0; i < in->sig.ncorners && !st; i++) {
       double r = in->sig.corners[i].s / L;
       bool last = k + 2 == m->nk;
-      if (r < r0 || r > r1 || (r == r1 && !last) ) continue;
+      if (r < r0 || r > r1 || (r == r1 && !last)) continue;
       double turn = cw * in->sig.corners[i].turn;
       if (turn >= KM_PI) turn = KM_PI - 1e-9;
       if (turn <= -KM_PI) turn = -KM_PI + 1e-9;
@@ -494,7 +505,8 @@ static km_status blend_linear(const km_morph *m, double t, km_pp *segs,
   int deg = 0;
   km_status st = KM_OK;
   for (size_t k = 0; !st && k + 1 < m->nk; k++) {
-    double la = (m->ra[k + 1] - m->ra[k]) * La, lb = (m->rb[k + 1] - m->rb[k]) * Lb;
+    double la = (m->ra[k + 1] - m->ra[k]) * La,
+           lb = (m->rb[k + 1] - m->rb[k]) * Lb;
     double l = (1 - t) * la + t * lb;
     /* a segment shorter than the frame resolves (a match next to an end or
      * to another match, on the side t weighs) is a point of the frame:
@@ -591,10 +603,11 @@ done:
 
 /* frame arc length s -> normalised positions on a and b */
 void km__corresponding(const km_morph *m, double t, double s, double *ra,
-                          double *rb) {
+                       double *rb) {
   double La = m->in[0].sig.length, Lb = m->in[1].sig.length, S = 0.0;
   for (size_t k = 0; k + 1 < m->nk; k++) {
-    double la = (m->ra[k + 1] - m->ra[k]) * La, lb = (m->rb[k + 1] - m->rb[k]) * Lb;
+    double la = (m->ra[k + 1] - m->ra[k]) * La,
+           lb = (m->rb[k + 1] - m->rb[k]) * Lb;
     double l = (1 - t) * la + t * lb;
     if (s <= S + l || k + 2 == m->nk) {
       double f = l > 0 ? (s - S) / l : 0.0;
@@ -608,4 +621,3 @@ void km__corresponding(const km_morph *m, double t, double s, double *ra,
   }
   *ra = *rb = 1.0;
 }
-

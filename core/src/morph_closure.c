@@ -60,13 +60,15 @@ void km__closure_metric_weighted(const double *w, double *M) {
       for (int i = 0; i < NF; i++) d[i] = km__bspline3_d(u - i);
       for (int i = 0; i < NF; i++) {
         if (d[i] == 0.0) continue;
-        for (int j = 0; j < NF; j++) M[i * NF + j] += w[iv] * W[g] * d[i] * d[j];
+        for (int j = 0; j < NF; j++)
+          M[i * NF + j] += w[iv] * W[g] * d[i] * d[j];
       }
     }
 }
 
 void km__closure_metric(double *M) {
-  static const double band[4] = {2.0 / 3.0, -1.0 / 8.0, -1.0 / 5.0, -1.0 / 120.0};
+  static const double band[4] = {2.0 / 3.0, -1.0 / 8.0, -1.0 / 5.0,
+                                 -1.0 / 120.0};
   for (int i = 0; i < NF; i++)
     for (int j = 0; j < NF; j++) {
       int d = i > j ? i - j : j - i;
@@ -131,7 +133,7 @@ km_status km__close_by_corners(const double *S, const double *tau, size_t nc,
       gx += c * S[2 * m] - sn * S[2 * m + 1];
       gy += sn * S[2 * m] + c * S[2 * m + 1];
       if (m >= 1) {
-        J[2 * (m - 1)] = -gy; /* d gx / d delta_m */
+        J[2 * (m - 1)] = -gy;    /* d gx / d delta_m */
         J[2 * (m - 1) + 1] = gx; /* d gy / d delta_m */
       }
     }
@@ -193,7 +195,8 @@ static km_status closure_nodes(const km_pp *kp, const km_pp *tp, double h,
         return KM_ECANCELLED;
       }
       for (int c = 0; c < chunks; c++) {
-        double ca = lo + (hi - lo) * c / chunks, cb = lo + (hi - lo) * (c + 1) / chunks;
+        double ca = lo + (hi - lo) * c / chunks,
+               cb = lo + (hi - lo) * (c + 1) / chunks;
         double mid = 0.5 * (ca + cb), hw = 0.5 * (cb - ca);
         if (n + 8 > cap) {
           cap = cap ? 2 * cap : 1024;
@@ -212,7 +215,8 @@ static km_status closure_nodes(const km_pp *kp, const km_pp *tp, double h,
           double s = mid + hw * km__gl8_x[k];
           q[n].s = s;
           q[n].w = hw * km__gl8_w[k];
-          q[n].theta = km__bern_eval(tp->c + i * (size_t)(dt + 1), dt, (s - a) / len);
+          q[n].theta =
+              km__bern_eval(tp->c + i * (size_t)(dt + 1), dt, (s - a) / len);
           n++;
         }
       }
@@ -275,9 +279,9 @@ static km_status turn_corners(const km_signature *sig, const double *delta,
     cs[k] = sig->corners[k];
     if (cs[k].s > 0 && cs[k].s < L) cs[k].turn += delta[m++];
   }
-  km_status st = km_signature_create(out, L, sig->start, sig->angle,
-                                     &sig->kappa, cs, sig->ncorners,
-                                     sig->closed, err);
+  km_status st =
+      km_signature_create(out, L, sig->start, sig->angle, &sig->kappa, cs,
+                          sig->ncorners, sig->closed, err);
   km__free(cs);
   return st;
 }
@@ -406,9 +410,8 @@ done:
 
 /* The closure by the corners, else by psi (see the DESIGN note). */
 km_status km__close_lsq(const km_signature *sig, bool by_corners,
-                        const double *weights, km_signature *out,
-                        double *gap0, bool *used_corners, km__poll *poll,
-                        km_error *err) {
+                        const double *weights, km_signature *out, double *gap0,
+                        bool *used_corners, km__poll *poll, km_error *err) {
   double L = sig->length, c[NF] = {0};
   km_pp kp, tp;
   km__pp_init(&kp);
@@ -474,7 +477,8 @@ void km__close_polygon(km_curve *c, km_closure how) {
     km_curve_eval(c, t0, 2, d);
     double k0 = (d[1][0] * d[2][1] - d[1][1] * d[2][0]) /
                 pow(hypot(d[1][0], d[1][1]), 3);
-    double tx = P[2 * n] - P[2 * (n - 1)], ty = P[2 * n + 1] - P[2 * (n - 1) + 1];
+    double tx = P[2 * n] - P[2 * (n - 1)],
+           ty = P[2 * n + 1] - P[2 * (n - 1) + 1];
     double tn = hypot(tx, ty);
     if (tn > 0) {
       double N[2] = {-ty / tn, tx / tn};
@@ -511,7 +515,8 @@ static void interval_max(const km_fn *kappa, double L, double *out) {
     if (!(w > 0)) continue;
     int iv0 = (int)floor(a / h), iv1 = (int)floor(b / h);
     for (int iv = iv0 < 0 ? 0 : iv0; iv <= iv1 && iv < NB; iv++) {
-      double lo = fmax(a, iv * h), hi = fmin(b, (iv + 1) * h), r[KM_MAX_FN_DEGREE + 2];
+      double lo = fmax(a, iv * h), hi = fmin(b, (iv + 1) * h),
+             r[KM_MAX_FN_DEGREE + 2];
       if (!(hi > lo)) continue;
       km__bern_restrict(c, d, (lo - a) / w, (hi - a) / w, r);
       out[iv] = fmax(out[iv], km__bern_abs_bound(r, d));
@@ -531,13 +536,14 @@ static void interval_max(const km_fn *kappa, double L, double *out) {
  * where the curvature changes moves. Frames without matches change too
  * little to need this (and their planned form must agree with this one). */
 km_status km__close_within_bound(const km_morph *m, const km_signature *blended,
-                                    km_signature *out, double *gap,
-                                    km__poll *poll, km_error *err) {
+                                 km_signature *out, double *gap, km__poll *poll,
+                                 km_error *err) {
   bool used = false;
-  km_status st = km__close_lsq(blended, m->close_by_corners, NULL, out, gap, &used,
-                           poll, err);
+  km_status st = km__close_lsq(blended, m->close_by_corners, NULL, out, gap,
+                               &used, poll, err);
   double bound = m->kmax * (1 + 1e-9);
-  if (st || used || m->nuser == 0 || km_signature_max_abs_kappa(out) <= bound) return st;
+  if (st || used || m->nuser == 0 || km_signature_max_abs_kappa(out) <= bound)
+    return st;
   double w[NB], kb[NB], best = km_signature_max_abs_kappa(out);
   interval_max(&blended->kappa, blended->length, kb);
   for (int iv = 0; iv < NB; iv++) {
@@ -548,7 +554,8 @@ km_status km__close_within_bound(const km_morph *m, const km_signature *blended,
     km_signature trial;
     double g;
     km_signature_init(&trial);
-    if (km__close_lsq(blended, false, w, &trial, &g, NULL, poll, NULL) != KM_OK) break;
+    if (km__close_lsq(blended, false, w, &trial, &g, NULL, poll, NULL) != KM_OK)
+      break;
     double k = km_signature_max_abs_kappa(&trial);
     interval_max(&trial.kappa, trial.length, kb);
     for (int iv = 0; iv < NB; iv++)
@@ -568,4 +575,3 @@ km_status km__close_within_bound(const km_morph *m, const km_signature *blended,
   }
   return KM_OK; /* the closed frame nearest to the bound */
 }
-

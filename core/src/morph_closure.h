@@ -62,16 +62,14 @@ km_status km__close_by_corners(const double *S, const double *tau, size_t nc,
  * when poll says stop; KM_ENOMEM, KM_ELIMIT (too many quadrature nodes)
  * and KM_ENOCONVERGE (err); the statuses of km_signature_create. */
 km_status km__close_lsq(const km_signature *sig, bool by_corners,
-                        const double *weights, km_signature *out,
-                        double *gap0, bool *used_corners, km__poll *poll,
-                        km_error *err);
+                        const double *weights, km_signature *out, double *gap0,
+                        bool *used_corners, km__poll *poll, km_error *err);
 /* km__close_lsq of a blended frame of m (with m's closure by corners),
  * kept within the inputs' largest |kappa| where the least change would
  * cross it; statuses as km__close_lsq. */
-km_status km__close_within_bound(const km_morph *m,
-                                 const km_signature *blended,
-                                 km_signature *out, double *gap,
-                                 km__poll *poll, km_error *err);
+km_status km__close_within_bound(const km_morph *m, const km_signature *blended,
+                                 km_signature *out, double *gap, km__poll *poll,
+                                 km_error *err);
 /* The paper's corrections of the control polygon (section 3.2) of a
  * curve whose ends miss each other: c0 spreads the gap over the points,
  * c1 also matches the end tangents, g2 also the end curvatures. c is

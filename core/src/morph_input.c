@@ -17,7 +17,8 @@
 #include "km/reconstruct.h"
 #include "morph_internal.h"
 
-#define ALIGN_N KM__TABLE_N /* samples of theta for start alignment: its
+#define ALIGN_N                                                                \
+  KM__TABLE_N /* samples of theta for start alignment: its
                              * shifts then land on table points (see
                              * km__input_rotate_start) */
 
@@ -29,10 +30,10 @@ void km__input_free(km__input *in) {
 }
 
 km_status km__input_ensure_curve(km__input *in, double tol, size_t max_points,
-                              km__poll *poll, km_error *err) {
+                                 km__poll *poll, km_error *err) {
   if (in->has_curve) return KM_OK;
-  km_status st = km__reconstruct(&in->sig, 3, tol, max_points, poll,
-                                 &in->curve, NULL, NULL, err);
+  km_status st = km__reconstruct(&in->sig, 3, tol, max_points, poll, &in->curve,
+                                 NULL, NULL, err);
   if (!st) in->has_curve = true;
   return st;
 }
@@ -42,8 +43,8 @@ km_status km__input_ensure_curve(km__input *in, double tol, size_t max_points,
  * at most 0.25 rad: its error bound K_4 h^9 max|f^(8)| is then about 1e-14
  * of the chunk's length, ample for placement targets at a fraction of the
  * work. */
-static void table_step(const double *tc, int d, double h, double u0,
-                       double u1, double kbound, double out[2]) {
+static void table_step(const double *tc, int d, double h, double u0, double u1,
+                       double kbound, double out[2]) {
   static const double X[4] = {-0.86113631159405258, -0.33998104358485626,
                               0.33998104358485626, 0.86113631159405258};
   static const double W[4] = {0.34785484513745386, 0.65214515486254614,
@@ -88,9 +89,11 @@ static km_status input_tables(km__input *in, bool keep_table, km__poll *poll) {
       double e = fmin(s, b);
       double u0 = (s_prev - a) / h, u1 = (e - a) / h;
       if (u1 > u0) {
-        double kb = km__bern_abs_bound(in->kappa.c + piece * (size_t)(dk + 1), dk);
+        double kb =
+            km__bern_abs_bound(in->kappa.c + piece * (size_t)(dk + 1), dk);
         double d[2];
-        table_step(in->theta.c + piece * (size_t)(dt + 1), dt, h, u0, u1, kb, d);
+        table_step(in->theta.c + piece * (size_t)(dt + 1), dt, h, u0, u1, kb,
+                   d);
         x += d[0];
         y += d[1];
         /* four nodes a chunk of a quarter radian (table_step) */
@@ -98,8 +101,10 @@ static km_status input_tables(km__input *in, bool keep_table, km__poll *poll) {
           return KM_ECANCELLED;
       }
       s_prev = e;
-      if (e >= b && piece + 1 < in->theta.m) piece++;
-      else if (e >= b) break;
+      if (e >= b && piece + 1 < in->theta.m)
+        piece++;
+      else if (e >= b)
+        break;
     }
     in->table[j][0] = x;
     in->table[j][1] = y;
@@ -134,7 +139,6 @@ double km__input_theta_at(const km__input *in, double s) {
   if (u > 1) u = 1;
   return km__bern_eval(in->theta.c + i * (size_t)(dt + 1), dt, u);
 }
-
 
 /* The signature of the same closed curve started at arc length s0: kappa
  * and the corners shifted cyclically (the seam's corner becomes an interior
@@ -176,8 +180,8 @@ static km_status rotate_signature(const km__input *in, double s0,
   if (n > 1) qsort(cs, n, sizeof *cs, km__cmp_corner);
   st = km__pp_to_fn(&kf, &kr);
   if (st) goto done;
-  st = km_signature_create(out, L, start, km__input_theta_at(in, s0), &kf, cs, n, true,
-                           err);
+  st = km_signature_create(out, L, start, km__input_theta_at(in, s0), &kf, cs,
+                           n, true, err);
 done:
   if (st == KM_ENOMEM) km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
   km_fn_free(&kf);
@@ -245,7 +249,7 @@ done:
 
 /* Closed input starting at arc length s0 instead of 0. */
 km_status km__input_rotate_start(km__input *in, double s0, km__poll *poll,
-                              km_error *err) {
+                                 km_error *err) {
   double L = in->sig.length;
   if (!(s0 > 1e-12 * L) || !(s0 < L - 1e-12 * L)) return KM_OK;
   km_status st = in->has_curve ? rotate_curve(in, s0, err) : KM_OK;
@@ -314,8 +318,8 @@ static km_status reverse_signature(const km_signature *sig, km_signature *out,
   km_fn_init(&kr);
   km_status st = km_fn_create(&kr, f->degree, n, knots, coef, err);
   if (!st)
-    st = km_signature_create(out, L, start, km__wrap_angle(end_angle + KM_PI), &kr,
-                             cr, m, sig->closed, err);
+    st = km_signature_create(out, L, start, km__wrap_angle(end_angle + KM_PI),
+                             &kr, cr, m, sig->closed, err);
   km_fn_free(&kr);
   km__free(buf);
   return st;
@@ -409,8 +413,10 @@ static void shift_costs(shift_work *w, double T) {
   km__fft(xr, xi, N, w->tw, false);
   km__fft(yr, yi, N, w->tw, false);
   for (int m = 0; m < N; m++) {
-    double r1 = ar[m] * br[m] + ai[m] * bi[m], i1 = ar[m] * bi[m] - ai[m] * br[m];
-    double r2 = xr[m] * yr[m] + xi[m] * yi[m], i2 = xr[m] * yi[m] - xi[m] * yr[m];
+    double r1 = ar[m] * br[m] + ai[m] * bi[m],
+           i1 = ar[m] * bi[m] - ai[m] * br[m];
+    double r2 = xr[m] * yr[m] + xi[m] * yi[m],
+           i2 = xr[m] * yi[m] - xi[m] * yr[m];
     ar[m] = r1;
     ai[m] = i1;
     xr[m] = r2;
@@ -458,14 +464,14 @@ static size_t deepest_minima(const double *cost, double *cand) {
  * (tb' continued by the total turning past the end), expands into sums of
  * squares, prefix sums and the cyclic correlations sum_j ta_j tb_(j+k) and
  * sum_j pa_j . pb_(j+k), which the FFT gives for all k at once. */
-km_status km__best_shifts(const km__input *a, const km__input *b,
-                          double *cand, size_t *n) {
+km_status km__best_shifts(const km__input *a, const km__input *b, double *cand,
+                          size_t *n) {
   enum { N = ALIGN_N };
   double *buf = km__malloc(14 * (size_t)N * sizeof(double));
   if (!buf) return KM_ENOMEM;
-  shift_work w = {buf,          buf + N,      buf + 2 * N,  buf + 3 * N,
-                  buf + 4 * N,  buf + 5 * N,  buf + 6 * N,  buf + 7 * N,
-                  buf + 8 * N,  buf + 9 * N,  buf + 10 * N, buf + 11 * N,
+  shift_work w = {buf,          buf + N,      buf + 2 * N,       buf + 3 * N,
+                  buf + 4 * N,  buf + 5 * N,  buf + 6 * N,       buf + 7 * N,
+                  buf + 8 * N,  buf + 9 * N,  buf + 10 * N,      buf + 11 * N,
                   buf + 12 * N, buf + 13 * N, {0, 0, 0, 0, 0, 0}};
   shift_samples(a, b, &w);
   shift_costs(&w, b->sig.turning);
@@ -477,7 +483,7 @@ km_status km__best_shifts(const km__input *a, const km__input *b,
 /* An input's copy, signature and tables; a signature computed from its
  * curve is held to tol, or without one to 1e-6 of its own length. */
 km_status km__input_prepare(km__input *in, const km_morph_input *src,
-                               double tol, km__poll *poll, km_error *err) {
+                            double tol, km__poll *poll, km_error *err) {
   memset(in, 0, sizeof *in);
   km_curve_init(&in->curve);
   km_signature_init(&in->sig);
@@ -511,7 +517,8 @@ km_status km__input_copy(km__input *out, const km__input *in, km_error *err) {
   memcpy(out->table, in->table, sizeof out->table);
   memcpy(out->centroid, in->centroid, sizeof out->centroid);
   out->has_curve = in->has_curve;
-  km_status st = in->has_curve ? km_curve_copy(&out->curve, &in->curve, err) : KM_OK;
+  km_status st =
+      in->has_curve ? km_curve_copy(&out->curve, &in->curve, err) : KM_OK;
   if (!st) st = km_signature_copy(&out->sig, &in->sig, err);
   if (!st) st = pp_copy(&out->kappa, &in->kappa);
   if (!st) st = pp_copy(&out->theta, &in->theta);
@@ -544,4 +551,3 @@ int km__cmp_corner(const void *x, const void *y) {
   double a = ((const km_corner *)x)->s, b = ((const km_corner *)y)->s;
   return (a > b) - (a < b);
 }
-

@@ -33,7 +33,7 @@ typedef struct km__input {
   km_curve curve;
   bool has_curve;
   km_signature sig;
-  km_pp kappa, theta; /* theta pieces in s */
+  km_pp kappa, theta;               /* theta pieces in s */
   double table[KM__TABLE_N + 1][2]; /* positions at s = L j / KM__TABLE_N */
   double centroid[2];
 } km__input;
@@ -45,9 +45,9 @@ struct km_morph {
   km__input in[2];
   double *ra, *rb; /* correspondence knots, nm+2 of them incl. 0 and 1 */
   size_t nk;
-  size_t nuser;    /* match pairs reported */
-  km_curve lin[2]; /* compatible curves (linear method) */
-  km__frame_plan *plan; /* frames planned once (morph_plan.c), or NULL */
+  size_t nuser;          /* match pairs reported */
+  km_curve lin[2];       /* compatible curves (linear method) */
+  km__frame_plan *plan;  /* frames planned once (morph_plan.c), or NULL */
   bool close_by_corners; /* lsq closure by the frames' corners */
   double kmax;           /* the inputs' largest |kappa|: the frames' bound */
   /* placement targets of planned frames: the inputs' points at the plan's
@@ -96,8 +96,8 @@ double km__input_theta_at(const km__input *in, double s);
 /* Fills cand[] with up to KM__SHIFT_CANDIDATES starts of b (fractions of
  * its length), best aligned with a first, and *n (out) with how many (at
  * least one). KM_OK or KM_ENOMEM (then nothing written). */
-km_status km__best_shifts(const km__input *a, const km__input *b,
-                          double *cand, size_t *n);
+km_status km__best_shifts(const km__input *a, const km__input *b, double *cand,
+                          size_t *n);
 
 /* Pieces of p restricted to [x0, x1] (x0 < x1, inside p's breaks) into
  * *out (initialised, empty; the caller frees it). KM_ENOMEM, no message. */

@@ -18,8 +18,8 @@ static double curve_kappa(const km_curve *c, double t, double *speed) {
 
 /* Metrics of a curve measured directly (linear frames may have cusps, so
  * no signature is assumed): dense Gauss-Legendre per span. */
-static km_status curve_metrics(const km_curve *c, double tol,
-                               km__poll *poll, km_frame_metrics *mt) {
+static km_status curve_metrics(const km_curve *c, double tol, km__poll *poll,
+                               km_frame_metrics *mt) {
   double L = 0.0, kmax = 0.0, bend = 0.0;
   for (size_t i = (size_t)c->degree; i < c->n; i++) {
     double a = c->knots[i], b = c->knots[i + 1];
@@ -46,17 +46,18 @@ static km_status curve_metrics(const km_curve *c, double tol,
   mt->closure_gap = 0.0;
   /* -1 for a valid curve: stopped (the caller reports it) or no memory */
   return mt->self_intersections < 0 && !(poll && poll->stopped) ? KM_ENOMEM
-                                                                 : KM_OK;
+                                                                : KM_OK;
 }
 
 km_status km__linear_frame(const km_morph *m, double t, km_curve *out,
-                              km_frame_metrics *metrics, km_signature *sig_out,
-                              km__poll *poll, km_error *err) {
+                           km_frame_metrics *metrics, km_signature *sig_out,
+                           km__poll *poll, km_error *err) {
   const km_curve *a = &m->lin[0], *b = &m->lin[1];
   km_curve f;
   km_status st = km_curve_copy(&f, a, err);
   if (st) return st;
-  for (size_t i = 0; i < 2 * f.n; i++) f.cp[i] = (1 - t) * a->cp[i] + t * b->cp[i];
+  for (size_t i = 0; i < 2 * f.n; i++)
+    f.cp[i] = (1 - t) * a->cp[i] + t * b->cp[i];
   if (f.w)
     for (size_t i = 0; i < f.n; i++) f.w[i] = (1 - t) * a->w[i] + t * b->w[i];
   f.closed = a->closed && b->closed;
@@ -82,4 +83,3 @@ km_status km__linear_frame(const km_morph *m, double t, km_curve *out,
   *out = f;
   return KM_OK;
 }
-

@@ -61,7 +61,7 @@ static size_t find_features(const km__input *in, feature *f, size_t cap) {
 /* Align feature sequences by dynamic programming (longest-path over pairs
  * with a score for like turning and a penalty for drift in r). */
 size_t km__auto_matches(const km__input *a, const km__input *b, double *pairs,
-                           size_t cap) {
+                        size_t cap) {
   enum { F = 64 };
   feature fa[F], fb[F];
   size_t na = find_features(a, fa, F), nb = find_features(b, fb, F);
@@ -126,4 +126,3 @@ size_t km__auto_matches(const km__input *a, const km__input *b, double *pairs,
   }
   return m;
 }
-

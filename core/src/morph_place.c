@@ -26,10 +26,12 @@ km_status km__place_plan_targets(km_morph *m, km_error *err) {
   size_t nb = km__frame_plan_pieces(m->plan) + 1;
   const double *x = km__frame_plan_breaks(m->plan);
   m->place_ab = km__malloc(nb * sizeof *m->place_ab);
-  if (!m->place_ab) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  if (!m->place_ab)
+    return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   double W = 0.0, qa[2] = {0, 0}, qb[2] = {0, 0};
   for (size_t k = 0; k < nb; k++) {
-    double w = 0.5 * ((k + 1 < nb ? x[k + 1] : x[k]) - (k > 0 ? x[k - 1] : x[k]));
+    double w =
+        0.5 * ((k + 1 < nb ? x[k + 1] : x[k]) - (k > 0 ? x[k - 1] : x[k]));
     m->place_ab[k][4] = w;
     km__input_point_at(&m->in[0], x[k], m->place_ab[k]);
     km__input_point_at(&m->in[1], x[k], m->place_ab[k] + 2);
@@ -81,7 +83,7 @@ static km_status place_samples(const km_morph *m, double t,
   if (t == 0.0 || t == 1.0 || m->opt.anchor == KM_ANCHOR_START || n == 0)
     return KM_OK;
   double fc[2] = {0, 0}, qc[2] = {0, 0}, W = 0.0;
-  double (*Q)[2] = km__malloc(n * sizeof *Q);
+  double(*Q)[2] = km__malloc(n * sizeof *Q);
   if (!Q) return KM_ENOMEM;
   for (size_t j = 0; j < n; j++) {
     double ra, rb, pa[2], pb[2];
@@ -106,7 +108,7 @@ static km_status place_samples(const km_morph *m, double t,
     T[0] = (1 - t) * a->centroid[0] + t * b->centroid[0] - fc[0];
     T[1] = (1 - t) * a->centroid[1] + t * b->centroid[1] - fc[1];
   } else {
-    procrustes(F, (const double (*)[2])Q, w, n, fc, qc, rot, T);
+    procrustes(F, (const double(*)[2])Q, w, n, fc, qc, rot, T);
   }
   km__free(Q);
   return KM_OK;
@@ -117,7 +119,7 @@ static km_status place_samples(const km_morph *m, double t,
 km_status km__place_frame(const km_morph *m, double t, const km_curve *f,
                           double Lt, double *rot, double T[2]) {
   static const size_t N = FIT_N;
-  double (*F)[2] = km__malloc(N * sizeof *F);
+  double(*F)[2] = km__malloc(N * sizeof *F);
   double *s = km__malloc(2 * N * sizeof(double));
   double *w = s ? s + N : NULL;
   km_status st = KM_ENOMEM;
@@ -130,7 +132,7 @@ km_status km__place_frame(const km_morph *m, double t, const km_curve *f,
     F[j][0] = d[0][0];
     F[j][1] = d[0][1];
   }
-  st = place_samples(m, t, (const double (*)[2])F, s, w, N, rot, T);
+  st = place_samples(m, t, (const double(*)[2])F, s, w, N, rot, T);
 done:
   km__free(F);
   km__free(s);
@@ -141,7 +143,7 @@ done:
  * breaks: the targets Q_k = (1 - t) A_k + t B_k are linear in t, so the
  * fit's sums split into a part of each input. */
 void km__place_planned(const km_morph *m, double t, const double (*F)[2],
-                              size_t nb, double *rot, double T[2]) {
+                       size_t nb, double *rot, double T[2]) {
   const km__input *a = &m->in[0], *b = &m->in[1];
   *rot = 0.0;
   T[0] = (1 - t) * a->sig.start[0] + t * b->sig.start[0];
@@ -177,4 +179,3 @@ void km__place_planned(const km_morph *m, double t, const double (*F)[2],
   T[0] = qc[0] - (cr * fc[0] - sr * fc[1]);
   T[1] = qc[1] - (sr * fc[0] + cr * fc[1]);
 }
-

@@ -33,10 +33,10 @@
 #include "morph_plan.h"
 #include "morph_plan_internal.h"
 
-#define MAX_RULE 8      /* highest Gauss-Legendre order used */
+#define MAX_RULE 8 /* highest Gauss-Legendre order used */
 #define NDER (2 * MAX_RULE)
-#define MERGE_DEGREE 7   /* of theta on merged input pieces */
-#define MERGE_SHARE 0.1  /* of the tolerance, for merging them */
+#define MERGE_DEGREE 7  /* of theta on merged input pieces */
+#define MERGE_SHARE 0.1 /* of the tolerance, for merging them */
 
 /* ---- small numerics ---------------------------------------------------- */
 
@@ -86,7 +86,6 @@ static void bell(const double *x, int mmax, double *B) {
     B[m + 1] = s;
   }
 }
-
 
 /* The closure basis at r: first index (-3 .. NF - 1) and four values,
  * zero for indices outside 0 .. NF - 1. */
@@ -142,7 +141,8 @@ static size_t side_piece_at(const side *sd, double r, int side_dir, double *u) {
    * length it may miss that break by a rounding unit either way */
   double x = r * sd->L, eps = 1e-12 * sd->L;
   size_t i = km__pp_find(sd->theta, x);
-  if (side_dir > 0 && i + 1 < sd->theta->m && x >= sd->theta->x[i + 1] - eps) i++;
+  if (side_dir > 0 && i + 1 < sd->theta->m && x >= sd->theta->x[i + 1] - eps)
+    i++;
   if (side_dir < 0 && i > 0 && x <= sd->theta->x[i] + eps) i--;
   double a = sd->theta->x[i], h = sd->theta->x[i + 1] - a;
   *u = fmin(fmax((r * sd->L - a) / h, 0.0), 1.0);
@@ -181,11 +181,11 @@ static double side_angle(const side *sd, double r, int side_dir) {
 /* An atom: a stretch of r inside one piece of each input. */
 typedef struct atom {
   double x0, x1;
-  double m4;    /* max |C''''(r)| / L over the atom */
+  double m4;     /* max |C''''(r)| / L over the atom */
   double j2, j3; /* jumps of C'', C''' (over L) at x0, bounds for every t */
-  bool corner;  /* theta jumps at x0 */
-  size_t iv;    /* merged interval it lies in */
-  bool whole;   /* it is the whole interval */
+  bool corner;   /* theta jumps at x0 */
+  size_t iv;     /* merged interval it lies in */
+  bool whole;    /* it is the whole interval */
 } atom;
 
 typedef struct vec {
@@ -224,8 +224,8 @@ static void both_bounds(const side sd[2], double r0, double r1, int nd,
  * max(La, Lb)). */
 static km_status plan_interval(vec *atoms, const side sd[2], double r0,
                                double r1, size_t iv, const double *D,
-                               double tolp, double j2, double j3,
-                               bool corner, size_t max_atoms, km__poll *poll) {
+                               double tolp, double j2, double j3, bool corner,
+                               size_t max_atoms, km__poll *poll) {
   double h = r1 - r0, e = pow(h, 4) / 384.0 * m4_of(D);
   int parts = 1;
   if (e > tolp) {
@@ -234,9 +234,11 @@ static km_status plan_interval(vec *atoms, const side sd[2], double r0,
   }
   if (max_atoms > 0 && atoms->n + (size_t)parts > max_atoms) return KM_ELIMIT;
   for (int k = 0; k < parts; k++) {
-    double a = r0 + h * k / parts, b = k + 1 == parts ? r1 : r0 + h * (k + 1) / parts;
-    atom at = {a, b, 0.0, k ? 0.0 : j2, k ? 0.0 : j3, k ? false : corner, iv,
-               parts == 1};
+    double a = r0 + h * k / parts,
+           b = k + 1 == parts ? r1 : r0 + h * (k + 1) / parts;
+    atom at = {
+        a,  b,         0.0, k ? 0.0 : j2, k ? 0.0 : j3, k ? false : corner,
+        iv, parts == 1};
     double Dk[4];
     if (parts > 1)
       both_bounds(sd, a, b, 3, Dk);
@@ -272,12 +274,12 @@ typedef struct builder {
   km_pp mt[2], mk[2]; /* the inputs' theta pieces merged, and their kappa */
   side sd[2];
   gl_rules *g;
-  double Lmax;        /* the longer input: tolerances below are over it */
-  double *br;         /* m merged breaks of both inputs in r */
+  double Lmax; /* the longer input: tolerances below are over it */
+  double *br;  /* m merged breaks of both inputs in r */
   size_t m;
-  double *Dall;       /* bounds on theta's derivatives per merged interval */
+  double *Dall; /* bounds on theta's derivatives per merged interval */
   vec atoms, nodes;
-  size_t *start;      /* first atom of each output piece, np + 1 */
+  size_t *start; /* first atom of each output piece, np + 1 */
 } builder;
 
 static void builder_free(builder *b) {
@@ -323,7 +325,8 @@ static km_status merged_breaks(builder *b, const double length[2],
   double *br = b->br = km__malloc(nbr * sizeof(double));
   if (!br) return KM_ENOMEM;
   for (int w = 0; w < 2; w++)
-    for (size_t i = 0; i <= b->mt[w].m; i++) br[q++] = b->mt[w].x[i] / length[w];
+    for (size_t i = 0; i <= b->mt[w].m; i++)
+      br[q++] = b->mt[w].x[i] / length[w];
   qsort(br, q, sizeof(double), km__cmp_double);
   for (size_t i = 0; i < q; i++) {
     double v = fmin(fmax(br[i], 0.0), 1.0);
@@ -349,7 +352,8 @@ static km_status merged_breaks(builder *b, const double length[2],
  * every t, and whether theta jumps there. */
 static void break_jumps(const builder *b, size_t i, double *j2, double *j3,
                         bool *corner) {
-  const double *Dl = b->Dall + (i - 1) * (NDER + 1), *Dr = b->Dall + i * (NDER + 1);
+  const double *Dl = b->Dall + (i - 1) * (NDER + 1),
+               *Dr = b->Dall + i * (NDER + 1);
   double D1 = fmax(Dl[1], Dr[1]);
   for (int w = 0; w < 2; w++) {
     double vl[3], vr[3];
@@ -371,8 +375,8 @@ static km_status make_atoms(builder *b, double tolp, size_t max_pieces,
     bool corner = false;
     if (i > 0) break_jumps(b, i, &j2, &j3, &corner);
     km_status st = plan_interval(&b->atoms, b->sd, b->br[i], b->br[i + 1], i,
-                                 b->Dall + i * (NDER + 1), tolp, j2, j3,
-                                 corner, 2 * max_pieces, poll);
+                                 b->Dall + i * (NDER + 1), tolp, j2, j3, corner,
+                                 2 * max_pieces, poll);
     if (st) return st;
   }
   return KM_OK;
@@ -513,7 +517,8 @@ static km_status plan_nodes(builder *b, km__frame_plan *p, double tol,
  * the basis functions' integrals; the corners. */
 static void break_tables(const builder *b, km__frame_plan *p) {
   size_t np = p->np;
-  for (size_t k = 0; k <= np; k++) basis_at(p->x[k], &p->at_break[k].bi, p->at_break[k].bv);
+  for (size_t k = 0; k <= np; k++)
+    basis_at(p->x[k], &p->at_break[k].bi, p->at_break[k].bv);
   for (size_t j = 0; j < p->nn; j++) {
     const gnode *N = &p->node[j];
     for (int q = 0; q < 4; q++)
@@ -538,18 +543,19 @@ static void break_tables(const builder *b, km__frame_plan *p) {
 static km_status choose_corner_closure(km__frame_plan *p, km__poll *poll) {
   size_t nc = p->ncorners, np = p->np;
   if (nc < 3) return KM_OK;
-  double *buf =
-      km__malloc((km__plan_frame_scratch(p) + 4 * nc + 2 + np) * sizeof(double));
+  double *buf = km__malloc((km__plan_frame_scratch(p) + 4 * nc + 2 + np) *
+                           sizeof(double));
   if (!buf) return KM_ENOMEM;
-  double *tau = buf + km__plan_frame_scratch(p), *delta = tau + nc, *S = delta + nc;
+  double *tau = buf + km__plan_frame_scratch(p), *delta = tau + nc,
+         *S = delta + nc;
   double *dp = S + 2 * (nc + 1), c0[NF] = {0};
   km_status st = KM_OK;
   p->by_corners = true;
   for (int k = 1; k <= 3 && p->by_corners && !st; k++) {
     /* a trial frame that does not close smoothly (or is stopped) rules
      * the corners out; only running out of memory fails the morph */
-    p->by_corners = km__plan_close_frame(p, k / 4.0, 0.0, false, false, c0,
-                                         buf, buf + 2 * np, poll) == KM_OK;
+    p->by_corners = km__plan_close_frame(p, k / 4.0, 0.0, false, false, c0, buf,
+                                         buf + 2 * np, poll) == KM_OK;
     if (p->by_corners)
       st = km__plan_corner_closure(p, k / 4.0, buf, tau, delta, S, dp,
                                    &p->by_corners);
@@ -590,10 +596,10 @@ static km_status warm_corrections(km__frame_plan *p, km__poll *poll) {
 
 /* ---- planning ---------------------------------------------------------- */
 
-km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const double length[2],
-                               const double angle[2], bool closed, double tol,
-                               size_t max_pieces, km__poll *poll,
-                               km_error *err) {
+km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2],
+                               const double length[2], const double angle[2],
+                               bool closed, double tol, size_t max_pieces,
+                               km__poll *poll, km_error *err) {
   builder b;
   memset(&b, 0, sizeof b);
   for (int w = 0; w < 2; w++) {
@@ -647,13 +653,20 @@ done:
                                   : NULL);
 }
 
-size_t km__frame_plan_pieces(const km__frame_plan *p) { return p->np; }
-size_t km__frame_plan_nodes(const km__frame_plan *p) { return p->nn; }
+size_t km__frame_plan_pieces(const km__frame_plan *p) {
+  return p->np;
+}
+size_t km__frame_plan_nodes(const km__frame_plan *p) {
+  return p->nn;
+}
 size_t km__frame_plan_points(const km__frame_plan *p) {
   size_t ncorner = 0;
   for (size_t k = 1; k < p->np; k++) ncorner += p->corner[k];
   return 2 * p->np + 2 + ncorner; /* as km__frame_plan_curve builds them */
 }
-const double *km__frame_plan_breaks(const km__frame_plan *p) { return p->x; }
-bool km__frame_plan_by_corners(const km__frame_plan *p) { return p->by_corners; }
-
+const double *km__frame_plan_breaks(const km__frame_plan *p) {
+  return p->x;
+}
+bool km__frame_plan_by_corners(const km__frame_plan *p) {
+  return p->by_corners;
+}

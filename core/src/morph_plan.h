@@ -24,10 +24,10 @@ typedef struct km__frame_plan km__frame_plan;
  * a frame (0: no bound but memory) fails with KM_ELIMIT, early: the
  * uniform splits are refused past twice that before their bounds are
  * taken. Stops (KM_ECANCELLED) when poll says so (NULL: never). */
-km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2], const double length[2],
-                               const double angle[2], bool closed, double tol,
-                               size_t max_pieces, km__poll *poll,
-                               km_error *err);
+km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2],
+                               const double length[2], const double angle[2],
+                               bool closed, double tol, size_t max_pieces,
+                               km__poll *poll, km_error *err);
 void km__frame_plan_free(km__frame_plan *p);
 size_t km__frame_plan_pieces(const km__frame_plan *p);
 size_t km__frame_plan_nodes(const km__frame_plan *p);
@@ -45,8 +45,8 @@ bool km__frame_plan_by_corners(const km__frame_plan *p);
  * its gap is within the tolerance. ends (optional, 2 (pieces + 1) values)
  * receives the pieces' end points. Stops (KM_ECANCELLED) when poll says so
  * (NULL: never). */
-km_status km__frame_plan_curve(const km__frame_plan *p, double t,
-                               double theta0, bool close_lsq, km_curve *out,
-                               double *ends, km__poll *poll, km_error *err);
+km_status km__frame_plan_curve(const km__frame_plan *p, double t, double theta0,
+                               bool close_lsq, km_curve *out, double *ends,
+                               km__poll *poll, km_error *err);
 
 #endif

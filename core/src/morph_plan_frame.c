@@ -22,7 +22,6 @@
  * over the nodes) */
 #define CLOSED_GAP 1e-10
 
-
 /* psi at break k, from the basis values there (computed once per plan). */
 static double psi_at_break(const km__frame_plan *p, const double *c, size_t k) {
   const gnode *b = &p->at_break[k];
@@ -48,10 +47,14 @@ static inline void exp_i_small(double d, double *cs, double *sn) {
   /* reciprocals, not divisions: a division takes some 15 cycles, and
    * these run at every node of every pass */
   double d2 = d * d;
-  *cs = 1 - d2 * 0.5 * (1 - d2 * (1.0 / 12) * (1 - d2 * (1.0 / 30) *
-        (1 - d2 * (1.0 / 56) * (1 - d2 * (1.0 / 90)))));
-  *sn = d * (1 - d2 * (1.0 / 6) * (1 - d2 * (1.0 / 20) * (1 - d2 * (1.0 / 42) *
-        (1 - d2 * (1.0 / 72)))));
+  *cs =
+      1 - d2 * 0.5 *
+              (1 - d2 * (1.0 / 12) *
+                       (1 - d2 * (1.0 / 30) *
+                                (1 - d2 * (1.0 / 56) * (1 - d2 * (1.0 / 90)))));
+  *sn = d * (1 - d2 * (1.0 / 6) *
+                     (1 - d2 * (1.0 / 20) *
+                              (1 - d2 * (1.0 / 42) * (1 - d2 * (1.0 / 72)))));
 }
 
 /* e^(i d) for |d| <= 0.01: the series to d^7 (the remainder is below
@@ -59,7 +62,8 @@ static inline void exp_i_small(double d, double *cs, double *sn) {
 static inline void exp_i_tiny(double d, double *cs, double *sn) {
   double d2 = d * d;
   *cs = 1 - d2 * 0.5 * (1 - d2 * (1.0 / 12) * (1 - d2 * (1.0 / 30)));
-  *sn = d * (1 - d2 * (1.0 / 6) * (1 - d2 * (1.0 / 20) * (1 - d2 * (1.0 / 42))));
+  *sn =
+      d * (1 - d2 * (1.0 / 6) * (1 - d2 * (1.0 / 20) * (1 - d2 * (1.0 / 42))));
 }
 
 /* One pass over the nodes: sum[2k], sum[2k+1] = integral over piece k of
@@ -213,8 +217,8 @@ static bool metric_step(double Y[2][NF], const double S[4], const double rhs[2],
  * share of the same bound) and the frame is closed to CLOSED_GAP of its
  * length, as by a further pass. */
 km_status km__plan_close_frame(const km__frame_plan *p, double t, double theta0,
-                             bool close_lsq, bool project, double *c,
-                             double *sum, double *scratch, km__poll *poll) {
+                               bool close_lsq, bool project, double *c,
+                               double *sum, double *scratch, km__poll *poll) {
   double Lt = (1 - t) * p->La + t * p->Lb;
   bool lsq = close_lsq && p->closed;
   double *e = scratch;
@@ -282,7 +286,8 @@ km_status km__plan_corner_closure(const km__frame_plan *p, double t,
   for (size_t k = 0; k < np; k++) {
     if (m < nc && p->corner_at[m] == k) {
       size_t b = p->corner_at[m];
-      tau[m] = (1 - t) * (p->ta_r[b] - p->ta_l[b]) + t * (p->tb_r[b] - p->tb_l[b]);
+      tau[m] =
+          (1 - t) * (p->ta_r[b] - p->ta_l[b]) + t * (p->tb_r[b] - p->tb_l[b]);
       m++;
       S[2 * m] = S[2 * m + 1] = 0.0;
     }
@@ -322,12 +327,13 @@ static void warm_start(const km__frame_plan *p, double t, double *c) {
  * left zero), else by the smooth curvature. c receives psi's
  * coefficients, sum the pieces' integrals (scratch: as
  * km__frame_plan_curve allocates it). */
-static km_status frame_closure(const km__frame_plan *p, double t,
-                               double theta0, bool close_lsq, double *c,
-                               double *sum, double *dp, km__poll *poll) {
+static km_status frame_closure(const km__frame_plan *p, double t, double theta0,
+                               bool close_lsq, double *c, double *sum,
+                               double *dp, km__poll *poll) {
   size_t np = p->np, nc = p->ncorners;
   double *e = sum + 2 * np;
-  double *tau = sum + km__plan_frame_scratch(p), *delta = tau + nc, *S = delta + nc;
+  double *tau = sum + km__plan_frame_scratch(p), *delta = tau + nc,
+         *S = delta + nc;
   bool lsq = close_lsq && p->closed, by_corners = false;
   km_status st = KM_OK;
   for (size_t k = 0; k < np; k++) dp[k] = 0.0;
@@ -417,9 +423,9 @@ static km_status hermite_points(const km__frame_plan *p, double t,
   return KM_OK;
 }
 
-km_status km__frame_plan_curve(const km__frame_plan *p, double t,
-                               double theta0, bool close_lsq, km_curve *out,
-                               double *ends, km__poll *poll, km_error *err) {
+km_status km__frame_plan_curve(const km__frame_plan *p, double t, double theta0,
+                               bool close_lsq, km_curve *out, double *ends,
+                               km__poll *poll, km_error *err) {
   double c[NF] = {0}, P[2];
   /* sums of the pieces, scratch of the nodes, and per corner its turn,
    * its change and the stretch sums; per piece the turn added before it */
@@ -429,8 +435,8 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t,
   const char *msg = "closing the frame did not converge";
   km_curve f;
   km_curve_init(&f);
-  km_status st = frame_closure(p, t, theta0, close_lsq, c, sum, sum + scratch,
-                               poll);
+  km_status st =
+      frame_closure(p, t, theta0, close_lsq, c, sum, sum + scratch, poll);
   if (st == KM_ECANCELLED || (poll && poll->stopped)) {
     st = KM_ECANCELLED;
     goto done;
@@ -455,4 +461,3 @@ done:
   if (st) return km__fail(err, st, KM_FIELD_NONE, -1, NAN, msg);
   return KM_OK;
 }
-

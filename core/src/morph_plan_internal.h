@@ -26,21 +26,22 @@ typedef struct gnode {
 struct km__frame_plan {
   double La, Lb, tol;
   bool closed;
-  size_t np;            /* output pieces */
-  double *x;            /* np + 1 breaks in r */
+  size_t np;             /* output pieces */
+  double *x;             /* np + 1 breaks in r */
   unsigned char *corner; /* np + 1: theta jumps there (C0 junction) */
-  double *ta_l, *ta_r;  /* Ta left / right of each break */
+  double *ta_l, *ta_r;   /* Ta left / right of each break */
   double *tb_l, *tb_r;
-  size_t *first;        /* nodes of piece k: first[k] .. first[k+1] - 1 */
-  double wb[NF];        /* sum over the nodes of w B_i: integral of B_i */
-  gnode *at_break;      /* the closure basis at every break (bi, bv) */
+  size_t *first;   /* nodes of piece k: first[k] .. first[k+1] - 1 */
+  double wb[NF];   /* sum over the nodes of w B_i: integral of B_i */
+  gnode *at_break; /* the closure basis at every break (bi, bv) */
   gnode *node;
   size_t nn;
   double chol[NF * NF]; /* Cholesky factor of the closure metric */
-  double c_at[WARM_POINTS + 1][NF]; /* closure corrections at t = k / WARM_POINTS */
-  size_t *corner_at;    /* breaks (1 .. np - 1) that are corners */
+  double c_at[WARM_POINTS + 1]
+             [NF];   /* closure corrections at t = k / WARM_POINTS */
+  size_t *corner_at; /* breaks (1 .. np - 1) that are corners */
   size_t ncorners;
-  bool by_corners;      /* closed frames close by their corners */
+  bool by_corners; /* closed frames close by their corners */
 };
 
 /* Scratch a frame's closure needs: the pieces' sums (2 per piece) and
@@ -57,10 +58,9 @@ static inline size_t km__plan_frame_scratch(const km__frame_plan *p) {
  * start with the projection onto the linearised constraints (as the kept
  * corrections are found) instead of a step from c. KM_ECANCELLED when poll
  * says stop, KM_ENOCONVERGE; no message (the caller words it). */
-km_status km__plan_close_frame(const km__frame_plan *p, double t,
-                               double theta0, bool close_lsq, bool project,
-                               double *c, double *sum, double *scratch,
-                               km__poll *poll);
+km_status km__plan_close_frame(const km__frame_plan *p, double t, double theta0,
+                               bool close_lsq, bool project, double *c,
+                               double *sum, double *scratch, km__poll *poll);
 /* Closes a frame by its corners (km__close_by_corners) given the pieces'
  * integrals sum (rotated in place when they close it); dp[k] receives the
  * turn added before piece k. Scratch: tau, delta (ncorners each), S (2

@@ -42,8 +42,7 @@ static km_status check_coord(double v, long idx, km_error *err) {
                     "coordinate is not finite");
   if (fabs(v) > KM_MAX_COORDINATE)
     return km__fail(err, KM_ERANGE, KM_FIELD_CONTROL_POINTS, idx, NAN,
-                    "coordinate %g exceeds the limit %g", v,
-                    KM_MAX_COORDINATE);
+                    "coordinate %g exceeds the limit %g", v, KM_MAX_COORDINATE);
   return KM_OK;
 }
 
@@ -72,8 +71,7 @@ static km_status push(km_path *p, const km_path_piece *pc, km_error *err) {
     if (cap > KM_MAX_PIECES) cap = KM_MAX_PIECES;
     if (p->npieces >= cap)
       return km__fail(err, KM_ELIMIT, KM_FIELD_NONE, -1, NAN,
-                      "path has more than %zu pieces",
-                      (size_t)KM_MAX_PIECES);
+                      "path has more than %zu pieces", (size_t)KM_MAX_PIECES);
     km_path_piece *np = km__realloc(p->pieces, cap * sizeof *np);
     if (!np) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
     p->pieces = np;
@@ -127,8 +125,8 @@ km_status km_path_line_to(km_path *p, double x, double y, km_error *err) {
   return poly_to(p, 1, v, err);
 }
 
-km_status km_path_quad_to(km_path *p, double x1, double y1, double x,
-                          double y, km_error *err) {
+km_status km_path_quad_to(km_path *p, double x1, double y1, double x, double y,
+                          km_error *err) {
   double v[4] = {x1, y1, x, y};
   return poly_to(p, 2, v, err);
 }
@@ -193,8 +191,10 @@ static km_status arc_to_centre(double x1, double y1, double rx, double ry,
   double vx = (-x1p - cxp) / rx, vy = (-y1p - cyp) / ry;
   double theta1 = atan2(uy, ux);
   double dtheta = vec_angle(ux, uy, vx, vy);
-  if (!sweep && dtheta > 0) dtheta -= 2.0 * KM_PI;
-  else if (sweep && dtheta < 0) dtheta += 2.0 * KM_PI;
+  if (!sweep && dtheta > 0)
+    dtheta -= 2.0 * KM_PI;
+  else if (sweep && dtheta < 0)
+    dtheta += 2.0 * KM_PI;
   if (!isfinite(cx) || !isfinite(cy) || !isfinite(dtheta))
     return km__fail(err, KM_ERANGE, KM_FIELD_CONTROL_POINTS, 0, NAN,
                     "arc cannot be computed");

@@ -15,7 +15,9 @@
 #include "km/alloc.h"
 #include "km/limits.h"
 
-void km__pp_init(km_pp *p) { memset(p, 0, sizeof *p); }
+void km__pp_init(km_pp *p) {
+  memset(p, 0, sizeof *p);
+}
 
 void km__pp_free(km_pp *p) {
   if (!p) return;
@@ -52,13 +54,22 @@ const double km__binomial[KM_MAX_FN_DEGREE + 2][KM_MAX_FN_DEGREE + 2] = {
     {1, 12, 66, 220, 495, 792, 924, 792, 495, 220, 66, 12, 1},
     {1, 13, 78, 286, 715, 1287, 1716, 1716, 1287, 715, 286, 78, 13, 1},
     {1, 14, 91, 364, 1001, 2002, 3003, 3432, 3003, 2002, 1001, 364, 91, 14, 1},
-    {1, 15, 105, 455, 1365, 3003, 5005, 6435, 6435, 5005, 3003, 1365, 455, 105, 15, 1},
-    {1, 16, 120, 560, 1820, 4368, 8008, 11440, 12870, 11440, 8008, 4368, 1820, 560, 120, 16, 1},
-    {1, 17, 136, 680, 2380, 6188, 12376, 19448, 24310, 24310, 19448, 12376, 6188, 2380, 680, 136, 17, 1},
-    {1, 18, 153, 816, 3060, 8568, 18564, 31824, 43758, 48620, 43758, 31824, 18564, 8568, 3060, 816, 153, 18, 1},
-    {1, 19, 171, 969, 3876, 11628, 27132, 50388, 75582, 92378, 92378, 75582, 50388, 27132, 11628, 3876, 969, 171, 19, 1},
-    {1, 20, 190, 1140, 4845, 15504, 38760, 77520, 125970, 167960, 184756, 167960, 125970, 77520, 38760, 15504, 4845, 1140, 190, 20, 1},
-    {1, 21, 210, 1330, 5985, 20349, 54264, 116280, 203490, 293930, 352716, 352716, 293930, 203490, 116280, 54264, 20349, 5985, 1330, 210, 21, 1},
+    {1, 15, 105, 455, 1365, 3003, 5005, 6435, 6435, 5005, 3003, 1365, 455, 105,
+     15, 1},
+    {1, 16, 120, 560, 1820, 4368, 8008, 11440, 12870, 11440, 8008, 4368, 1820,
+     560, 120, 16, 1},
+    {1, 17, 136, 680, 2380, 6188, 12376, 19448, 24310, 24310, 19448, 12376,
+     6188, 2380, 680, 136, 17, 1},
+    {1, 18, 153, 816, 3060, 8568, 18564, 31824, 43758, 48620, 43758, 31824,
+     18564, 8568, 3060, 816, 153, 18, 1},
+    {1,     19,    171,   969,   3876,  11628, 27132, 50388, 75582, 92378,
+     92378, 75582, 50388, 27132, 11628, 3876,  969,   171,   19,    1},
+    {1,     20,     190,    1140,   4845,   15504,  38760,
+     77520, 125970, 167960, 184756, 167960, 125970, 77520,
+     38760, 15504,  4845,   1140,   190,    20,     1},
+    {1,      21,     210,    1330,   5985,   20349,  54264,  116280,
+     203490, 293930, 352716, 352716, 293930, 203490, 116280, 54264,
+     20349,  5985,   1330,   210,    21,     1},
 };
 
 double km__bern_eval(const double *c, int d, double u) {
@@ -86,8 +97,7 @@ double km__bern_eval(const double *c, int d, double u) {
 
 /* Split at u: left coefficients (over [0,u]) into L, right into R (either
  * may be NULL). */
-static void bern_split(const double *c, int d, double u, double *L,
-                       double *R) {
+static void bern_split(const double *c, int d, double u, double *L, double *R) {
   double b[KM_MAX_FN_DEGREE + 2];
   memcpy(b, c, (size_t)(d + 1) * sizeof(double));
   double v = 1.0 - u;
@@ -297,8 +307,9 @@ km_status km__pp_to_fn(km_fn *out, const km_pp *p) {
 
 typedef struct merge_fit {
   int d;
-  double u[KM_MAX_FN_DEGREE + 2];                            /* nodes */
-  double inv[(KM_MAX_FN_DEGREE + 2) * (KM_MAX_FN_DEGREE + 2)]; /* values -> coefficients */
+  double u[KM_MAX_FN_DEGREE + 2]; /* nodes */
+  double inv[(KM_MAX_FN_DEGREE + 2) *
+             (KM_MAX_FN_DEGREE + 2)]; /* values -> coefficients */
 } merge_fit;
 
 static bool merge_fit_make(merge_fit *mf, int d) {
@@ -320,8 +331,8 @@ static bool merge_fit_make(merge_fit *mf, int d) {
 
 /* Fits pieces [i0, i1) of p with one polynomial (coefficients into coef)
  * and returns whether it stays within delta of every piece. */
-static bool merge_try(const km_pp *p, const merge_fit *mf, size_t i0,
-                      size_t i1, double delta, double *coef) {
+static bool merge_try(const km_pp *p, const merge_fit *mf, size_t i0, size_t i1,
+                      double delta, double *coef) {
   int d = mf->d, n = d + 1, dp = p->degree;
   double X0 = p->x[i0], W = p->x[i1] - X0, v[KM_MAX_FN_DEGREE + 2];
   size_t i = i0;
@@ -363,8 +374,8 @@ km_status km__pp_merge(const km_pp *p, int degree, double delta, km_pp *out) {
   while (!st && i < m) {
     /* the run may extend up to the next jump */
     size_t lim = i + 1;
-    while (lim < m && fabs(p->c[lim * (dp + 1)] - p->c[(lim - 1) * (dp + 1) + dp]) <=
-                          0.25 * delta)
+    while (lim < m && fabs(p->c[lim * (dp + 1)] -
+                           p->c[(lim - 1) * (dp + 1) + dp]) <= 0.25 * delta)
       lim++;
     double *coef = c + np * (size_t)(d + 1);
     size_t good = i + 1, bad = lim + 1;
@@ -397,7 +408,8 @@ km_status km__pp_merge(const km_pp *p, int degree, double delta, km_pp *out) {
         bad = mid;
       }
     }
-    if (good == i + 1) km__bern_elevate(p->c + i * (dp + 1), p->degree, d, coef);
+    if (good == i + 1)
+      km__bern_elevate(p->c + i * (dp + 1), p->degree, d, coef);
     x[np] = p->x[i];
     np++;
     i = good;

@@ -15,9 +15,9 @@
  * d+1 Bernstein coefficients over [x[i], x[i+1]]. */
 typedef struct km_pp {
   int degree;
-  size_t m;    /* number of pieces */
-  double *x;   /* m + 1 breaks */
-  double *c;   /* m * (degree + 1) coefficients */
+  size_t m;  /* number of pieces */
+  double *x; /* m + 1 breaks */
+  double *c; /* m * (degree + 1) coefficients */
 } km_pp;
 
 void km__pp_init(km_pp *p);

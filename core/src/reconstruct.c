@@ -84,7 +84,8 @@ km_status km__build_theta(const km_signature *sig, km_pp *kappa, km_pp *theta) {
   size_t ci = 0;
   for (size_t i = 0; i + 1 < m; i++) {
     double a = br[i], b = br[i + 1], h = b - a;
-    while (ci < sig->ncorners && sig->corners[ci].s <= a) th += sig->corners[ci++].turn;
+    while (ci < sig->ncorners && sig->corners[ci].s <= a)
+      th += sig->corners[ci++].turn;
     /* the kappa piece holding [a, b]: found by a, a break itself (the
      * midpoint of a piece one ulp wide rounds onto b, the next piece) */
     size_t j = km__pp_find(&k0, a);
@@ -113,8 +114,8 @@ done:
 
 /* Integral of (cos theta, sin theta) over [u0, u1] (piece variable in
  * [0,1]) of theta piece i of length h. */
-void km__integrate_exp(const double *tc, int d, double h, double u0,
-                            double u1, double kbound, double out[2]) {
+void km__integrate_exp(const double *tc, int d, double h, double u0, double u1,
+                       double kbound, double out[2]) {
   double len = (u1 - u0) * h;
   /* chunks over which theta moves at most 0.5 rad */
   int chunks = (int)ceil(kbound * len / 0.5);
@@ -140,8 +141,8 @@ void km__integrate_exp(const double *tc, int d, double h, double u0,
 }
 
 /* Bounds on |kappa^(j)| for j = 0..nd-1 over [u0,u1] of kappa piece kc. */
-void km__kappa_bounds(const double *kc, int dk, double h, double u0,
-                      double u1, int nd, double *bnd) {
+void km__kappa_bounds(const double *kc, int dk, double h, double u0, double u1,
+                      int nd, double *bnd) {
   double c[MAXD], dc[MAXD];
   km__bern_restrict(kc, dk, u0, u1, c);
   int d = dk;
@@ -174,15 +175,15 @@ typedef struct out_piece {
   size_t piece_end; /* theta piece where it ends, at u1 (cubic merging) */
   double u0, u1;
   double bound;
-  double m4;        /* bound on |C''''| over the piece */
-  double h;         /* arc length */
-  double j2, j3;    /* sums of the jumps of |C''|, |C'''| inside */
+  double m4;     /* bound on |C''''| over the piece */
+  double h;      /* arc length */
+  double j2, j3; /* sums of the jumps of |C''|, |C'''| inside */
 } out_piece;
 
 typedef struct plan {
   out_piece *p;
   size_t n, cap;
-  size_t limit; /* pieces allowed (KM_MAX_OUTPUT_PIECES beyond the input's) */
+  size_t limit;   /* pieces allowed (KM_MAX_OUTPUT_PIECES beyond the input's) */
   km__poll *poll; /* the caller's stop condition, or NULL */
 } plan;
 
@@ -215,8 +216,8 @@ static km_status plan_range(plan *pl, const theta_pieces *tp, size_t i,
   double e = hermite_bound(degree, kb, (u1 - u0) * h);
   if (e <= tol || depth > 60) {
     double hh = (u1 - u0) * h;
-    out_piece op = {i, i, u0, u1, e, e / fmax(pow(hh, 4) / 384.0, 1e-300), hh,
-                    0.0, 0.0};
+    out_piece op = {i,  i,   u0, u1, e, e / fmax(pow(hh, 4) / 384.0, 1e-300),
+                    hh, 0.0, 0.0};
     return plan_push(pl, op);
   }
   /* split into as many equal parts as the bound's order suggests */
@@ -233,7 +234,6 @@ static km_status plan_range(plan *pl, const theta_pieces *tp, size_t i,
   }
   return KM_OK;
 }
-
 
 static double kappa_end(const theta_pieces *tp, size_t i, int right_end,
                         double *slope) {
@@ -269,8 +269,10 @@ static void merge_cubic(plan *pl, const theta_pieces *tp, double tol) {
     bool ok = true;
     if (nx.piece != cur.piece_end) {
       /* a breakpoint of kappa between them: theta must be continuous */
-      double tha = km__bern_eval(tp->theta.c + cur.piece_end * (size_t)(dt + 1), dt, 1.0);
-      double thb = km__bern_eval(tp->theta.c + nx.piece * (size_t)(dt + 1), dt, 0.0);
+      double tha = km__bern_eval(tp->theta.c + cur.piece_end * (size_t)(dt + 1),
+                                 dt, 1.0);
+      double thb =
+          km__bern_eval(tp->theta.c + nx.piece * (size_t)(dt + 1), dt, 0.0);
       if (fabs(thb - tha) > 1e-13) ok = false;
       double sa, sb;
       double ka = kappa_end(tp, cur.piece_end, 1, &sa);
@@ -379,7 +381,8 @@ static km_status integrate_positions(const plan *pl, const theta_pieces *tp,
       sx += d[0];
       sy += d[1];
       /* 16 nodes a chunk of at most half a radian (km__integrate_exp) */
-      if (km__poll_stop(poll, 16 + (long)fmin(32.0 * kb[0] * (u1 - u0) * h, 1e9)))
+      if (km__poll_stop(poll,
+                        16 + (long)fmin(32.0 * kb[0] * (u1 - u0) * h, 1e9)))
         return km__stopped(err);
     }
     pos[2 * j + 2] = pos[2 * j] + sx;
@@ -393,17 +396,21 @@ static km_status integrate_positions(const plan *pl, const theta_pieces *tp,
  * corner (C0), 1 = a jump of kappa (C1; also every cubic junction, the
  * Hermite pieces being C1), 2 = C2. Returns the knot count of the
  * B-spline. */
-static size_t junctions(const plan *pl, const theta_pieces *tp, int p,
-                        double L, int *cont) {
+static size_t junctions(const plan *pl, const theta_pieces *tp, int p, double L,
+                        int *cont) {
   int dk = tp->kappa.degree, dt = dk + 1;
   size_t nknots = 2 * (size_t)(p + 1);
   double kscale = km__pp_max_abs(&tp->kappa) + 1.0 / L;
   for (size_t j = 1; j < pl->n; j++) {
     const out_piece *a = &pl->p[j - 1], *b = &pl->p[j];
-    double tha = km__bern_eval(tp->theta.c + a->piece_end * (size_t)(dt + 1), dt, a->u1);
-    double thb = km__bern_eval(tp->theta.c + b->piece * (size_t)(dt + 1), dt, b->u0);
-    double ka = km__bern_eval(tp->kappa.c + a->piece_end * (size_t)(dk + 1), dk, a->u1);
-    double kb = km__bern_eval(tp->kappa.c + b->piece * (size_t)(dk + 1), dk, b->u0);
+    double tha =
+        km__bern_eval(tp->theta.c + a->piece_end * (size_t)(dt + 1), dt, a->u1);
+    double thb =
+        km__bern_eval(tp->theta.c + b->piece * (size_t)(dt + 1), dt, b->u0);
+    double ka =
+        km__bern_eval(tp->kappa.c + a->piece_end * (size_t)(dk + 1), dk, a->u1);
+    double kb =
+        km__bern_eval(tp->kappa.c + b->piece * (size_t)(dk + 1), dk, b->u0);
     if (fabs(thb - tha) > 1e-13)
       cont[j] = 0;
     else if (fabs(kb - ka) > 1e-12 * kscale)
@@ -428,7 +435,8 @@ static void piece_bezier(const plan *pl, const theta_pieces *tp,
   const double *tce = tp->theta.c + ie * (size_t)(dt + 1);
   const double *kce = tp->kappa.c + ie * (size_t)(dk + 1);
   double h = op->h;
-  double t0 = km__bern_eval(tc, dt, op->u0), t1 = km__bern_eval(tce, dt, op->u1);
+  double t0 = km__bern_eval(tc, dt, op->u0),
+         t1 = km__bern_eval(tce, dt, op->u1);
   double T0[2] = {cos(t0), sin(t0)}, T1[2] = {cos(t1), sin(t1)};
   double P0[2] = {pos[2 * j], pos[2 * j + 1]};
   double P1[2] = {pos[2 * j + 2], pos[2 * j + 3]};
@@ -441,7 +449,8 @@ static void piece_bezier(const plan *pl, const theta_pieces *tp,
     }
     return;
   }
-  double k0 = km__bern_eval(kc, dk, op->u0), k1 = km__bern_eval(kce, dk, op->u1);
+  double k0 = km__bern_eval(kc, dk, op->u0),
+         k1 = km__bern_eval(kce, dk, op->u1);
   double N0[2] = {-T0[1], T0[0]}, N1[2] = {-T1[1], T1[0]};
   for (int a = 0; a < 2; a++) {
     Q[0][a] = P0[a];
@@ -568,11 +577,13 @@ km_status km__reconstruct(const km_signature *sig, int degree, double tol,
     goto cleanup;
   }
   /* the ends' positions carry the rounding of every integral before them */
-  double bound = max_bound + 8e-16 * (double)(np + 1) *
-                                 (L + fabs(sig->start[0]) + fabs(sig->start[1]));
+  double bound =
+      max_bound + 8e-16 * (double)(np + 1) *
+                      (L + fabs(sig->start[0]) + fabs(sig->start[1]));
   c.closed = false;
   if (sig->closed) {
-    double gx = c.cp[2 * (ncp - 1)] - c.cp[0], gy = c.cp[2 * (ncp - 1) + 1] - c.cp[1];
+    double gx = c.cp[2 * (ncp - 1)] - c.cp[0],
+           gy = c.cp[2 * (ncp - 1) + 1] - c.cp[1];
     double gap = hypot(gx, gy);
     if (gap <= tol) {
       c.cp[2 * (ncp - 1)] = c.cp[0];

@@ -55,7 +55,8 @@ int km__poly_winding(const double *P, size_t np, const double p[2]) {
   int w = 0;
   for (size_t i = 0; i < np; i++) {
     const double *a = P + 2 * i, *b = P + 2 * ((i + 1) % np);
-    double cross = (b[0] - a[0]) * (p[1] - a[1]) - (p[0] - a[0]) * (b[1] - a[1]);
+    double cross =
+        (b[0] - a[0]) * (p[1] - a[1]) - (p[0] - a[0]) * (b[1] - a[1]);
     if (a[1] <= p[1]) {
       if (b[1] > p[1] && cross > 0) w++;
     } else if (b[1] <= p[1] && cross < 0) {
@@ -113,8 +114,8 @@ static bool proper_cross(const double *a, const double *b, const double *c,
          ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0));
 }
 
-long km__poly_crossings(const double *P, size_t np, const double *Q,
-                        size_t nq, km__poll *poll) {
+long km__poly_crossings(const double *P, size_t np, const double *Q, size_t nq,
+                        km__poll *poll) {
   long count = 0;
   for (size_t i = 0; i + 1 < np; i++) {
     const double *a = P + 2 * i, *b = a + 2;
@@ -210,12 +211,12 @@ static km_status take_contour(km_shape *s, const km_curve *c, size_t i,
   km__curve_area(c, &a, s->centroid + 2 * i);
   double len = km_curve_length(c);
   if (!isfinite(a))
-    return km__fail(err, KM_ENONFINITE, KM_FIELD_CONTROL_POINTS, (long)i,
-                    NAN, "contour %zu: its area is not finite", i);
+    return km__fail(err, KM_ENONFINITE, KM_FIELD_CONTROL_POINTS, (long)i, NAN,
+                    "contour %zu: its area is not finite", i);
   /* an area of rounding size beside length^2 encloses nothing */
   if (!(fabs(a) > 1e-12 * len * len))
-    return km__fail(err, KM_EDEGENERATE, KM_FIELD_CONTROL_POINTS, (long)i,
-                    NAN, "contour %zu encloses no area", i);
+    return km__fail(err, KM_EDEGENERATE, KM_FIELD_CONTROL_POINTS, (long)i, NAN,
+                    "contour %zu encloses no area", i);
   s->area[i] = a; /* signed until the orientation is normalised */
   return km__shape_flatten(c, flat, np);
 }
@@ -319,8 +320,8 @@ static km_status check_args(const km_curve *contours, size_t n,
                             km_error *err) {
   size_t maxc = lim && lim->max_contours ? lim->max_contours
                                          : KM_SHAPE_DEFAULT_MAX_CONTOURS;
-  size_t maxp = lim && lim->max_points ? lim->max_points
-                                       : KM_SHAPE_DEFAULT_MAX_POINTS;
+  size_t maxp =
+      lim && lim->max_points ? lim->max_points : KM_SHAPE_DEFAULT_MAX_POINTS;
   if (maxc > KM_SHAPE_MAX_CONTOURS) maxc = KM_SHAPE_MAX_CONTOURS;
   if (maxp > KM_SHAPE_MAX_POINTS) maxp = KM_SHAPE_MAX_POINTS;
   if (fill != KM_FILL_NONZERO && fill != KM_FILL_EVENODD)
@@ -330,8 +331,7 @@ static km_status check_args(const km_curve *contours, size_t n,
     return km__fail(err, KM_ECOUNT, KM_FIELD_NONE, -1, NAN,
                     "a shape needs at least one contour");
   if (!contours)
-    return km__fail(err, KM_EINVAL, KM_FIELD_NONE, -1, NAN,
-                    "contours missing");
+    return km__fail(err, KM_EINVAL, KM_FIELD_NONE, -1, NAN, "contours missing");
   if (n > maxc)
     return km__fail(err, KM_ELIMIT, KM_FIELD_NONE, (long)maxc, NAN,
                     "%zu contours, above the limit of %zu", n, maxc);

@@ -66,8 +66,8 @@ static km_status contour_at(const km_shape_morph *m, size_t k, double t,
   return KM_OK;
 }
 
-static bool all_inside(const double *P, size_t np, const double *Q,
-                       size_t nq, const double d[2]) {
+static bool all_inside(const double *P, size_t np, const double *Q, size_t nq,
+                       const double d[2]) {
   for (size_t i = 0; i < np; i++) {
     double q[2] = {P[2 * i] + d[0], P[2 * i + 1] + d[1]};
     if (km__poly_winding(Q, nq, q) == 0) return false;
@@ -102,8 +102,10 @@ static bool adjust(km_shape_frame *f, size_t k, double **fl, size_t *np) {
     double mid = 0.5 * (lo + hi);
     d[0] = mid * full[0];
     d[1] = mid * full[1];
-    if (all_inside(fl[k], np[k], fl[p], np[p], d)) hi = mid;
-    else lo = mid;
+    if (all_inside(fl[k], np[k], fl[p], np[p], d))
+      hi = mid;
+    else
+      lo = mid;
   }
   d[0] = hi * full[0];
   d[1] = hi * full[1];
@@ -162,8 +164,8 @@ static km_status frame_alloc(km_shape_frame *f, size_t n) {
 }
 
 km_status km_shape_morph_frame_until(const km_shape_morph *m, double t,
-                                     const km_stop *stop,
-                                     km_shape_frame *out, km_error *err) {
+                                     const km_stop *stop, km_shape_frame *out,
+                                     km_error *err) {
   if (!m || !out)
     return km__fail(err, KM_EINVAL, KM_FIELD_NONE, -1, NAN, "no morph");
   if (!(t >= 0.0 && t <= 1.0))

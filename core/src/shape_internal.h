@@ -28,8 +28,8 @@ void km__curve_area(const km_curve *c, double *area, double centroid[2]);
 /* Number of proper crossings between polylines P (np points) and Q (nq
  * points), both closed; polls p (may be NULL) once a segment of P. -1
  * when stopped. */
-long km__poly_crossings(const double *P, size_t np, const double *Q,
-                        size_t nq, km__poll *poll);
+long km__poly_crossings(const double *P, size_t np, const double *Q, size_t nq,
+                        km__poll *poll);
 
 /* A point inside the closed polyline P (np points) near x (shape.c); x
  * itself when no edge offset lands inside. */

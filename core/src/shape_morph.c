@@ -32,7 +32,8 @@ void km_shape_morph_options_default(km_shape_morph_options *o) {
 
 void km_shape_morph_free(km_shape_morph *m) {
   if (!m) return;
-  for (size_t k = 0; m->morphs && k < m->npairs; k++) km_morph_free(m->morphs[k]);
+  for (size_t k = 0; m->morphs && k < m->npairs; k++)
+    km_morph_free(m->morphs[k]);
   km__free(m->morphs);
   km__free(m->pairs);
   km__free(m->kind);
@@ -56,8 +57,8 @@ static km_status circle_of(km_curve *out, const double c[2], double len,
                            bool ccw, km_error *err) {
   static const double ux[9] = {1, 1, 0, -1, -1, -1, 0, 1, 1};
   static const double uy[9] = {0, 1, 1, 1, 0, -1, -1, -1, 0};
-  static const double kn[12] = {0, 0, 0, 0.25, 0.25, 0.5,
-                                0.5, 0.75, 0.75, 1, 1, 1};
+  static const double kn[12] = {0,   0,    0,    0.25, 0.25, 0.5,
+                                0.5, 0.75, 0.75, 1,    1,    1};
   double r = len / (2 * KM_PI), cp[18], w[9];
   for (int i = 0; i < 9; i++) {
     cp[2 * i] = c[0] + r * ux[i];
@@ -209,7 +210,9 @@ static void plan_slots(km_shape_morph *m, const km_shape *a,
   int maxd = 0;
   for (size_t k = 0; k < m->npairs; k++) {
     long i = m->pairs[k].from, j = m->pairs[k].to;
-    m->kind[k] = i >= 0 && j >= 0 ? KM__PAIRED : i >= 0 ? KM__VANISH : KM__APPEAR;
+    m->kind[k] = i >= 0 && j >= 0 ? KM__PAIRED
+                 : i >= 0         ? KM__VANISH
+                                  : KM__APPEAR;
     m->parent_from[k] = i >= 0 ? slot_of(m, a->parent[i], true) : -1;
     m->parent_to[k] = j >= 0 ? slot_of(m, b->parent[j], false) : -1;
   }
@@ -233,7 +236,8 @@ km_status km_shape_morph_create(km_shape_morph **out, const km_shape *from,
   if (!out || !from || !to || !from->ncontours || !to->ncontours)
     return km__fail(err, KM_EINVAL, KM_FIELD_NONE, -1, NAN, "empty shape");
   km_shape_morph *m = km__calloc(1, sizeof *m);
-  if (!m) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, "out of memory");
+  if (!m)
+    return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, "out of memory");
   km_status st = take_pairs(m, from, to, opt, stop, err);
   if (st == KM_OK) {
     st = morph_alloc(m, m->npairs);

@@ -30,7 +30,9 @@ void km_shape_pair_costs_default(km_shape_pair_costs *c) {
   c->unpaired = 1.0;
 }
 
-void km_shape_pairs_free(km_shape_pair *pairs) { km__free(pairs); }
+void km_shape_pairs_free(km_shape_pair *pairs) {
+  km__free(pairs);
+}
 
 /* Tangent angle less the uniform turn 2 pi r at TURN_SAMPLES equal
  * arc-length fractions of contour i's flattening (unwrapped). */
@@ -108,7 +110,8 @@ static double pair_cost(const km_shape *a, size_t i, const double *ta,
 static km_status hungarian(const double *cost, size_t N, size_t *assign) {
   double *u = km__calloc(N + 1, sizeof *u), *v = km__calloc(N + 1, sizeof *v);
   double *minv = km__malloc((N + 1) * sizeof *minv);
-  size_t *p = km__calloc(N + 1, sizeof *p), *way = km__calloc(N + 1, sizeof *way);
+  size_t *p = km__calloc(N + 1, sizeof *p),
+         *way = km__calloc(N + 1, sizeof *way);
   bool *used = km__malloc((N + 1) * sizeof *used);
   km_status st = (u && v && minv && p && way && used) ? KM_OK : KM_ENOMEM;
   for (size_t i = 1; st == KM_OK && i <= N; i++) {
@@ -265,10 +268,9 @@ static void sort_pairs(km_shape_pair *p, size_t n) {
 }
 
 static bool costs_ok(const km_shape_pair_costs *c) {
-  return isfinite(c->w_position) && c->w_position >= 0 &&
-         isfinite(c->w_size) && c->w_size >= 0 && isfinite(c->w_turning) &&
-         c->w_turning >= 0 && isfinite(c->unpaired) && c->unpaired >= 0 &&
-         c->unpaired < BIG / 4;
+  return isfinite(c->w_position) && c->w_position >= 0 && isfinite(c->w_size) &&
+         c->w_size >= 0 && isfinite(c->w_turning) && c->w_turning >= 0 &&
+         isfinite(c->unpaired) && c->unpaired >= 0 && c->unpaired < BIG / 4;
 }
 
 km_status km_shape_pair_auto(const km_shape *a, const km_shape *b,
@@ -328,9 +330,8 @@ static long partner(const km_shape_pair *pairs, size_t npairs, long i,
 }
 
 static km_status check_one(const km_shape *a, const km_shape *b,
-                           const km_shape_pair *pairs, size_t npairs,
-                           size_t k, int *seen_a, int *seen_b,
-                           km_error *err) {
+                           const km_shape_pair *pairs, size_t npairs, size_t k,
+                           int *seen_a, int *seen_b, km_error *err) {
   long i = pairs[k].from, j = pairs[k].to;
   if (i < -1 || j < -1 || i >= (long)a->ncontours || j >= (long)b->ncontours)
     return bad_pair(err, k, "a contour index out of range");

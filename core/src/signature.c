@@ -48,8 +48,7 @@ static km_status check_placement(double length, const double start[2],
                       "start point is not finite");
     if (fabs(start[k]) > KM_MAX_COORDINATE)
       return km__fail(err, KM_ERANGE, KM_FIELD_START, k, NAN,
-                      "start point exceeds %g in magnitude",
-                      KM_MAX_COORDINATE);
+                      "start point exceeds %g in magnitude", KM_MAX_COORDINATE);
   }
   if (!isfinite(angle) || fabs(angle) > 1e6)
     return km__fail(err, KM_ERANGE, KM_FIELD_ANGLE, -1, NAN,
@@ -85,7 +84,8 @@ static km_status check_turning(const km_fn *kappa, const km_corner *corners,
   int p = kappa->degree;
   for (size_t i = 0; i < kappa->n; i++)
     abs_turning += fabs(kappa->coef[i]) *
-                   (kappa->knots[i + (size_t)p + 1] - kappa->knots[i]) / (p + 1);
+                   (kappa->knots[i + (size_t)p + 1] - kappa->knots[i]) /
+                   (p + 1);
   for (size_t i = 0; i < ncorners; i++) abs_turning += fabs(corners[i].turn);
   double max_turns = KM_MAX_SIGNATURE_TURNS + 0.25 * (double)kappa->n;
   if (!(abs_turning <= 2 * KM_PI * max_turns))

@@ -22,12 +22,12 @@
 typedef struct km__sig_builder km__sig_builder;
 struct km__sig_builder {
   const km_curve *c;
-  double L;         /* total length */
-  double tol;       /* allowed distance to the curve */
-  double tol_theta; /* allowed |theta - theta~| */
-  double span_t;    /* width in t of the span being processed */
-  double span_speed; /* its mean speed: the scale of |C'| there */
-  double span_len;  /* its arc length: estimated, then confirmed */
+  double L;                 /* total length */
+  double tol;               /* allowed distance to the curve */
+  double tol_theta;         /* allowed |theta - theta~| */
+  double span_t;            /* width in t of the span being processed */
+  double span_speed;        /* its mean speed: the scale of |C'| there */
+  double span_len;          /* its arc length: estimated, then confirmed */
   double span_weight_ratio; /* largest over smallest weight (1 without) */
   /* pieces of theta: breaks s[0..m], coefficients th[m*(P+1)] */
   double *s, *th;
@@ -42,7 +42,7 @@ struct km__sig_builder {
   long span_work;       /* and for the span being processed */
   double free_len;      /* position error left for pieces taken as turning
                            uniformly (twice their length) */
-  km__poll *poll;        /* the caller's stop condition, or NULL */
+  km__poll *poll;       /* the caller's stop condition, or NULL */
   km_error *err;
 };
 

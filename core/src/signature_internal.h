@@ -35,13 +35,13 @@ km_status km__build_theta(const struct km_signature *sig, km_pp *kappa,
 /* Integral of (cos theta, sin theta) over [u0,u1] of a theta piece (degree
  * d Bernstein coefficients tc, piece length h); kbound bounds |kappa| there
  * and sets the chunking (theta moves <= 0.5 rad per 16-point rule). */
-void km__integrate_exp(const double *tc, int d, double h, double u0,
-                       double u1, double kbound, double out[2]);
+void km__integrate_exp(const double *tc, int d, double h, double u0, double u1,
+                       double kbound, double out[2]);
 /* Bounds bnd[j] >= |kappa^(j)| (j < nd, derivatives in arc length) over
  * [u0, u1] of a kappa piece (degree dk Bernstein coefficients kc, piece
  * length h), from the Bernstein coefficients of the restricted piece. */
-void km__kappa_bounds(const double *kc, int dk, double h, double u0,
-                      double u1, int nd, double *bnd);
+void km__kappa_bounds(const double *kc, int dk, double h, double u0, double u1,
+                      int nd, double *bnd);
 /* Sup over the jump position c and s in [0, 1] of |q - Hq| for the cubic
  * Hermite interpolant H of q = (s - c)_+^2 / 2 and (s - c)_+^3 / 6, rounded
  * up (0.016151 and 1/192 measured on a fine grid): a cubic Hermite piece of

@@ -40,7 +40,7 @@
 #define SPAN_CACHE 20000 /* spans kept in Bezier form */
 
 km_status km__sig_push_piece(km__sig_builder *b, double s0, double s1,
-                            const double *coef) {
+                             const double *coef) {
   if (b->m + 1 >= b->cap) {
     size_t cap = b->cap ? 2 * b->cap : 64;
     if (cap > KM_MAX_PIECES)
@@ -64,7 +64,8 @@ km_status km__sig_push_piece(km__sig_builder *b, double s0, double s1,
   return KM_OK;
 }
 
-static km_status push_corner(km__sig_builder *b, double s, double turn, double t) {
+static km_status push_corner(km__sig_builder *b, double s, double turn,
+                             double t) {
   if (b->ncorners > 0 && s - b->corners[b->ncorners - 1].s <= 1e-14 * b->L) {
     /* one corner seen in several steps: one turn, which may reverse */
     double sum = km__wrap_angle(b->corners[b->ncorners - 1].turn + turn);
@@ -123,7 +124,8 @@ static bool tangent_limit(const km__sig_builder *b, double t, int side,
   if ((side > 0 && t == sp->a) || (side < 0 && t == sp->b)) {
     int e = side > 0 ? 0 : p, step = side > 0 ? 1 : -1;
     double ex = sp->h[e][0] / sp->h[e][2], ey = sp->h[e][1] / sp->h[e][2];
-    double floor_p = b->deriv_noise * (sp->b - sp->a); /* ~ rounding of points */
+    double floor_p =
+        b->deriv_noise * (sp->b - sp->a); /* ~ rounding of points */
     for (int k = e + step; k >= 0 && k <= p; k += step) {
       double vx = (sp->h[k][0] / sp->h[k][2] - ex) * step;
       double vy = (sp->h[k][1] / sp->h[k][2] - ey) * step;
@@ -173,7 +175,7 @@ static bool tangent_limit(const km__sig_builder *b, double t, int side,
  * noise turned 7.4e-4 rad too far, 1.5e-3 off at the end at a tolerance
  * of 1e-3). */
 km_status km__sig_take_turn(km__sig_builder *b, double turn, double s,
-                           double theta_before, double t, bool knot_corner) {
+                            double theta_before, double t, bool knot_corner) {
   double tol = 4.0 * b->tol_theta * b->L;
   double prev_end = b->m > 0 ? b->s[b->m] : -1.0;
   double prev_h = b->m > 0 ? b->s[b->m] - b->s[b->m - 1] : INFINITY;
@@ -202,7 +204,8 @@ km_status km__sig_take_turn(km__sig_builder *b, double turn, double s,
 
 /* The turn between two spans at parameter t, arc length s: a cusp where
  * the tangent reverses. */
-static km_status check_cusp(km__sig_builder *b, double turn, double t, double s) {
+static km_status check_cusp(km__sig_builder *b, double turn, double t,
+                            double s) {
   if (fabs(turn) > KM_PI - KM__CUSP_MARGIN)
     return km__fail(b->err, KM_ECUSP, KM_FIELD_KNOTS, -1, t,
                     "the tangent reverses at parameter t = %g (arc length "
@@ -211,8 +214,8 @@ static km_status check_cusp(km__sig_builder *b, double turn, double t, double s)
   return KM_OK;
 }
 
-km_status km_signature_compute(const km_curve *c, double tol,
-                               km_signature *out, km_error *err) {
+km_status km_signature_compute(const km_curve *c, double tol, km_signature *out,
+                               km_error *err) {
   return km__signature_compute(c, tol, 1e-5, NULL, out, err);
 }
 
@@ -231,14 +234,14 @@ km_status km_signature_compute_until(const km_curve *c, double tol,
  * the derivative of the theta pieces. */
 typedef struct walk {
   const km_curve *c;
-  double *span_len;  /* per span: the estimate, then the confirmed length */
-  km__bspan *spans;  /* the spans in Bezier form, or NULL past SPAN_CACHE */
-  double L;          /* total length: estimated, then confirmed */
-  double extent;     /* largest |coordinate| of a control point */
-  double point_len;  /* twice the length left for spans taken as points */
+  double *span_len; /* per span: the estimate, then the confirmed length */
+  km__bspan *spans; /* the spans in Bezier form, or NULL past SPAN_CACHE */
+  double L;         /* total length: estimated, then confirmed */
+  double extent;    /* largest |coordinate| of a control point */
+  double point_len; /* twice the length left for spans taken as points */
   double s_at, theta, start_angle;
   double prev_dir[2], first_dir[2];
-  bool have_prev;    /* a span was fitted: prev_dir is its end direction */
+  bool have_prev; /* a span was fitted: prev_dir is its end direction */
 } walk;
 
 /* Span lengths by one 16-point rule first: they scale the tolerance and
@@ -262,8 +265,7 @@ static km_status estimate_lengths(km__sig_builder *b, walk *w) {
       double est = km__sig_gl16_length(&sp, 0.0, 1.0);
       b->work -= 16;
       if (!(est > 1e-9 * poly) || !(est > 1e6 * km__bspan_noise(&sp)))
-        est = km__bspan_length_counted(&sp, 0.0, 1.0, 1e-15 * poly,
-                                       &evals);
+        est = km__bspan_length_counted(&sp, 0.0, 1.0, 1e-15 * poly, &evals);
       w->span_len[i] = est;
       b->work -= evals;
       if (km__poll_stop(b->poll, 16 + evals)) return km__stopped(b->err);
@@ -296,9 +298,9 @@ static km_status set_tolerance(km__sig_builder *b, walk *w, double tol,
    * small for its distance from the origin to meet even the default
    * tolerance (1e-5 of its length) is refused: its shape is rounding
    * noise at that scale. */
-  double tol_min = fmax(KM_MIN_RELATIVE_TOLERANCE * L,
-                        KM_MIN_TOLERANCE_ULPS * DBL_EPSILON * w->c->degree *
-                            extent);
+  double tol_min =
+      fmax(KM_MIN_RELATIVE_TOLERANCE * L,
+           KM_MIN_TOLERANCE_ULPS * DBL_EPSILON * w->c->degree * extent);
   if (tol < tol_min) {
     if (tol_min > 1e-5 * L)
       return km__fail(b->err, KM_ERANGE, KM_FIELD_CONTROL_POINTS, -1, NAN,
@@ -332,8 +334,7 @@ static km_status set_tolerance(km__sig_builder *b, walk *w, double tol,
  * may cost a quarter of the tolerance; past that the spans are a real
  * curve whose shape its coordinates do not carry, refused rather than
  * taken for a point. */
-static km_status enter_span(km__sig_builder *b, walk *w, size_t i,
-                            bool *skip) {
+static km_status enter_span(km__sig_builder *b, walk *w, size_t i, bool *skip) {
   const km_curve *c = w->c;
   double ua = c->knots[i], ub = c->knots[i + 1], len = w->span_len[i];
   *skip = true;
@@ -408,8 +409,8 @@ static km_status fit_span(km__sig_builder *b, walk *w, size_t i) {
     w->have_prev = true;
   } else {
     const double *pd = w->prev_dir;
-    double turn = atan2(pd[0] * da[1] - pd[1] * da[0],
-                        pd[0] * da[0] + pd[1] * da[1]);
+    double turn =
+        atan2(pd[0] * da[1] - pd[1] * da[0], pd[0] * da[0] + pd[1] * da[1]);
     km_status st = check_cusp(b, turn, ua, w->s_at);
     if (st) return st;
     st = km__sig_take_turn(b, turn, w->s_at, w->theta, ua, true);
@@ -419,8 +420,8 @@ static km_status fit_span(km__sig_builder *b, walk *w, size_t i) {
   size_t m0 = b->m, c0 = b->ncorners;
   b->span_first = m0;
   double s_start = w->s_at;
-  km_status st = km__sig_fit_piece(b, ua, ub, len, &w->s_at, &w->theta, da,
-                                   db, 0);
+  km_status st =
+      km__sig_fit_piece(b, ua, ub, len, &w->s_at, &w->theta, da, db, 0);
   if (st) return st;
   w->L += b->span_len - len; /* the confirmed length replaces the estimate */
   fit_to_span_length(b, w, m0, c0, s_start, b->span_len);
@@ -451,8 +452,8 @@ static km_status end_turns(km__sig_builder *b, walk *w, double t1) {
                     "the curve has zero length");
   if (w->c->closed) {
     const double *pd = w->prev_dir, *fd = w->first_dir;
-    double turn = atan2(pd[0] * fd[1] - pd[1] * fd[0],
-                        pd[0] * fd[0] + pd[1] * fd[1]);
+    double turn =
+        atan2(pd[0] * fd[1] - pd[1] * fd[0], pd[0] * fd[0] + pd[1] * fd[1]);
     st = check_cusp(b, turn, t1, w->s_at);
     if (st) return st;
     if (fabs(turn) > KM__CORNER_NOISE) {

@@ -21,16 +21,13 @@
  * sending side still reads its answer; srv_http_fin_probe tells the two
  * apart (the probe goes out once; a closed peer's reset is then seen
  * here as an error). */
-static bool client_gone(srv_req *r)
-{
+static bool client_gone(srv_req *r) {
   const union MHD_ConnectionInfo *ci =
       MHD_get_connection_info(r->conn, MHD_CONNECTION_INFO_CONNECTION_FD);
-  if (ci == NULL)
-    return false;
+  if (ci == NULL) return false;
   char b;
   ssize_t n = recv(ci->connect_fd, &b, 1, MSG_PEEK | MSG_DONTWAIT);
-  if (n == 0)
-    return srv_http_fin_probe(ci->connect_fd, r->http11, &r->probed);
+  if (n == 0) return srv_http_fin_probe(ci->connect_fd, r->http11, &r->probed);
   return n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR;
 }
 
@@ -38,20 +35,15 @@ static bool client_gone(srv_req *r)
  * short intervals of work (api_request.stop): the shutdown's grace ran
  * out, the compute time limit passed, or the client left (looked at every
  * 20 ms: a recv on the socket). Runs on the worker that owns r. */
-static bool request_should_stop(void *ctx)
-{
+static bool request_should_stop(void *ctx) {
   srv_req *r = ctx;
-  if (r->stopped != STOP_NONE)
-    return true;
-  if (atomic_load(&r->srv->abort_compute))
-    r->stopped = STOP_SHUTDOWN;
+  if (r->stopped != STOP_NONE) return true;
+  if (atomic_load(&r->srv->abort_compute)) r->stopped = STOP_SHUTDOWN;
   double now = srv_now();
-  if (r->stopped == STOP_NONE && now > r->deadline)
-    r->stopped = STOP_TIME;
+  if (r->stopped == STOP_NONE && now > r->deadline) r->stopped = STOP_TIME;
   if (r->stopped == STOP_NONE && now >= r->next_gone_check) {
     r->next_gone_check = now + 0.02;
-    if (client_gone(r))
-      r->stopped = STOP_GONE;
+    if (client_gone(r)) r->stopped = STOP_GONE;
   }
   return r->stopped != STOP_NONE;
 }
@@ -61,13 +53,12 @@ static bool request_should_stop(void *ctx)
  * request long (a time limit is a limit like the frame limit: 422). */
 static void stopped_problem(srv_req *r, double limit, const char *name,
                             const char *pointer, const char *message,
-                            const char *progress)
-{
+                            const char *progress) {
   api_response_free(&r->resp);
   if (r->stopped == STOP_GONE) {
     api_problem(&r->resp, 503, "/problems/client-gone", "Client gone",
-                "the client closed the connection during the work", NULL,
-                NULL, r->rid);
+                "the client closed the connection during the work", NULL, NULL,
+                r->rid);
     return;
   }
   if (r->stopped == STOP_SHUTDOWN) {
@@ -84,17 +75,15 @@ static void stopped_problem(srv_req *r, double limit, const char *name,
            r->route == SRV_R_MORPH
                ? "; POST /v1/jobs computes long morphs asynchronously"
                : "");
-  srv_metrics_reject(r->srv->metrics, r->route == SRV_R_MORPH
-                                          ? "morph_time"
-                                          : "compute_time");
+  srv_metrics_reject(r->srv->metrics,
+                     r->route == SRV_R_MORPH ? "morph_time" : "compute_time");
   api_problem(&r->resp, 422, "/problems/limit-exceeded", "Limit exceeded",
               detail, pointer, message, r->rid);
 }
 
 /* ------------------------------------------------------------- jobs */
 
-static int job_created_body(api_response *out, const char *id, size_t total)
-{
+static int job_created_body(api_response *out, const char *id, size_t total) {
   char tmp[512];
   int n = snprintf(tmp, sizeof tmp,
                    "{\"id\":\"%s\",\"state\":\"queued\",\"progress\":0,"
@@ -103,8 +92,7 @@ static int job_created_body(api_response *out, const char *id, size_t total)
                    "\"result\":\"/v1/jobs/%s/result\"}}",
                    id, total, id, id);
   char *body = malloc((size_t)n + 1);
-  if (body == NULL)
-    return -1;
+  if (body == NULL) return -1;
   memcpy(body, tmp, (size_t)n + 1);
   out->status = 202;
   out->content_type = SRV_JSON_TYPE;
@@ -116,8 +104,7 @@ static int job_created_body(api_response *out, const char *id, size_t total)
 /* Validate and plan the job's morph within limit seconds from the
  * request's start. The plan (owned by the caller), or NULL with the
  * problem in r->resp. */
-static api_morph_plan *plan_job(srv_req *r, api_request *req, double limit)
-{
+static api_morph_plan *plan_job(srv_req *r, api_request *req, double limit) {
   srv_server *s = r->srv;
   api_morph_plan *plan = NULL;
   api_response err;
@@ -137,13 +124,14 @@ static api_morph_plan *plan_job(srv_req *r, api_request *req, double limit)
     char message[160];
     snprintf(message, sizeof message,
              "preparing the morph takes longer than the %g s a job may "
-             "take", limit);
+             "take",
+             limit);
     stopped_problem(r, limit, "KMORPH_JOB_TIME", "/tolerance", message,
                     " while preparing the morph");
   } else if (r->resp.body == NULL) {
     api_problem(&r->resp, rc >= 400 ? rc : 500, "/problems/internal",
-                "Internal error", "the morph could not be prepared", NULL,
-                NULL, r->rid);
+                "Internal error", "the morph could not be prepared", NULL, NULL,
+                r->rid);
   }
   return NULL;
 }
@@ -151,16 +139,15 @@ static api_morph_plan *plan_job(srv_req *r, api_request *req, double limit)
 /* False, with a 422 in r->resp, if a result of predicted bytes could
  * never be kept: a limit of the request, like its frames. */
 static bool result_fits(srv_req *r, const api_morph_plan *plan,
-                        size_t predicted)
-{
+                        size_t predicted) {
   size_t keep = r->srv->cfg.result_memory;
-  if (predicted <= keep)
-    return true;
+  if (predicted <= keep) return true;
   const char *ptr = api_morph_frames_pointer(plan);
   char message[200], detail[400];
   snprintf(message, sizeof message,
            "the result would take up to %zu bytes; job results are kept "
-           "within %zu", predicted, keep);
+           "within %zu",
+           predicted, keep);
   snprintf(detail, sizeof detail,
            "%s: the result would take up to %zu bytes, more than the %zu "
            "kept for job results (KMORPH_RESULT_MEMORY); ask for fewer "
@@ -172,14 +159,13 @@ static bool result_fits(srv_req *r, const api_morph_plan *plan,
 }
 
 /* The answer to srv_jobs_start's refusal st (not 0) in r->resp. */
-static void job_refused(srv_req *r, int st)
-{
+static void job_refused(srv_req *r, int st) {
   srv_server *s = r->srv;
   if (st == -1) {
     srv_metrics_reject(s->metrics, "jobs_full");
     api_problem(&r->resp, 429, "/problems/too-many-jobs", "Too many jobs",
-                "the job limit (KMORPH_MAX_JOBS) is reached; retry later",
-                NULL, NULL, r->rid);
+                "the job limit (KMORPH_MAX_JOBS) is reached; retry later", NULL,
+                NULL, r->rid);
   } else if (st == -4) {
     srv_metrics_reject(s->metrics, "result_memory");
     api_problem(&r->resp, 503, "/problems/overloaded", "Overloaded",
@@ -198,14 +184,12 @@ static void job_refused(srv_req *r, int st)
 
 /* POST /v1/jobs on a worker: validate and plan (within the job's time),
  * then admit the job with the rest of that time. */
-static void create_job(srv_req *r, api_request *req)
-{
+static void create_job(srv_req *r, api_request *req) {
   srv_server *s = r->srv;
   double limit = srv_jobs_time_limit(s->jobs);
   r->deadline = r->t0 + limit;
   api_morph_plan *plan = plan_job(r, req, limit);
-  if (plan == NULL)
-    return;
+  if (plan == NULL) return;
   size_t total = api_morph_frame_count(plan);
   size_t predicted = api_morph_predicted_bytes(plan);
   if (!result_fits(r, plan, predicted)) {
@@ -233,8 +217,7 @@ static void create_job(srv_req *r, api_request *req)
  * so that the work stops when the client leaves or the compute time limit
  * passes - between frames, and inside preparing and each frame through
  * the stop condition. The time counts from the start of the work. */
-static void morph_sync(srv_req *r, api_request *req)
-{
+static void morph_sync(srv_req *r, api_request *req) {
   srv_server *s = r->srv;
   api_morph_plan *plan = NULL;
   double limit = s->cfg.morph_time;
@@ -245,7 +228,8 @@ static void morph_sync(srv_req *r, api_request *req)
     if (r->stopped != STOP_NONE) {
       snprintf(message, sizeof message,
                "preparing the morph takes longer than the %g s a "
-               "synchronous morph may compute", limit);
+               "synchronous morph may compute",
+               limit);
       stopped_problem(r, limit, "KMORPH_MORPH_TIME", "/tolerance", message,
                       " while preparing the morph");
     }
@@ -257,14 +241,14 @@ static void morph_sync(srv_req *r, api_request *req)
    * for api_morph_result; one that was stopped ends the work. */
   while (done < n && !request_should_stop(r)) {
     api_morph_render_frame_until(plan, done, request_should_stop, r);
-    if (r->stopped == STOP_NONE)
-      done++;
+    if (r->stopped == STOP_NONE) done++;
   }
   if (r->stopped != STOP_NONE) {
     char progress[80];
     snprintf(message, sizeof message,
              "%zu frames take longer than the %g s a synchronous morph may "
-             "compute", n, limit);
+             "compute",
+             n, limit);
     snprintf(progress, sizeof progress, " with %zu of %zu frames done", done,
              n);
     stopped_problem(r, limit, "KMORPH_MORPH_TIME",
@@ -277,8 +261,7 @@ static void morph_sync(srv_req *r, api_request *req)
 
 /* POST /v1/signature or /v1/reconstruct on a worker, within the compute
  * time limit. */
-static void compute_sync(srv_req *r, api_request *req)
-{
+static void compute_sync(srv_req *r, api_request *req) {
   double limit = r->srv->cfg.compute_time;
   r->deadline = srv_now() + limit;
   api_handle(&r->srv->api, req, &r->resp);
@@ -286,17 +269,16 @@ static void compute_sync(srv_req *r, api_request *req)
     char message[160];
     snprintf(message, sizeof message,
              "the computation takes longer than the %g s a request may "
-             "compute", limit);
-    stopped_problem(r, limit, "KMORPH_COMPUTE_TIME", "/tolerance", message,
-                    "");
+             "compute",
+             limit);
+    stopped_problem(r, limit, "KMORPH_COMPUTE_TIME", "/tolerance", message, "");
   }
 }
 
 /* ------------------------------------------------------------ hand-off */
 
 /* Run r's computation on this worker, by route. */
-static void compute_request(srv_req *r)
-{
+static void compute_request(srv_req *r) {
   api_request req;
   memset(&req, 0, sizeof req);
   req.body = r->body ? r->body : "";
@@ -321,8 +303,7 @@ static void compute_request(srv_req *r)
 
 /* The pool's task (pool.h): cancelled when the pool stops before the
  * request was started. */
-static void compute_task(void *arg, bool cancelled)
-{
+static void compute_task(void *arg, bool cancelled) {
   srv_req *r = arg;
   api_response_init(&r->resp);
   if (!cancelled && client_gone(r)) {
@@ -331,8 +312,8 @@ static void compute_task(void *arg, bool cancelled)
                 NULL, NULL, r->rid);
   } else if (cancelled) {
     api_problem(&r->resp, 503, "/problems/shutting-down", "Shutting down",
-                "the service is stopping; retry on another instance",
-                NULL, NULL, r->rid);
+                "the service is stopping; retry on another instance", NULL,
+                NULL, r->rid);
   } else {
     compute_request(r);
   }
@@ -343,8 +324,7 @@ static void compute_task(void *arg, bool cancelled)
   MHD_resume_connection(r->conn);
 }
 
-enum MHD_Result srv__hand_off(srv_req *r)
-{
+enum MHD_Result srv__hand_off(srv_req *r) {
   srv_server *s = r->srv;
   if (atomic_load(&s->draining))
     return srv__problem(r, 503, "/problems/shutting-down", "Shutting down",

@@ -38,8 +38,8 @@ static const opt_def OPTS[] = {
      "compute workers (0: number of cores)"},
     {"queue", "KMORPH_QUEUE", OPT_UINT, F(queue), 0, 1, 1000000,
      "compute requests waiting before 503"},
-    {"max-connections", "KMORPH_MAX_CONNECTIONS", OPT_UINT,
-     F(max_connections), 0, 1, 100000, "concurrent connections"},
+    {"max-connections", "KMORPH_MAX_CONNECTIONS", OPT_UINT, F(max_connections),
+     0, 1, 100000, "concurrent connections"},
     {"timeout", "KMORPH_TIMEOUT", OPT_UINT, F(timeout), 0, 1, 86400,
      "idle seconds before a connection is closed"},
     {"request-time", "KMORPH_REQUEST_TIME", OPT_SECONDS, F(request_time), 0,
@@ -50,10 +50,10 @@ static const opt_def OPTS[] = {
      0.01, 86400,
      "compute seconds per POST /v1/signature or /v1/reconstruct (past it: "
      "422)"},
-    {"header-time", "KMORPH_HEADER_TIME", OPT_SECONDS, F(header_time), 0,
-     0.05, 3600, "seconds to receive a request's header (past it: 408)"},
-    {"send-time", "KMORPH_SEND_TIME", OPT_SECONDS, F(send_time), 0, 0.05,
-     86400, "seconds to deliver one answer before the connection is cut"},
+    {"header-time", "KMORPH_HEADER_TIME", OPT_SECONDS, F(header_time), 0, 0.05,
+     3600, "seconds to receive a request's header (past it: 408)"},
+    {"send-time", "KMORPH_SEND_TIME", OPT_SECONDS, F(send_time), 0, 0.05, 86400,
+     "seconds to deliver one answer before the connection is cut"},
     {"per-ip", "KMORPH_PER_IP", OPT_UINT, F(per_ip), 0, 1, 100000,
      "concurrent connections from one client address"},
     {"reserved-connections", "KMORPH_RESERVED_CONNECTIONS", OPT_UINT,
@@ -61,18 +61,18 @@ static const opt_def OPTS[] = {
      "slots beyond --max-connections kept for quick requests (/healthz)"},
     {"max-body", "KMORPH_MAX_BODY", OPT_SIZE, F(max_body), 0, 1, 1e12,
      "request body bytes (larger: 413)"},
-    {"max-output", "KMORPH_MAX_OUTPUT", OPT_SIZE, F(max_output), 0, 1024,
-     1e13, "bytes of one answer, predicted before work (larger: 422)"},
-    {"body-memory", "KMORPH_BODY_MEMORY", OPT_SIZE, F(body_memory), 0, 1,
-     1e13, "bytes of all request bodies in flight (past it: 503)"},
-    {"result-memory", "KMORPH_RESULT_MEMORY", OPT_SIZE, F(result_memory), 0,
-     1, 1e13, "bytes of kept job results (oldest evicted: 410)"},
+    {"max-output", "KMORPH_MAX_OUTPUT", OPT_SIZE, F(max_output), 0, 1024, 1e13,
+     "bytes of one answer, predicted before work (larger: 422)"},
+    {"body-memory", "KMORPH_BODY_MEMORY", OPT_SIZE, F(body_memory), 0, 1, 1e13,
+     "bytes of all request bodies in flight (past it: 503)"},
+    {"result-memory", "KMORPH_RESULT_MEMORY", OPT_SIZE, F(result_memory), 0, 1,
+     1e13, "bytes of kept job results (oldest evicted: 410)"},
     {"max-points", "KMORPH_MAX_POINTS", OPT_SIZE, F(max_points), 0, 1, 1e9,
      "control points per curve, given or returned"},
     {"max-frames", "KMORPH_MAX_FRAMES", OPT_SIZE, F(max_frames), 0, 1, 1e9,
      "frames per POST /v1/morph"},
-    {"max-job-frames", "KMORPH_MAX_JOB_FRAMES", OPT_SIZE, F(max_job_frames),
-     0, 1, 1e9, "frames per POST /v1/jobs"},
+    {"max-job-frames", "KMORPH_MAX_JOB_FRAMES", OPT_SIZE, F(max_job_frames), 0,
+     1, 1e9, "frames per POST /v1/jobs"},
     {"max-samples", "KMORPH_MAX_SAMPLES", OPT_SIZE, F(max_samples), 0, 1, 1e9,
      "curvature samples per request"},
     {"max-jobs", "KMORPH_MAX_JOBS", OPT_UINT, F(max_jobs), 0, 1, 1000000,
@@ -83,10 +83,10 @@ static const opt_def OPTS[] = {
      "seconds a finished job stays readable"},
     {"job-keep", "KMORPH_JOB_KEEP", OPT_UINT, F(job_keep), 0, 1, 10000000,
      "finished jobs kept at most (oldest dropped)"},
-    {"shutdown-grace", "KMORPH_SHUTDOWN_GRACE", OPT_SECONDS,
-     F(shutdown_grace), 0, 0, 3600, "seconds to finish work on SIGTERM"},
-    {"retry-after", "KMORPH_RETRY_AFTER", OPT_UINT, F(retry_after), 0, 0,
-     3600, "Retry-After seconds sent with 429/503"},
+    {"shutdown-grace", "KMORPH_SHUTDOWN_GRACE", OPT_SECONDS, F(shutdown_grace),
+     0, 0, 3600, "seconds to finish work on SIGTERM"},
+    {"retry-after", "KMORPH_RETRY_AFTER", OPT_UINT, F(retry_after), 0, 0, 3600,
+     "Retry-After seconds sent with 429/503"},
     {"cors-origins", "KMORPH_CORS_ORIGINS", OPT_STR, F(cors_origins),
      sizeof(((srv_config *)0)->cors_origins), 0, 0,
      "allowed CORS origins, comma-separated; * = any; empty = none"},
@@ -102,8 +102,7 @@ static const opt_def OPTS[] = {
 #undef F
 #define NOPTS (sizeof OPTS / sizeof OPTS[0])
 
-void srv_config_default(srv_config *cfg)
-{
+void srv_config_default(srv_config *cfg) {
   memset(cfg, 0, sizeof *cfg);
   snprintf(cfg->bind, sizeof cfg->bind, "127.0.0.1");
   cfg->port = 8080;
@@ -138,30 +137,20 @@ void srv_config_default(srv_config *cfg)
   cfg->access_log = true;
 }
 
-static void print_default(FILE *out, const opt_def *o, const srv_config *d)
-{
+static void print_default(FILE *out, const opt_def *o, const srv_config *d) {
   const char *p = (const char *)d + o->offset;
   switch (o->kind) {
-  case OPT_STR:
-    fprintf(out, "\"%s\"", p);
-    break;
-  case OPT_UINT:
-    fprintf(out, "%u", *(const unsigned *)(const void *)p);
-    break;
-  case OPT_SIZE:
-    fprintf(out, "%zu", *(const size_t *)(const void *)p);
-    break;
-  case OPT_SECONDS:
-    fprintf(out, "%g", *(const double *)(const void *)p);
-    break;
+  case OPT_STR: fprintf(out, "\"%s\"", p); break;
+  case OPT_UINT: fprintf(out, "%u", *(const unsigned *)(const void *)p); break;
+  case OPT_SIZE: fprintf(out, "%zu", *(const size_t *)(const void *)p); break;
+  case OPT_SECONDS: fprintf(out, "%g", *(const double *)(const void *)p); break;
   case OPT_BOOL:
     fprintf(out, "%d", *(const bool *)(const void *)p ? 1 : 0);
     break;
   }
 }
 
-void srv_config_usage(FILE *out)
-{
+void srv_config_usage(FILE *out) {
   srv_config d;
   srv_config_default(&d);
   fprintf(out,
@@ -183,8 +172,7 @@ void srv_config_usage(FILE *out)
 }
 
 static int set_value(srv_config *cfg, const opt_def *o, const char *v,
-                     const char *from, FILE *err)
-{
+                     const char *from, FILE *err) {
   char *p = (char *)cfg + o->offset;
   if (o->kind == OPT_STR) {
     if (strlen(v) >= o->size) {
@@ -206,32 +194,22 @@ static int set_value(srv_config *cfg, const opt_def *o, const char *v,
     return -1;
   }
   if (x < o->min || x > o->max) {
-    fprintf(err, "kmorphd: %s: %s is out of range [%g, %g]\n", from, v,
-            o->min, o->max);
+    fprintf(err, "kmorphd: %s: %s is out of range [%g, %g]\n", from, v, o->min,
+            o->max);
     return -1;
   }
   switch (o->kind) {
-  case OPT_UINT:
-    *(unsigned *)(void *)p = (unsigned)x;
-    break;
-  case OPT_SIZE:
-    *(size_t *)(void *)p = (size_t)x;
-    break;
-  case OPT_SECONDS:
-    *(double *)(void *)p = x;
-    break;
-  case OPT_BOOL:
-    *(bool *)(void *)p = x != 0;
-    break;
-  case OPT_STR:
-    break;
+  case OPT_UINT: *(unsigned *)(void *)p = (unsigned)x; break;
+  case OPT_SIZE: *(size_t *)(void *)p = (size_t)x; break;
+  case OPT_SECONDS: *(double *)(void *)p = x; break;
+  case OPT_BOOL: *(bool *)(void *)p = x != 0; break;
+  case OPT_STR: break;
   }
   return 0;
 }
 
 int srv_config_load(srv_config *cfg, int argc, char **argv, FILE *out,
-                    FILE *err)
-{
+                    FILE *err) {
   for (size_t i = 0; i < NOPTS; i++) {
     const char *v = getenv(OPTS[i].env);
     if (v != NULL && set_value(cfg, &OPTS[i], v, OPTS[i].env, err) != 0)
@@ -256,7 +234,8 @@ int srv_config_load(srv_config *cfg, int argc, char **argv, FILE *out,
     size_t nlen = eq ? (size_t)(eq - name) : strlen(name);
     const opt_def *o = NULL;
     for (size_t i = 0; i < NOPTS; i++)
-      if (strlen(OPTS[i].flag) == nlen && strncmp(OPTS[i].flag, name, nlen) == 0)
+      if (strlen(OPTS[i].flag) == nlen &&
+          strncmp(OPTS[i].flag, name, nlen) == 0)
         o = &OPTS[i];
     if (o == NULL) {
       fprintf(err, "kmorphd: unknown flag \"%s\" (see --help)\n", arg);
@@ -271,8 +250,7 @@ int srv_config_load(srv_config *cfg, int argc, char **argv, FILE *out,
       fprintf(err, "kmorphd: --%s needs a value\n", o->flag);
       return -1;
     }
-    if (set_value(cfg, o, v, arg, err) != 0)
-      return -1;
+    if (set_value(cfg, o, v, arg, err) != 0) return -1;
   }
   return 0;
 }

@@ -22,17 +22,14 @@
 
 /* ---------------------------------------------------------------- target */
 
-void srv_http_target_scan(srv_http_target *t, const char *uri)
-{
+void srv_http_target_scan(srv_http_target *t, const char *uri) {
   memset(t, 0, sizeof *t);
-  if (uri == NULL)
-    return;
+  if (uri == NULL) return;
   t->raw = uri;
   t->len = strlen(uri);
   for (size_t i = 0; i < t->len; i++) {
     unsigned char c = (unsigned char)uri[i];
-    if (c < 0x21 || c == 0x7f)
-      t->control = true;
+    if (c < 0x21 || c == 0x7f) t->control = true;
     if (c == '%' && uri[i + 1] == '0' && uri[i + 2] == '0')
       t->nul_escape = true;
   }
@@ -40,15 +37,13 @@ void srv_http_target_scan(srv_http_target *t, const char *uri)
 
 /* ----------------------------------------------------------------- fields */
 
-static bool is_tchar(unsigned char c)
-{
+static bool is_tchar(unsigned char c) {
   return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
-         (c >= '0' && c <= '9') || (c != '\0' && strchr("!#$%&'*+-.^_`|~",
-                                                        c) != NULL);
+         (c >= '0' && c <= '9') ||
+         (c != '\0' && strchr("!#$%&'*+-.^_`|~", c) != NULL);
 }
 
-void srv_http_log_token(char *out, size_t n, const char *s)
-{
+void srv_http_log_token(char *out, size_t n, const char *s) {
   size_t k = 0;
   for (; s != NULL && s[k] != '\0' && k + 1 < n; k++)
     out[k] = is_tchar((unsigned char)s[k]) ? s[k] : '?';
@@ -58,28 +53,25 @@ void srv_http_log_token(char *out, size_t n, const char *s)
 typedef struct scan {
   srv_http_verdict *out;
   bool http11;
-  const char *lo, *hi; /* the header block in the read buffer, or NULL */
-  const char *prev_end; /* where the previous line's value ended */
+  const char *lo, *hi;   /* the header block in the read buffer, or NULL */
+  const char *prev_end;  /* where the previous line's value ended */
   const char *prev_name; /* and its name, NULL for the request line */
   size_t prev_name_len;
   unsigned hosts, lengths, codings;
   unsigned long long length;
   bool other_coding;
-  char coding[40];   /* the first coding other than chunked */
+  char coding[40]; /* the first coding other than chunked */
 } scan;
 
 /* Refuse with status and a detail; the first fault found is the one told. */
 static void refuse(scan *s, int status, const char *fmt, const char *name,
-                   size_t name_len)
-{
-  if (s->out->status != 0)
-    return;
+                   size_t name_len) {
+  if (s->out->status != 0) return;
   char shown[48];
   size_t k = 0;
   for (; k < name_len && k + 1 < sizeof shown; k++) {
     unsigned char c = (unsigned char)name[k];
-    shown[k] = (c >= 0x20 && c < 0x7f && c != '"' && c != '\\') ? (char)c
-                                                                : '?';
+    shown[k] = (c >= 0x20 && c < 0x7f && c != '"' && c != '\\') ? (char)c : '?';
   }
   shown[k] = '\0';
   s->out->status = status;
@@ -89,36 +81,27 @@ static void refuse(scan *s, int status, const char *fmt, const char *name,
 /* The bytes from a line's value end (its terminating NUL) to p are the
  * NULs of one line end (CR LF or LF), extra of them more allowed (the
  * empty line that ends the block). */
-static bool line_end_ok(const char *end, const char *p, size_t extra)
-{
-  if (p < end + 1 || (size_t)(p - end) > 2 + extra)
-    return false;
+static bool line_end_ok(const char *end, const char *p, size_t extra) {
+  if (p < end + 1 || (size_t)(p - end) > 2 + extra) return false;
   for (; end < p; end++)
-    if (*end != '\0')
-      return false;
+    if (*end != '\0') return false;
   return true;
 }
 
-static bool in_block(const scan *s, const char *p)
-{
+static bool in_block(const scan *s, const char *p) {
   return p >= s->lo && p < s->hi;
 }
 
 /* One transfer-coding list (RFC 9110 5.6.1: elements, OWS around commas). */
-static void codings(scan *s, const char *v, size_t n)
-{
+static void codings(scan *s, const char *v, size_t n) {
   size_t i = 0;
   while (i < n) {
-    while (i < n && (v[i] == ' ' || v[i] == '\t' || v[i] == ','))
-      i++;
+    while (i < n && (v[i] == ' ' || v[i] == '\t' || v[i] == ',')) i++;
     size_t b = i;
-    while (i < n && v[i] != ',')
-      i++;
+    while (i < n && v[i] != ',') i++;
     size_t e = i;
-    while (e > b && (v[e - 1] == ' ' || v[e - 1] == '\t'))
-      e--;
-    if (e == b)
-      continue;
+    while (e > b && (v[e - 1] == ' ' || v[e - 1] == '\t')) e--;
+    if (e == b) continue;
     s->codings++;
     bool chunked = e - b == 7 && strncasecmp(v + b, "chunked", 7) == 0;
     if (!chunked && !s->other_coding) {
@@ -128,8 +111,7 @@ static void codings(scan *s, const char *v, size_t n)
   }
 }
 
-static void content_length(scan *s, const char *v, size_t n)
-{
+static void content_length(scan *s, const char *v, size_t n) {
   unsigned long long x = 0;
   bool ok = n > 0 && n <= 19;
   for (size_t i = 0; ok && i < n; i++) {
@@ -140,8 +122,10 @@ static void content_length(scan *s, const char *v, size_t n)
     refuse(s, 400, "the Content-Length header is not a decimal number%s", "",
            0);
   else if (s->lengths > 0 && x != s->length)
-    refuse(s, 400, "the Content-Length header appears with different values"
-           "%s", "", 0);
+    refuse(s, 400,
+           "the Content-Length header appears with different values"
+           "%s",
+           "", 0);
   s->length = x;
   s->lengths++;
 }
@@ -149,21 +133,22 @@ static void content_length(scan *s, const char *v, size_t n)
 /* What lies after a value is not its line end: a NUL byte in the line, a
  * line libmicrohttpd did not list (an empty field name) or a folded
  * continuation. */
-static void line_refused(scan *s)
-{
+static void line_refused(scan *s) {
   if (s->prev_name == NULL)
-    refuse(s, 400, "the line after the request line has a NUL byte, an "
-           "empty field name or a folded continuation line%s", "", 0);
+    refuse(s, 400,
+           "the line after the request line has a NUL byte, an "
+           "empty field name or a folded continuation line%s",
+           "", 0);
   else
-    refuse(s, 400, "the %s header line, or the line after it, has a NUL "
+    refuse(s, 400,
+           "the %s header line, or the line after it, has a NUL "
            "byte, an empty field name or a folded continuation line",
            s->prev_name, s->prev_name_len);
 }
 
 static enum MHD_Result field(void *cls, enum MHD_ValueKind kind,
                              const char *name, size_t name_len,
-                             const char *value, size_t value_len)
-{
+                             const char *value, size_t value_len) {
   scan *s = cls;
   (void)kind;
   if (name_len == 0) {
@@ -172,15 +157,17 @@ static enum MHD_Result field(void *cls, enum MHD_ValueKind kind,
   }
   for (size_t i = 0; i < name_len; i++)
     if (!is_tchar((unsigned char)name[i])) {
-      refuse(s, 400, "the header field name \"%s\" is not a token "
-             "(whitespace before the colon?)", name, name_len);
+      refuse(s, 400,
+             "the header field name \"%s\" is not a token "
+             "(whitespace before the colon?)",
+             name, name_len);
       return MHD_NO;
     }
   for (size_t i = 0; value != NULL && i < value_len; i++) {
     unsigned char c = (unsigned char)value[i];
     if ((c < 0x20 && c != '\t') || c == 0x7f) {
-      refuse(s, 400, "the %s header has a control character in its value",
-             name, name_len);
+      refuse(s, 400, "the %s header has a control character in its value", name,
+             name_len);
       return MHD_NO;
     }
   }
@@ -211,33 +198,30 @@ static enum MHD_Result field(void *cls, enum MHD_ValueKind kind,
 /* The request line in the read buffer: method NUL, spaces, the target,
  * NUL, version, then its line end. */
 static bool request_line_ok(const scan *s, const char *method,
-                            const srv_http_target *t, const char *version)
-{
+                            const srv_http_target *t, const char *version) {
   const char *m_end = method + strlen(method);
   if (t->raw == NULL || !in_block(s, t->raw) || !in_block(s, version) ||
       t->raw <= m_end || *m_end != '\0')
     return false;
   for (const char *p = m_end + 1; p < t->raw; p++)
-    if (*p != ' ')
-      return false;
+    if (*p != ' ') return false;
   return version == t->raw + t->len + 1;
 }
 
 void srv_http_check(struct MHD_Connection *conn, const char *method,
                     const char *version, const srv_http_target *target,
-                    srv_http_verdict *out)
-{
+                    srv_http_verdict *out) {
   memset(out, 0, sizeof *out);
   scan s;
   memset(&s, 0, sizeof s);
   s.out = out;
   s.http11 = version != NULL && strcmp(version, "HTTP/1.1") == 0;
   if (target != NULL && target->nul_escape)
-    refuse(&s, 400, "the request target has %%00 (an encoded NUL byte)%s",
-           "", 0);
+    refuse(&s, 400, "the request target has %%00 (an encoded NUL byte)%s", "",
+           0);
   else if (target != NULL && target->control)
-    refuse(&s, 400, "the request target has a space or a control byte%s",
-           "", 0);
+    refuse(&s, 400, "the request target has a space or a control byte%s", "",
+           0);
 #if MHD_VERSION <= 0x00097500
   const union MHD_ConnectionInfo *ci =
       MHD_get_connection_info(conn, MHD_CONNECTION_INFO_REQUEST_HEADER_SIZE);
@@ -250,46 +234,46 @@ void srv_http_check(struct MHD_Connection *conn, const char *method,
       refuse(&s, 400, "the request line has a NUL byte%s", "", 0);
   }
 #endif
-  if (out->status != 0)
-    return;
+  if (out->status != 0) return;
   MHD_get_connection_values_n(conn, MHD_HEADER_KIND, field, &s);
-  if (out->status != 0)
-    return;
+  if (out->status != 0) return;
   if (s.lo != NULL && !line_end_ok(s.prev_end, s.hi, 2))
     line_refused(&s);
   else if (s.hosts == 0 && s.http11)
-    refuse(&s, 400, "the Host header is missing (HTTP/1.1 requires it)%s",
-           "", 0);
+    refuse(&s, 400, "the Host header is missing (HTTP/1.1 requires it)%s", "",
+           0);
   else if (s.hosts > 1)
     refuse(&s, 400, "the Host header appears more than once%s", "", 0);
   else if (s.codings > 0 && s.lengths > 0)
-    refuse(&s, 400, "both Content-Length and Transfer-Encoding headers: "
-           "the length of the body is ambiguous%s", "", 0);
-  else if (s.codings > 0 && !s.http11)
-    refuse(&s, 400, "the Transfer-Encoding header in an HTTP/1.0 request%s",
+    refuse(&s, 400,
+           "both Content-Length and Transfer-Encoding headers: "
+           "the length of the body is ambiguous%s",
            "", 0);
+  else if (s.codings > 0 && !s.http11)
+    refuse(&s, 400, "the Transfer-Encoding header in an HTTP/1.0 request%s", "",
+           0);
   else if (s.other_coding)
-    refuse(&s, 501, "the Transfer-Encoding header names %s; chunked is the "
-           "only transfer coding this service implements", s.coding,
-           strlen(s.coding));
+    refuse(&s, 501,
+           "the Transfer-Encoding header names %s; chunked is the "
+           "only transfer coding this service implements",
+           s.coding, strlen(s.coding));
   else if (s.codings > 1)
-    refuse(&s, 400, "the Transfer-Encoding header applies chunked more than "
-           "once%s", "", 0);
+    refuse(&s, 400,
+           "the Transfer-Encoding header applies chunked more than "
+           "once%s",
+           "", 0);
 }
 
 /* ------------------------------------------------------------------ probe */
 
-bool srv_http_fin_probe(int fd, bool http11, bool *sent)
-{
+bool srv_http_fin_probe(int fd, bool http11, bool *sent) {
   static const char CONTINUE[] = "HTTP/1.1 100 Continue\r\n\r\n";
   const size_t len = sizeof CONTINUE - 1;
   const int flags = MSG_DONTWAIT | MSG_NOSIGNAL;
-  if (!http11)
-    return false;
+  if (!http11) return false;
   if (!*sent) {
     ssize_t n = send(fd, CONTINUE, len, flags);
-    if (n < 0)
-      return errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR;
+    if (n < 0) return errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR;
     *sent = true;
     if ((size_t)n < len) {
       /* 25 bytes into an idle socket's send buffer: a partial write means
@@ -297,8 +281,7 @@ bool srv_http_fin_probe(int fd, bool http11, bool *sent)
        * answer, so a peer that cannot take it now counts as gone. */
       size_t rest = len - (size_t)n;
       n = send(fd, CONTINUE + (len - rest), rest, flags);
-      if (n < 0 || (size_t)n < rest)
-        return true;
+      if (n < 0 || (size_t)n < rest) return true;
     }
   }
   /* After a FIN, recv reports end of file even once a reset came (the

@@ -11,21 +11,19 @@
 /* 404 for a job never known (or deleted), 410 for one that was known and
  * is no longer kept, with why: a client must not take an expired or
  * evicted job for a mistyped id, nor resubmit blindly. */
-static enum MHD_Result job_missing(srv_req *r, int rc, const srv_job_view *v)
-{
+static enum MHD_Result job_missing(srv_req *r, int rc, const srv_job_view *v) {
   if (rc == SRV_STORE_GONE) {
     char detail[400];
     snprintf(detail, sizeof detail, "job %s is no longer kept: %s", r->job_id,
              v->error);
-    return srv__problem(r, 410, "/problems/job-gone", "Job gone", detail,
-                        NULL, NULL);
+    return srv__problem(r, 410, "/problems/job-gone", "Job gone", detail, NULL,
+                        NULL);
   }
   return srv__problem(r, 404, "/problems/job-not-found", "Job not found",
                       "no such job", NULL, NULL);
 }
 
-static enum MHD_Result delete_job(srv_req *r)
-{
+static enum MHD_Result delete_job(srv_req *r) {
   srv_server *s = r->srv;
   if (srv_jobs_cancel(s->jobs, r->job_id) == 0)
     return srv__answer(r, 204, NULL, (char *)"", 0, false);
@@ -38,20 +36,16 @@ static enum MHD_Result delete_job(srv_req *r)
                       NULL, NULL);
 }
 
-enum MHD_Result srv__serve_job(srv_req *r)
-{
+enum MHD_Result srv__serve_job(srv_req *r) {
   srv_server *s = r->srv;
   srv_job_view v;
   double now = srv_now();
-  if (strcmp(r->method, "DELETE") == 0)
-    return delete_job(r);
+  if (strcmp(r->method, "DELETE") == 0) return delete_job(r);
   int rc = s->store->ops->get(s->store, r->job_id, now, &v);
-  if (rc != SRV_STORE_OK)
-    return job_missing(r, rc, &v);
+  if (rc != SRV_STORE_OK) return job_missing(r, rc, &v);
   double progress =
       v.frames_total ? (double)v.frames_done / (double)v.frames_total : 0.0;
-  if (v.state == SRV_JOB_DONE)
-    progress = 1.0;
+  if (v.state == SRV_JOB_DONE) progress = 1.0;
   char err[600] = "";
   if (v.state == SRV_JOB_FAILED) {
     char esc[520];
@@ -69,13 +63,14 @@ enum MHD_Result srv__serve_job(srv_req *r)
       v.frames_total, v.age, v.id, v.id, err);
 }
 
-static void drop_result_ref(void *cls) { srv_result_unref(cls); }
+static void drop_result_ref(void *cls) {
+  srv_result_unref(cls);
+}
 
 /* A job's result, sent from the store's own copy: the answer holds a
  * reference until libmicrohttpd has sent it, so a slow reader costs no
  * memory of its own and an eviction meanwhile frees nothing under it. */
-static enum MHD_Result answer_result(srv_req *r, srv_result *res)
-{
+static enum MHD_Result answer_result(srv_req *r, srv_result *res) {
   size_t len = srv_result_length(res);
   struct MHD_Response *resp =
       MHD_create_response_from_buffer_with_free_callback_cls(
@@ -91,16 +86,13 @@ static enum MHD_Result answer_result(srv_req *r, srv_result *res)
   return srv__queue(r, status, resp, len);
 }
 
-enum MHD_Result srv__serve_result(srv_req *r)
-{
+enum MHD_Result srv__serve_result(srv_req *r) {
   srv_server *s = r->srv;
   srv_job_view v;
   srv_result *res = NULL;
   int rc = s->store->ops->result(s->store, r->job_id, srv_now(), &v, &res);
-  if (rc != SRV_STORE_OK)
-    return job_missing(r, rc, &v);
-  if (v.state == SRV_JOB_DONE && res != NULL)
-    return answer_result(r, res);
+  if (rc != SRV_STORE_OK) return job_missing(r, rc, &v);
+  if (v.state == SRV_JOB_DONE && res != NULL) return answer_result(r, res);
   srv_result_unref(res);
   char detail[400];
   if (v.state == SRV_JOB_FAILED)
@@ -110,8 +102,7 @@ enum MHD_Result srv__serve_result(srv_req *r)
   else
     snprintf(detail, sizeof detail,
              "the job is %s (%zu of %zu frames done); poll /v1/jobs/%s",
-             srv_job_state_name(v.state), v.frames_done, v.frames_total,
-             v.id);
+             srv_job_state_name(v.state), v.frames_done, v.frames_total, v.id);
   return srv__problem(r, 409, "/problems/job-not-done", "Result not ready",
                       detail, NULL, NULL);
 }

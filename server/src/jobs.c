@@ -33,11 +33,9 @@ struct srv_jobs {
 };
 
 srv_jobs *srv_jobs_create(srv_jobstore *store, size_t max_active,
-                          double job_time)
-{
+                          double job_time) {
   srv_jobs *j = calloc(1, sizeof *j);
-  if (j == NULL)
-    return NULL;
+  if (j == NULL) return NULL;
   pthread_mutex_init(&j->mu, NULL);
   j->store = store;
   j->max_active = max_active;
@@ -47,31 +45,28 @@ srv_jobs *srv_jobs_create(srv_jobstore *store, size_t max_active,
 
 /* Live = admitted and not yet final (cancelled or failed jobs that still
  * have frames in flight no longer count against the admission limit). */
-static size_t count_active(const srv_jobs *j)
-{
+static size_t count_active(const srv_jobs *j) {
   size_t n = 0;
   for (const job *p = j->first; p; p = p->next)
-    if (!p->cancelled && !p->failed)
-      n++;
+    if (!p->cancelled && !p->failed) n++;
   return n;
 }
 
-bool srv_jobs_full(srv_jobs *j)
-{
+bool srv_jobs_full(srv_jobs *j) {
   pthread_mutex_lock(&j->mu);
   bool full = count_active(j) >= j->max_active;
   pthread_mutex_unlock(&j->mu);
   return full;
 }
 
-double srv_jobs_time_limit(const srv_jobs *j) { return j->job_time; }
+double srv_jobs_time_limit(const srv_jobs *j) {
+  return j->job_time;
+}
 
 int srv_jobs_start(srv_jobs *j, api_morph_plan *plan, double deadline,
-                   size_t result_bytes, char id[SRV_JOB_ID_LEN + 1])
-{
+                   size_t result_bytes, char id[SRV_JOB_ID_LEN + 1]) {
   job *nj = calloc(1, sizeof *nj);
-  if (nj == NULL)
-    return -2;
+  if (nj == NULL) return -2;
   srv_random_hex(nj->id, SRV_JOB_ID_LEN);
   nj->plan = plan;
   nj->total = api_morph_frame_count(plan);
@@ -85,16 +80,15 @@ int srv_jobs_start(srv_jobs *j, api_morph_plan *plan, double deadline,
     free(nj);
     return rc;
   }
-  int st = j->store->ops->create(j->store, nj->id, nj->total, result_bytes,
-                                 now);
+  int st =
+      j->store->ops->create(j->store, nj->id, nj->total, result_bytes, now);
   if (st != SRV_STORE_OK) {
     pthread_mutex_unlock(&j->mu);
     free(nj);
     return st == SRV_STORE_FULL ? -4 : -2;
   }
   job **tail = &j->first;
-  while (*tail)
-    tail = &(*tail)->next;
+  while (*tail) tail = &(*tail)->next;
   *tail = nj;
   j->live++;
   /* Copied under the lock: once it is released a worker may render every
@@ -104,8 +98,7 @@ int srv_jobs_start(srv_jobs *j, api_morph_plan *plan, double deadline,
   return 0;
 }
 
-static void unlink_job(srv_jobs *j, job *x)
-{
+static void unlink_job(srv_jobs *j, job *x) {
   for (job **pp = &j->first; *pp; pp = &(*pp)->next)
     if (*pp == x) {
       *pp = x->next;
@@ -116,20 +109,17 @@ static void unlink_job(srv_jobs *j, job *x)
 
 /* Mark a job failed (lock held); the store learns at once. */
 static void fail_locked(srv_jobs *j, job *x, int status, const char *msg,
-                        double now)
-{
-  if (x->failed || x->cancelled)
-    return;
+                        double now) {
+  if (x->failed || x->cancelled) return;
   x->failed = true;
   atomic_store(&x->stop, true);
   x->fail_status = status;
   snprintf(x->fail_msg, sizeof x->fail_msg, "%s", msg);
-  j->store->ops->finish(j->store, x->id, SRV_JOB_FAILED, x->done, NULL,
-                        status, x->fail_msg, now);
+  j->store->ops->finish(j->store, x->id, SRV_JOB_FAILED, x->done, NULL, status,
+                        x->fail_msg, now);
 }
 
-static void out_of_time_locked(srv_jobs *j, job *x, double now)
-{
+static void out_of_time_locked(srv_jobs *j, job *x, double now) {
   char msg[160];
   snprintf(msg, sizeof msg,
            "the job ran out of time: wall-time limit %g s "
@@ -140,20 +130,16 @@ static void out_of_time_locked(srv_jobs *j, job *x, double now)
 
 /* A frame's stop condition, polled inside its computation: the job was
  * cancelled or failed, or its time is up. Reads no lock-guarded field. */
-static bool job_should_stop(void *ctx)
-{
+static bool job_should_stop(void *ctx) {
   job *x = ctx;
   return atomic_load(&x->stop) || srv_now() > x->deadline;
 }
 
 /* If nothing of x is in flight and it needs no more frames, take it off
  * the list (lock held); the caller then calls finalize outside the lock. */
-static bool take_if_over(srv_jobs *j, job *x)
-{
-  if (x->finishing || x->in_flight > 0)
-    return false;
-  if (!(x->cancelled || x->failed || x->done == x->total))
-    return false;
+static bool take_if_over(srv_jobs *j, job *x) {
+  if (x->finishing || x->in_flight > 0) return false;
+  if (!(x->cancelled || x->failed || x->done == x->total)) return false;
   x->finishing = true;
   unlink_job(j, x);
   return true;
@@ -161,8 +147,7 @@ static bool take_if_over(srv_jobs *j, job *x)
 
 /* Assemble the result of a completed job, or just drop a cancelled or
  * failed one (its final record was written when it stopped). */
-static void finalize(srv_jobs *j, job *x)
-{
+static void finalize(srv_jobs *j, job *x) {
   if (!x->cancelled && !x->failed) {
     api_response res;
     api_response_init(&res);
@@ -174,8 +159,7 @@ static void finalize(srv_jobs *j, job *x)
     } else {
       api_response_free(&res);
       char msg[96];
-      snprintf(msg, sizeof msg, "the result could not be assembled (%d)",
-               rc);
+      snprintf(msg, sizeof msg, "the result could not be assembled (%d)", rc);
       j->store->ops->finish(j->store, x->id, SRV_JOB_FAILED, x->done, NULL,
                             rc >= 400 ? rc : 500, msg, now);
     }
@@ -184,16 +168,14 @@ static void finalize(srv_jobs *j, job *x)
   free(x);
 }
 
-bool srv_jobs_work(void *ctx)
-{
+bool srv_jobs_work(void *ctx) {
   srv_jobs *j = ctx;
   job *x = NULL, *over = NULL;
   size_t i = 0;
   double now = srv_now();
   pthread_mutex_lock(&j->mu);
   for (job *p = j->first; p; p = p->next) {
-    if (p->cancelled || p->failed || p->next_frame >= p->total)
-      continue;
+    if (p->cancelled || p->failed || p->next_frame >= p->total) continue;
     if (now > p->deadline) {
       out_of_time_locked(j, p, now);
       if (take_if_over(j, p)) {
@@ -218,8 +200,7 @@ bool srv_jobs_work(void *ctx)
     finalize(j, over);
     return true;
   }
-  if (x == NULL)
-    return false;
+  if (x == NULL) return false;
 
   int rc = api_morph_render_frame_until(x->plan, i, job_should_stop, x);
 
@@ -241,46 +222,37 @@ bool srv_jobs_work(void *ctx)
   }
   bool take = take_if_over(j, x);
   pthread_mutex_unlock(&j->mu);
-  if (take)
-    finalize(j, x);
+  if (take) finalize(j, x);
   return true;
 }
 
-static void cancel_locked(srv_jobs *j, job *x, double now)
-{
-  if (x->cancelled || x->failed || x->finishing)
-    return;
+static void cancel_locked(srv_jobs *j, job *x, double now) {
+  if (x->cancelled || x->failed || x->finishing) return;
   x->cancelled = true;
   atomic_store(&x->stop, true);
   j->store->ops->finish(j->store, x->id, SRV_JOB_CANCELLED, x->done, NULL, 0,
                         NULL, now);
 }
 
-int srv_jobs_cancel(srv_jobs *j, const char *id)
-{
+int srv_jobs_cancel(srv_jobs *j, const char *id) {
   job *take = NULL;
   int rc = -1;
   pthread_mutex_lock(&j->mu);
   for (job *p = j->first; p; p = p->next) {
-    if (strcmp(p->id, id) != 0)
-      continue;
-    if (!p->cancelled && !p->failed && !p->finishing &&
-        p->done < p->total) {
+    if (strcmp(p->id, id) != 0) continue;
+    if (!p->cancelled && !p->failed && !p->finishing && p->done < p->total) {
       cancel_locked(j, p, srv_now());
       rc = 0;
-      if (take_if_over(j, p))
-        take = p;
+      if (take_if_over(j, p)) take = p;
     }
     break;
   }
   pthread_mutex_unlock(&j->mu);
-  if (take)
-    finalize(j, take);
+  if (take) finalize(j, take);
   return rc;
 }
 
-void srv_jobs_cancel_all(srv_jobs *j)
-{
+void srv_jobs_cancel_all(srv_jobs *j) {
   job *done_list = NULL;
   double now = srv_now();
   pthread_mutex_lock(&j->mu);
@@ -290,8 +262,9 @@ void srv_jobs_cancel_all(srv_jobs *j)
     next = p->next;
     if (p->done < p->total && !p->cancelled && !p->failed && !p->finishing) {
       /* one line per job, so every accepted job is accounted for */
-      fprintf(stderr, "kmorphd: job %s cancelled by shutdown (%zu/%zu frames)\n",
-              p->id, p->done, p->total);
+      fprintf(stderr,
+              "kmorphd: job %s cancelled by shutdown (%zu/%zu frames)\n", p->id,
+              p->done, p->total);
       cancel_locked(j, p, now);
     }
     if (take_if_over(j, p)) {
@@ -307,18 +280,15 @@ void srv_jobs_cancel_all(srv_jobs *j)
   }
 }
 
-size_t srv_jobs_live(srv_jobs *j)
-{
+size_t srv_jobs_live(srv_jobs *j) {
   pthread_mutex_lock(&j->mu);
   size_t n = j->live;
   pthread_mutex_unlock(&j->mu);
   return n;
 }
 
-void srv_jobs_destroy(srv_jobs *j)
-{
-  if (j == NULL)
-    return;
+void srv_jobs_destroy(srv_jobs *j) {
+  if (j == NULL) return;
   while (j->first) {
     job *p = j->first;
     j->first = p->next;

@@ -20,8 +20,7 @@ struct srv_result {
   api_response res;
 };
 
-srv_result *srv_result_wrap(api_response *res)
-{
+srv_result *srv_result_wrap(api_response *res) {
   srv_result *r = malloc(sizeof *r);
   if (r == NULL) {
     api_response_free(res);
@@ -33,26 +32,27 @@ srv_result *srv_result_wrap(api_response *res)
   return r;
 }
 
-srv_result *srv_result_ref(srv_result *r)
-{
-  if (r != NULL)
-    atomic_fetch_add(&r->refs, 1);
+srv_result *srv_result_ref(srv_result *r) {
+  if (r != NULL) atomic_fetch_add(&r->refs, 1);
   return r;
 }
 
-void srv_result_unref(srv_result *r)
-{
-  if (r == NULL || atomic_fetch_sub(&r->refs, 1) != 1)
-    return;
+void srv_result_unref(srv_result *r) {
+  if (r == NULL || atomic_fetch_sub(&r->refs, 1) != 1) return;
   api_response_free(&r->res);
   free(r);
 }
 
-const char *srv_result_body(const srv_result *r) { return r->res.body; }
-size_t srv_result_length(const srv_result *r) { return r->res.length; }
-int srv_result_status(const srv_result *r) { return r->res.status; }
-const char *srv_result_type(const srv_result *r)
-{
+const char *srv_result_body(const srv_result *r) {
+  return r->res.body;
+}
+size_t srv_result_length(const srv_result *r) {
+  return r->res.length;
+}
+int srv_result_status(const srv_result *r) {
+  return r->res.status;
+}
+const char *srv_result_type(const srv_result *r) {
   return r->res.content_type;
 }
 
@@ -91,34 +91,29 @@ typedef struct memstore {
 static const char *const STATE_NAMES[SRV_JOB_NSTATES] = {
     "queued", "running", "done", "failed", "cancelled"};
 
-const char *srv_job_state_name(srv_job_state s)
-{
+const char *srv_job_state_name(srv_job_state s) {
   return (unsigned)s < SRV_JOB_NSTATES ? STATE_NAMES[s] : "unknown";
 }
 
-bool srv_job_state_final(srv_job_state s)
-{
+bool srv_job_state_final(srv_job_state s) {
   return s == SRV_JOB_DONE || s == SRV_JOB_FAILED || s == SRV_JOB_CANCELLED;
 }
 
-static void remember_gone(memstore *m, const char *id, const char *why)
-{
+static void remember_gone(memstore *m, const char *id, const char *why) {
   gone *g = &m->ring[m->ring_next];
   m->ring_next = (m->ring_next + 1) % m->ring_cap;
   snprintf(g->id, sizeof g->id, "%s", id);
   snprintf(g->why, sizeof g->why, "%s", why);
 }
 
-static const gone *find_gone(const memstore *m, const char *id)
-{
+static const gone *find_gone(const memstore *m, const char *id) {
   for (size_t i = 0; i < m->ring_cap; i++)
     if (m->ring[i].id[0] != '\0' && strcmp(m->ring[i].id, id) == 0)
       return &m->ring[i];
   return NULL;
 }
 
-static void drop_result(memstore *m, rec *r)
-{
+static void drop_result(memstore *m, rec *r) {
   if (r->result != NULL) {
     m->used -= srv_result_length(r->result);
     srv_result_unref(r->result);
@@ -129,10 +124,8 @@ static void drop_result(memstore *m, rec *r)
 }
 
 /* Unlink and free r; why (may be NULL) is remembered for its id. */
-static void unlink_free(memstore *m, rec *r, const char *why)
-{
-  if (why != NULL)
-    remember_gone(m, r->id, why);
+static void unlink_free(memstore *m, rec *r, const char *why) {
+  if (why != NULL) remember_gone(m, r->id, why);
   if (r->prev)
     r->prev->next = r->next;
   else
@@ -147,15 +140,13 @@ static void unlink_free(memstore *m, rec *r, const char *why)
 
 /* Drop finished records older than ttl, then the oldest finished ones
  * beyond keep. Called with the lock held. */
-static void expire(memstore *m, double now)
-{
+static void expire(memstore *m, double now) {
   size_t finished = 0;
   rec *next;
   char why[160];
   for (rec *r = m->first; r; r = next) {
     next = r->next;
-    if (!srv_job_state_final(r->state))
-      continue;
+    if (!srv_job_state_final(r->state)) continue;
     if (now - r->finished >= m->ttl) {
       snprintf(why, sizeof why,
                "the job finished %.0f s ago; finished jobs are kept for "
@@ -181,8 +172,7 @@ static void expire(memstore *m, double now)
 
 /* Evict kept results, oldest first, until need more bytes fit. Returns
  * false if they cannot (live reservations fill the budget). */
-static bool make_room(memstore *m, size_t need)
-{
+static bool make_room(memstore *m, size_t need) {
   for (rec *r = m->first; r && m->used + need > m->budget; r = r->next)
     if (r->result != NULL) {
       drop_result(m, r);
@@ -191,16 +181,13 @@ static bool make_room(memstore *m, size_t need)
   return m->used + need <= m->budget;
 }
 
-static rec *find(memstore *m, const char *id)
-{
+static rec *find(memstore *m, const char *id) {
   for (rec *r = m->first; r; r = r->next)
-    if (strcmp(r->id, id) == 0)
-      return r;
+    if (strcmp(r->id, id) == 0) return r;
   return NULL;
 }
 
-static void view_of(const rec *r, double now, srv_job_view *v)
-{
+static void view_of(const rec *r, double now, srv_job_view *v) {
   memcpy(v->id, r->id, sizeof v->id);
   v->state = r->state;
   v->frames_done = r->frames_done;
@@ -212,11 +199,9 @@ static void view_of(const rec *r, double now, srv_job_view *v)
 
 /* Fill a view for a forgotten job. Returns SRV_STORE_GONE or
  * SRV_STORE_UNKNOWN. */
-static int lookup_gone(const memstore *m, const char *id, srv_job_view *v)
-{
+static int lookup_gone(const memstore *m, const char *id, srv_job_view *v) {
   const gone *g = find_gone(m, id);
-  if (g == NULL)
-    return SRV_STORE_UNKNOWN;
+  if (g == NULL) return SRV_STORE_UNKNOWN;
   memset(v, 0, sizeof *v);
   memcpy(v->id, g->id, sizeof v->id);
   snprintf(v->error, sizeof v->error, "%s", g->why);
@@ -224,12 +209,10 @@ static int lookup_gone(const memstore *m, const char *id, srv_job_view *v)
 }
 
 static int m_create(srv_jobstore *s, const char *id, size_t total,
-                    size_t result_bytes, double now)
-{
+                    size_t result_bytes, double now) {
   memstore *m = (memstore *)s;
   rec *r = calloc(1, sizeof *r);
-  if (r == NULL)
-    return -1;
+  if (r == NULL) return -1;
   snprintf(r->id, sizeof r->id, "%s", id);
   r->state = SRV_JOB_QUEUED;
   r->frames_total = total;
@@ -254,8 +237,7 @@ static int m_create(srv_jobstore *s, const char *id, size_t total,
 }
 
 static int m_get(srv_jobstore *s, const char *id, double now,
-                 srv_job_view *out)
-{
+                 srv_job_view *out) {
   memstore *m = (memstore *)s;
   int rc = SRV_STORE_OK;
   pthread_mutex_lock(&m->mu);
@@ -270,8 +252,7 @@ static int m_get(srv_jobstore *s, const char *id, double now,
 }
 
 static void m_progress(srv_jobstore *s, const char *id, srv_job_state state,
-                       size_t done, double now)
-{
+                       size_t done, double now) {
   memstore *m = (memstore *)s;
   (void)now;
   pthread_mutex_lock(&m->mu);
@@ -287,8 +268,7 @@ static void m_progress(srv_jobstore *s, const char *id, srv_job_state state,
  * The prediction is an upper bound, so the result fits its own
  * reservation; should it not, older results make room, and a result
  * that fits in no way is not kept. */
-static void keep_result(memstore *m, rec *r, api_response *result)
-{
+static void keep_result(memstore *m, rec *r, api_response *result) {
   size_t len = result->length;
   m->used -= r->reserved;
   r->reserved = 0;
@@ -306,8 +286,7 @@ static void keep_result(memstore *m, rec *r, api_response *result)
 
 static void m_finish(srv_jobstore *s, const char *id, srv_job_state state,
                      size_t done, api_response *result, int error_status,
-                     const char *error, double now)
-{
+                     const char *error, double now) {
   memstore *m = (memstore *)s;
   pthread_mutex_lock(&m->mu);
   rec *r = find(m, id);
@@ -324,13 +303,11 @@ static void m_finish(srv_jobstore *s, const char *id, srv_job_state state,
   }
   expire(m, now);
   pthread_mutex_unlock(&m->mu);
-  if (result != NULL)
-    api_response_free(result);
+  if (result != NULL) api_response_free(result);
 }
 
 static int m_result(srv_jobstore *s, const char *id, double now,
-                    srv_job_view *view, srv_result **out)
-{
+                    srv_job_view *view, srv_result **out) {
   memstore *m = (memstore *)s;
   int rc = SRV_STORE_OK;
   *out = NULL;
@@ -355,32 +332,25 @@ static int m_result(srv_jobstore *s, const char *id, double now,
   return rc;
 }
 
-static int m_remove(srv_jobstore *s, const char *id)
-{
+static int m_remove(srv_jobstore *s, const char *id) {
   memstore *m = (memstore *)s;
   pthread_mutex_lock(&m->mu);
   rec *r = find(m, id);
-  if (r)
-    unlink_free(m, r, NULL);
+  if (r) unlink_free(m, r, NULL);
   pthread_mutex_unlock(&m->mu);
   return r ? 0 : -1;
 }
 
-static void m_counts(srv_jobstore *s, double now,
-                     size_t out[SRV_JOB_NSTATES])
-{
+static void m_counts(srv_jobstore *s, double now, size_t out[SRV_JOB_NSTATES]) {
   memstore *m = (memstore *)s;
-  for (int i = 0; i < SRV_JOB_NSTATES; i++)
-    out[i] = 0;
+  for (int i = 0; i < SRV_JOB_NSTATES; i++) out[i] = 0;
   pthread_mutex_lock(&m->mu);
   expire(m, now);
-  for (rec *r = m->first; r; r = r->next)
-    out[r->state]++;
+  for (rec *r = m->first; r; r = r->next) out[r->state]++;
   pthread_mutex_unlock(&m->mu);
 }
 
-static size_t m_result_bytes(srv_jobstore *s)
-{
+static size_t m_result_bytes(srv_jobstore *s) {
   memstore *m = (memstore *)s;
   pthread_mutex_lock(&m->mu);
   size_t n = m->used;
@@ -388,28 +358,23 @@ static size_t m_result_bytes(srv_jobstore *s)
   return n;
 }
 
-static void m_destroy(srv_jobstore *s)
-{
+static void m_destroy(srv_jobstore *s) {
   memstore *m = (memstore *)s;
-  if (m == NULL)
-    return;
-  while (m->first)
-    unlink_free(m, m->first, NULL);
+  if (m == NULL) return;
+  while (m->first) unlink_free(m, m->first, NULL);
   pthread_mutex_destroy(&m->mu);
   free(m->ring);
   free(m);
 }
 
-static const srv_jobstore_ops MEM_OPS = {
-    m_create, m_get,    m_progress, m_finish,       m_result,
-    m_remove, m_counts, m_result_bytes, m_destroy};
+static const srv_jobstore_ops MEM_OPS = {m_create, m_get,          m_progress,
+                                         m_finish, m_result,       m_remove,
+                                         m_counts, m_result_bytes, m_destroy};
 
 srv_jobstore *srv_jobstore_memory_create(double ttl, size_t keep,
-                                         size_t result_budget)
-{
+                                         size_t result_budget) {
   memstore *m = calloc(1, sizeof *m);
-  if (m == NULL)
-    return NULL;
+  if (m == NULL) return NULL;
   /* Room to remember the forgotten for a few generations of kept jobs. */
   m->ring_cap = keep < GONE_RING_MAX / 4 ? 4 * keep + 16 : GONE_RING_MAX;
   m->ring = calloc(m->ring_cap, sizeof *m->ring);

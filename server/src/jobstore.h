@@ -46,9 +46,9 @@ typedef struct srv_job_view {
   char id[SRV_JOB_ID_LEN + 1];
   srv_job_state state;
   size_t frames_done, frames_total;
-  int error_status;  /* HTTP-style status of the failure, 0 if none */
-  char error[256];   /* why it failed, or why it is gone; "" if neither */
-  double age;        /* seconds since it was created */
+  int error_status; /* HTTP-style status of the failure, 0 if none */
+  char error[256];  /* why it failed, or why it is gone; "" if neither */
+  double age;       /* seconds since it was created */
 } srv_job_view;
 
 /* An immutable job result shared by the store and the answers being sent
@@ -68,8 +68,12 @@ const char *srv_result_type(const srv_result *r);
 
 /* Lookups of a record that is no longer kept (SRV_STORE_GONE) fill the
  * view's id and error (the reason) only. */
-enum { SRV_STORE_OK = 0, SRV_STORE_UNKNOWN = -1, SRV_STORE_GONE = -2,
-       SRV_STORE_FULL = -3 };
+enum {
+  SRV_STORE_OK = 0,
+  SRV_STORE_UNKNOWN = -1,
+  SRV_STORE_GONE = -2,
+  SRV_STORE_FULL = -3
+};
 
 typedef struct srv_jobstore srv_jobstore;
 
@@ -96,8 +100,8 @@ typedef struct srv_jobstore_ops {
   /* Copy the record into *view and, if it is done, give a reference to
    * its result in *out (the caller drops it with srv_result_unref; NULL
    * when not done). Returns as get does. */
-  int (*result)(srv_jobstore *s, const char *id, double now,
-                srv_job_view *view, srv_result **out);
+  int (*result)(srv_jobstore *s, const char *id, double now, srv_job_view *view,
+                srv_result **out);
   /* Forget a record. Returns 0, or -1 if it was unknown. */
   int (*remove)(srv_jobstore *s, const char *id);
   /* Records per state (expired ones dropped first). */

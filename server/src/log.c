@@ -35,13 +35,11 @@ struct srv_log {
   rl_slot slots[SRV_LOG_KINDS];
 };
 
-static int open_append(const char *path)
-{
+static int open_append(const char *path) {
   return open(path, O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0640);
 }
 
-srv_log *srv_log_open(const char *path, FILE *err)
-{
+srv_log *srv_log_open(const char *path, FILE *err) {
   srv_log *l = calloc(1, sizeof *l);
   if (l == NULL) {
     fprintf(err, "kmorphd: out of memory for the log\n");
@@ -61,10 +59,8 @@ srv_log *srv_log_open(const char *path, FILE *err)
     int rc = fd == STDERR_FILENO ? 0 : dup2(fd, STDERR_FILENO);
     if (rc < 0)
       fprintf(err, "kmorphd: --log-file \"%s\": %s\n", path, strerror(errno));
-    if (fd != STDERR_FILENO)
-      close(fd);
-    if (rc < 0)
-      goto fail;
+    if (fd != STDERR_FILENO) close(fd);
+    if (rc < 0) goto fail;
     snprintf(l->path, sizeof l->path, "%s", path);
   }
   return l;
@@ -74,22 +70,22 @@ fail:
   return NULL;
 }
 
-FILE *srv_log_stream(const srv_log *l) { return l->stream; }
+FILE *srv_log_stream(const srv_log *l) {
+  return l->stream;
+}
 
-const char *srv_log_path(const srv_log *l) { return l->path; }
+const char *srv_log_path(const srv_log *l) {
+  return l->path;
+}
 
-int srv_log_reopen(srv_log *l)
-{
-  if (l->path[0] == '\0')
-    return 0;
+int srv_log_reopen(srv_log *l) {
+  if (l->path[0] == '\0') return 0;
   int fd = open_append(l->path);
-  if (fd < 0)
-    return -1;
+  if (fd < 0) return -1;
   int rc = 1;
   flockfile(l->stream);
   fflush(l->stream);
-  if (dup2(fd, fileno(l->stream)) < 0)
-    rc = -1;
+  if (dup2(fd, fileno(l->stream)) < 0) rc = -1;
   int saved = errno;
   funlockfile(l->stream);
   close(fd);
@@ -97,8 +93,7 @@ int srv_log_reopen(srv_log *l)
   return rc;
 }
 
-void srv_log_printf(srv_log *l, const char *fmt, ...)
-{
+void srv_log_printf(srv_log *l, const char *fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
   vfprintf(l->stream, fmt, ap);
@@ -106,13 +101,11 @@ void srv_log_printf(srv_log *l, const char *fmt, ...)
 }
 
 /* The slot of kind, or the one to give it (free, else least recent). */
-static rl_slot *slot_for(srv_log *l, const void *kind)
-{
+static rl_slot *slot_for(srv_log *l, const void *kind) {
   rl_slot *pick = &l->slots[0];
   for (size_t i = 0; i < SRV_LOG_KINDS; i++) {
     rl_slot *sl = &l->slots[i];
-    if (sl->kind == kind)
-      return sl;
+    if (sl->kind == kind) return sl;
     if (pick->kind != NULL && (sl->kind == NULL || sl->last < pick->last))
       pick = sl;
   }
@@ -121,8 +114,7 @@ static rl_slot *slot_for(srv_log *l, const void *kind)
 }
 
 bool srv_log_admit(srv_log *l, const void *kind, const char *sample,
-                   unsigned long *suppressed)
-{
+                   unsigned long *suppressed) {
   double now = srv_now();
   bool ok;
   pthread_mutex_lock(&l->mu);
@@ -146,10 +138,8 @@ bool srv_log_admit(srv_log *l, const void *kind, const char *sample,
   return ok;
 }
 
-void srv_log_close(srv_log *l)
-{
-  if (l == NULL)
-    return;
+void srv_log_close(srv_log *l) {
+  if (l == NULL) return;
   pthread_mutex_lock(&l->mu);
   for (size_t i = 0; i < SRV_LOG_KINDS; i++) {
     const rl_slot *sl = &l->slots[i];

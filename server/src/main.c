@@ -32,27 +32,23 @@
 static const struct {
   int sig;
   const char *name;
-} SIGNALS[] = {{SIGTERM, "SIGTERM"}, {SIGINT, "SIGINT"},
-               {SIGHUP, "SIGHUP"},   {SIGUSR1, "SIGUSR1"},
-               {SIGUSR2, "SIGUSR2"}, {SIGALRM, "SIGALRM"},
+} SIGNALS[] = {{SIGTERM, "SIGTERM"},    {SIGINT, "SIGINT"},
+               {SIGHUP, "SIGHUP"},      {SIGUSR1, "SIGUSR1"},
+               {SIGUSR2, "SIGUSR2"},    {SIGALRM, "SIGALRM"},
                {SIGVTALRM, "SIGVTALRM"}};
 #define NSIGNALS (sizeof SIGNALS / sizeof SIGNALS[0])
 
-static const char *signal_name(int sig)
-{
+static const char *signal_name(int sig) {
   for (size_t i = 0; i < NSIGNALS; i++)
-    if (SIGNALS[i].sig == sig)
-      return SIGNALS[i].name;
+    if (SIGNALS[i].sig == sig) return SIGNALS[i].name;
   return "signal";
 }
 
 /* Block the answered signals (before any thread exists) and ignore the
  * ones whose only effect would be to kill the process on a write. */
-static void setup_signals(sigset_t *set)
-{
+static void setup_signals(sigset_t *set) {
   sigemptyset(set);
-  for (size_t i = 0; i < NSIGNALS; i++)
-    sigaddset(set, SIGNALS[i].sig);
+  for (size_t i = 0; i < NSIGNALS; i++) sigaddset(set, SIGNALS[i].sig);
   pthread_sigmask(SIG_BLOCK, set, NULL);
   struct sigaction ign;
   memset(&ign, 0, sizeof ign);
@@ -62,8 +58,7 @@ static void setup_signals(sigset_t *set)
   sigaction(SIGXFSZ, &ign, NULL);
 }
 
-static void reopen_log(srv_log *log)
-{
+static void reopen_log(srv_log *log) {
   int rc = srv_log_reopen(log);
   if (rc > 0)
     srv_log_printf(log, "kmorphd: SIGHUP: log file \"%s\" reopened\n",
@@ -78,14 +73,11 @@ static void reopen_log(srv_log *log)
 }
 
 /* Serve signals until one asks the daemon to stop; returns that one. */
-static int wait_for_stop(srv_log *log, const sigset_t *set)
-{
+static int wait_for_stop(srv_log *log, const sigset_t *set) {
   for (;;) {
     int sig = 0;
-    if (sigwait(set, &sig) != 0)
-      continue;
-    if (sig == SIGTERM || sig == SIGINT)
-      return sig;
+    if (sigwait(set, &sig) != 0) continue;
+    if (sig == SIGTERM || sig == SIGINT) return sig;
     if (sig == SIGHUP)
       reopen_log(log);
     else
@@ -96,14 +88,12 @@ static int wait_for_stop(srv_log *log, const sigset_t *set)
 
 /* Descriptors open now: new ones take the lowest free numbers, so EMFILE
  * comes when every number under the limit is taken. */
-static unsigned long open_fds(unsigned long limit)
-{
+static unsigned long open_fds(unsigned long limit) {
   unsigned long n = 0;
   DIR *d = opendir("/proc/self/fd");
   if (d != NULL) {
     const struct dirent *e;
-    while ((e = readdir(d)) != NULL)
-      n += e->d_name[0] != '.';
+    while ((e = readdir(d)) != NULL) n += e->d_name[0] != '.';
     closedir(d);
     return n > 0 ? n - 1 : 0; /* the directory's own descriptor */
   }
@@ -119,8 +109,7 @@ static unsigned long open_fds(unsigned long limit)
  * /proc/PID/fd), a file served from the web root per I/O thread, a
  * reopened log, and 8 spare. Returns 0, or -1 (with a message) when not
  * one connection per I/O thread fits. */
-static int fit_connections_to_fds(srv_config *cfg, srv_log *log)
-{
+static int fit_connections_to_fds(srv_config *cfg, srv_log *log) {
   struct rlimit rl;
   if (getrlimit(RLIMIT_NOFILE, &rl) != 0 || rl.rlim_cur == RLIM_INFINITY)
     return 0;
@@ -128,8 +117,7 @@ static int fit_connections_to_fds(srv_config *cfg, srv_log *log)
   unsigned long used = open_fds(limit) + 1 + 3ul * cfg->io_threads + 1 + 8;
   unsigned long room = limit > used ? limit - used : 0;
   unsigned long want = (unsigned long)cfg->max_connections + cfg->reserved;
-  if (room >= want)
-    return 0;
+  if (room >= want) return 0;
   if (room < 2ul * cfg->io_threads) {
     srv_log_printf(log,
                    "kmorphd: RLIMIT_NOFILE %lu leaves no descriptors for "
@@ -151,13 +139,11 @@ static int fit_connections_to_fds(srv_config *cfg, srv_log *log)
   return 0;
 }
 
-int main(int argc, char **argv)
-{
+int main(int argc, char **argv) {
   srv_config cfg;
   srv_config_default(&cfg);
   int rc = srv_config_load(&cfg, argc, argv, stdout, stderr);
-  if (rc != 0)
-    return rc > 0 ? 0 : 2;
+  if (rc != 0) return rc > 0 ? 0 : 2;
   if (cfg.workers == 0) {
     long n = sysconf(_SC_NPROCESSORS_ONLN);
     cfg.workers = n > 0 ? (unsigned)n : 1;
@@ -166,8 +152,7 @@ int main(int argc, char **argv)
   sigset_t set;
   setup_signals(&set);
   srv_log *log = srv_log_open(cfg.log_file, stderr);
-  if (log == NULL)
-    return 2;
+  if (log == NULL) return 2;
   srv_server *srv = fit_connections_to_fds(&cfg, log) == 0
                         ? srv_server_create(&cfg, log)
                         : NULL;

@@ -14,24 +14,24 @@
 #include <string.h>
 
 static const char *const ROUTE_NAMES[SRV_R_COUNT] = {
-    "index",  "healthz", "readyz",      "metrics", "openapi",
-    "signature", "reconstruct", "morph", "jobs",   "job",
-    "job_result", "static", "other"};
+    "index",      "healthz",     "readyz", "metrics", "openapi",
+    "signature",  "reconstruct", "morph",  "jobs",    "job",
+    "job_result", "static",      "other"};
 
 static const int STATUSES[] = {200, 202, 204, 400, 404, 405, 406, 409,
                                413, 415, 422, 429, 500, 503, 0};
 #define NSTATUS (sizeof STATUSES / sizeof STATUSES[0])
 
-static const double BUCKETS[] = {0.0005, 0.001, 0.0025, 0.005, 0.01, 0.025,
-                                 0.05,   0.1,   0.25,   0.5,   1,    2.5,
-                                 5,      10,    30};
+static const double BUCKETS[] = {0.0005, 0.001, 0.0025, 0.005, 0.01,
+                                 0.025,  0.05,  0.1,    0.25,  0.5,
+                                 1,      2.5,   5,      10,    30};
 #define NBUCKET (sizeof BUCKETS / sizeof BUCKETS[0])
 
 /* Why requests are refused to protect the daemon; an unknown reason counts
  * as the first. */
 static const char *const REASONS[] = {
-    "queue_full",    "jobs_full",    "morph_time",      "compute_time",
-    "body_memory",   "result_memory", "connections_full"};
+    "queue_full",  "jobs_full",     "morph_time",      "compute_time",
+    "body_memory", "result_memory", "connections_full"};
 #define NREASON (sizeof REASONS / sizeof REASONS[0])
 
 struct srv_metrics {
@@ -43,52 +43,41 @@ struct srv_metrics {
   unsigned long long rejected[NREASON];
 };
 
-const char *srv_route_name(srv_route r)
-{
+const char *srv_route_name(srv_route r) {
   return (unsigned)r < SRV_R_COUNT ? ROUTE_NAMES[r] : "other";
 }
 
-srv_metrics *srv_metrics_create(void)
-{
+srv_metrics *srv_metrics_create(void) {
   srv_metrics *m = calloc(1, sizeof *m);
-  if (m)
-    pthread_mutex_init(&m->mu, NULL);
+  if (m) pthread_mutex_init(&m->mu, NULL);
   return m;
 }
 
-void srv_metrics_destroy(srv_metrics *m)
-{
-  if (m == NULL)
-    return;
+void srv_metrics_destroy(srv_metrics *m) {
+  if (m == NULL) return;
   pthread_mutex_destroy(&m->mu);
   free(m);
 }
 
 void srv_metrics_observe(srv_metrics *m, srv_route route, int status,
-                         double seconds)
-{
-  if ((unsigned)route >= SRV_R_COUNT)
-    route = SRV_R_OTHER;
+                         double seconds) {
+  if ((unsigned)route >= SRV_R_COUNT) route = SRV_R_OTHER;
   size_t s = NSTATUS - 1;
   for (size_t i = 0; i + 1 < NSTATUS; i++)
-    if (STATUSES[i] == status)
-      s = i;
+    if (STATUSES[i] == status) s = i;
   pthread_mutex_lock(&m->mu);
   m->count[route][s]++;
   for (size_t b = 0; b < NBUCKET; b++)
-    if (seconds <= BUCKETS[b])
-      m->bucket[route][b]++;
+    if (seconds <= BUCKETS[b]) m->bucket[route][b]++;
   m->observed[route]++;
   m->sum[route] += seconds;
   pthread_mutex_unlock(&m->mu);
 }
 
-void srv_metrics_reject(srv_metrics *m, const char *reason)
-{
+void srv_metrics_reject(srv_metrics *m, const char *reason) {
   size_t k = 0;
   for (size_t i = 0; i < NREASON; i++)
-    if (strcmp(reason, REASONS[i]) == 0)
-      k = i;
+    if (strcmp(reason, REASONS[i]) == 0) k = i;
   pthread_mutex_lock(&m->mu);
   m->rejected[k]++;
   pthread_mutex_unlock(&m->mu);
@@ -100,10 +89,8 @@ typedef struct buf {
   int oom;
 } buf;
 
-static void put(buf *b, const char *fmt, ...)
-{
-  if (b->oom)
-    return;
+static void put(buf *b, const char *fmt, ...) {
+  if (b->oom) return;
   for (;;) {
     va_list ap;
     va_start(ap, fmt);
@@ -129,8 +116,7 @@ static void put(buf *b, const char *fmt, ...)
 }
 
 /* Requests answered, by route and status (m->mu held). */
-static void put_requests(buf *b, const srv_metrics *m)
-{
+static void put_requests(buf *b, const srv_metrics *m) {
   put(b, "# HELP kmorph_http_requests_total HTTP requests answered, by "
          "route and status.\n"
          "# TYPE kmorph_http_requests_total counter\n");
@@ -151,14 +137,12 @@ static void put_requests(buf *b, const srv_metrics *m)
 }
 
 /* The duration histogram of every route seen (m->mu held). */
-static void put_durations(buf *b, const srv_metrics *m)
-{
+static void put_durations(buf *b, const srv_metrics *m) {
   put(b, "# HELP kmorph_http_request_duration_seconds Time from request "
          "headers to response, by route.\n"
          "# TYPE kmorph_http_request_duration_seconds histogram\n");
   for (int r = 0; r < SRV_R_COUNT; r++) {
-    if (m->observed[r] == 0)
-      continue;
+    if (m->observed[r] == 0) continue;
     for (size_t k = 0; k < NBUCKET; k++)
       put(b,
           "kmorph_http_request_duration_seconds_bucket{route=\"%s\","
@@ -175,22 +159,19 @@ static void put_durations(buf *b, const srv_metrics *m)
 }
 
 /* Requests refused, by reason (m->mu held). */
-static void put_rejections(buf *b, const srv_metrics *m)
-{
-  put(b,
-      "# HELP kmorph_rejected_total Requests refused to protect the daemon: "
-      "at once because it was full (queue, jobs, memory for bodies or "
-      "results, connection slots), or a computation stopped at its time "
-      "limit.\n"
-      "# TYPE kmorph_rejected_total counter\n");
+static void put_rejections(buf *b, const srv_metrics *m) {
+  put(b, "# HELP kmorph_rejected_total Requests refused to protect the daemon: "
+         "at once because it was full (queue, jobs, memory for bodies or "
+         "results, connection slots), or a computation stopped at its time "
+         "limit.\n"
+         "# TYPE kmorph_rejected_total counter\n");
   for (size_t i = 0; i < NREASON; i++)
     put(b, "kmorph_rejected_total{reason=\"%s\"} %llu\n", REASONS[i],
         m->rejected[i]);
 }
 
 /* The caller's gauges, read at render time. */
-static void put_gauges(buf *b, const srv_gauges *g)
-{
+static void put_gauges(buf *b, const srv_gauges *g) {
   put(b,
       "# HELP kmorph_queue_depth Compute requests waiting for a worker.\n"
       "# TYPE kmorph_queue_depth gauge\n"
@@ -232,11 +213,9 @@ static void put_gauges(buf *b, const srv_gauges *g)
         g->jobs[s]);
 }
 
-char *srv_metrics_render(srv_metrics *m, const srv_gauges *g, size_t *len)
-{
+char *srv_metrics_render(srv_metrics *m, const srv_gauges *g, size_t *len) {
   buf b = {malloc(16384), 0, 16384, 0};
-  if (b.p == NULL)
-    return NULL;
+  if (b.p == NULL) return NULL;
   b.p[0] = '\0';
   pthread_mutex_lock(&m->mu);
   put_requests(&b, m);

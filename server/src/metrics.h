@@ -53,7 +53,7 @@ typedef struct srv_gauges {
   size_t connections;
   size_t body_bytes, result_bytes;  /* memory held in the two budgets */
   size_t late_requests, late_sends; /* connections cut by their deadlines */
-  size_t jobs[5]; /* by srv_job_state */
+  size_t jobs[5];                   /* by srv_job_state */
   const char *const *job_state_names;
 } srv_gauges;
 

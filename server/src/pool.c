@@ -25,8 +25,7 @@ struct srv_pool {
   size_t nthreads;
 };
 
-static void *worker_main(void *arg)
-{
+static void *worker_main(void *arg) {
   srv_pool *p = arg;
   pthread_mutex_lock(&p->mu);
   for (;;) {
@@ -43,8 +42,7 @@ static void *worker_main(void *arg)
       pthread_cond_broadcast(&p->cv); /* someone may wait for idleness */
       continue;
     }
-    if (p->stopping && p->reserved == 0)
-      break;
+    if (p->stopping && p->reserved == 0) break;
     if (!p->stopping && p->idle != NULL) {
       unsigned long seen = p->kicks;
       p->busy++;
@@ -52,8 +50,7 @@ static void *worker_main(void *arg)
       bool did = p->idle(p->idle_ctx);
       pthread_mutex_lock(&p->mu);
       p->busy--;
-      if (did || p->kicks != seen || p->count > 0)
-        continue;
+      if (did || p->kicks != seen || p->count > 0) continue;
     }
     pthread_cond_wait(&p->cv, &p->mu);
   }
@@ -62,29 +59,23 @@ static void *worker_main(void *arg)
 }
 
 srv_pool *srv_pool_create(size_t workers, size_t capacity, srv_idle_fn idle,
-                          void *idle_ctx)
-{
-  if (workers == 0 || capacity == 0)
-    return NULL;
+                          void *idle_ctx) {
+  if (workers == 0 || capacity == 0) return NULL;
   srv_pool *p = calloc(1, sizeof *p);
-  if (p == NULL)
-    return NULL;
+  if (p == NULL) return NULL;
   p->ring = calloc(capacity, sizeof *p->ring);
   p->threads = calloc(workers, sizeof *p->threads);
-  if (p->ring == NULL || p->threads == NULL)
-    goto fail;
+  if (p->ring == NULL || p->threads == NULL) goto fail;
   p->capacity = capacity;
   p->idle = idle;
   p->idle_ctx = idle_ctx;
   pthread_mutex_init(&p->mu, NULL);
   pthread_cond_init(&p->cv, NULL);
   for (size_t i = 0; i < workers; i++) {
-    if (pthread_create(&p->threads[i], NULL, worker_main, p) != 0)
-      break;
+    if (pthread_create(&p->threads[i], NULL, worker_main, p) != 0) break;
     p->nthreads++;
   }
-  if (p->nthreads == workers)
-    return p;
+  if (p->nthreads == workers) return p;
   srv_pool_destroy(p);
   return NULL;
 fail:
@@ -94,27 +85,23 @@ fail:
   return NULL;
 }
 
-bool srv_pool_reserve(srv_pool *p)
-{
+bool srv_pool_reserve(srv_pool *p) {
   bool ok;
   pthread_mutex_lock(&p->mu);
   ok = !p->stopping && p->count + p->reserved < p->capacity;
-  if (ok)
-    p->reserved++;
+  if (ok) p->reserved++;
   pthread_mutex_unlock(&p->mu);
   return ok;
 }
 
-void srv_pool_unreserve(srv_pool *p)
-{
+void srv_pool_unreserve(srv_pool *p) {
   pthread_mutex_lock(&p->mu);
   p->reserved--;
   pthread_cond_broadcast(&p->cv);
   pthread_mutex_unlock(&p->mu);
 }
 
-void srv_pool_submit(srv_pool *p, srv_task_fn fn, void *arg)
-{
+void srv_pool_submit(srv_pool *p, srv_task_fn fn, void *arg) {
   pthread_mutex_lock(&p->mu);
   p->reserved--;
   p->ring[(p->head + p->count) % p->capacity] = (task){fn, arg};
@@ -123,48 +110,45 @@ void srv_pool_submit(srv_pool *p, srv_task_fn fn, void *arg)
   pthread_mutex_unlock(&p->mu);
 }
 
-void srv_pool_kick(srv_pool *p)
-{
+void srv_pool_kick(srv_pool *p) {
   pthread_mutex_lock(&p->mu);
   p->kicks++;
   pthread_cond_broadcast(&p->cv);
   pthread_mutex_unlock(&p->mu);
 }
 
-size_t srv_pool_depth(srv_pool *p)
-{
+size_t srv_pool_depth(srv_pool *p) {
   pthread_mutex_lock(&p->mu);
   size_t n = p->count + p->reserved;
   pthread_mutex_unlock(&p->mu);
   return n;
 }
 
-size_t srv_pool_busy(srv_pool *p)
-{
+size_t srv_pool_busy(srv_pool *p) {
   pthread_mutex_lock(&p->mu);
   size_t n = p->busy;
   pthread_mutex_unlock(&p->mu);
   return n;
 }
 
-size_t srv_pool_workers(const srv_pool *p) { return p->nthreads; }
-size_t srv_pool_capacity(const srv_pool *p) { return p->capacity; }
+size_t srv_pool_workers(const srv_pool *p) {
+  return p->nthreads;
+}
+size_t srv_pool_capacity(const srv_pool *p) {
+  return p->capacity;
+}
 
-void srv_pool_stop(srv_pool *p)
-{
+void srv_pool_stop(srv_pool *p) {
   pthread_mutex_lock(&p->mu);
   p->stopping = true;
   pthread_cond_broadcast(&p->cv);
   pthread_mutex_unlock(&p->mu);
 }
 
-void srv_pool_destroy(srv_pool *p)
-{
-  if (p == NULL)
-    return;
+void srv_pool_destroy(srv_pool *p) {
+  if (p == NULL) return;
   srv_pool_stop(p);
-  for (size_t i = 0; i < p->nthreads; i++)
-    pthread_join(p->threads[i], NULL);
+  for (size_t i = 0; i < p->nthreads; i++) pthread_join(p->threads[i], NULL);
   pthread_mutex_destroy(&p->mu);
   pthread_cond_destroy(&p->cv);
   free(p->ring);

@@ -9,45 +9,36 @@
 #include "route.h"
 #include "util.h"
 
-srv_conn *srv__req_conn(const srv_req *r)
-{
+srv_conn *srv__req_conn(const srv_req *r) {
   const union MHD_ConnectionInfo *ci =
       MHD_get_connection_info(r->conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
   return ci ? ci->socket_context : NULL;
 }
 
 /* The origin to allow for this request, or NULL for no CORS headers. */
-static const char *cors_origin(const srv_req *r)
-{
-  const char *origin = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND,
-                                                   "Origin");
+static const char *cors_origin(const srv_req *r) {
+  const char *origin =
+      MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, "Origin");
   const char *list = r->srv->cfg.cors_origins;
-  if (origin == NULL || list[0] == '\0')
-    return NULL;
+  if (origin == NULL || list[0] == '\0') return NULL;
   size_t olen = strlen(origin);
   const char *p = list;
   while (*p) {
-    while (*p == ' ' || *p == ',')
-      p++;
+    while (*p == ' ' || *p == ',') p++;
     const char *e = p;
-    while (*e && *e != ',')
-      e++;
+    while (*e && *e != ',') e++;
     const char *t = e;
-    while (t > p && t[-1] == ' ')
-      t--;
+    while (t > p && t[-1] == ' ') t--;
     size_t n = (size_t)(t - p);
-    if (n == 1 && *p == '*')
-      return "*";
-    if (n > 0 && n == olen && strncmp(p, origin, n) == 0)
-      return origin;
+    if (n == 1 && *p == '*') return "*";
+    if (n > 0 && n == olen && strncmp(p, origin, n) == 0) return origin;
     p = e;
   }
   return NULL;
 }
 
 static void add_common_headers(srv_req *r, struct MHD_Response *resp,
-                               int status)
-{
+                               int status) {
   srv_server *s = r->srv;
   MHD_add_response_header(resp, "X-Request-Id", r->rid);
   const char *origin = cors_origin(r);
@@ -75,8 +66,7 @@ static void add_common_headers(srv_req *r, struct MHD_Response *resp,
 }
 
 enum MHD_Result srv__queue(srv_req *r, int status, struct MHD_Response *resp,
-                           size_t len)
-{
+                           size_t len) {
   add_common_headers(r, resp, status);
   if (r->location) {
     char loc[64];
@@ -93,13 +83,11 @@ enum MHD_Result srv__queue(srv_req *r, int status, struct MHD_Response *resp,
 }
 
 enum MHD_Result srv__answer(srv_req *r, int status, const char *ctype,
-                            char *body, size_t len, bool owned)
-{
+                            char *body, size_t len, bool owned) {
   struct MHD_Response *resp = MHD_create_response_from_buffer(
       len, body, owned ? MHD_RESPMEM_MUST_FREE : MHD_RESPMEM_PERSISTENT);
   if (resp == NULL) {
-    if (owned)
-      free(body);
+    if (owned) free(body);
     r->cut = "out of memory";
     return MHD_NO;
   }
@@ -108,8 +96,7 @@ enum MHD_Result srv__answer(srv_req *r, int status, const char *ctype,
   return srv__queue(r, status, resp, len);
 }
 
-enum MHD_Result srv__answer_api(srv_req *r, api_response *res)
-{
+enum MHD_Result srv__answer_api(srv_req *r, api_response *res) {
   if (res->body == NULL) {
     static const char oom[] =
         "{\"type\":\"/problems/internal\",\"title\":\"Out of memory\","
@@ -126,16 +113,14 @@ enum MHD_Result srv__answer_api(srv_req *r, api_response *res)
 
 enum MHD_Result srv__problem(srv_req *r, int status, const char *type,
                              const char *title, const char *detail,
-                             const char *pointer, const char *message)
-{
+                             const char *pointer, const char *message) {
   api_response res;
   api_response_init(&res);
   api_problem(&res, status, type, title, detail, pointer, message, r->rid);
   return srv__answer_api(r, &res);
 }
 
-enum MHD_Result srv__answer_json(srv_req *r, int status, const char *fmt, ...)
-{
+enum MHD_Result srv__answer_json(srv_req *r, int status, const char *fmt, ...) {
   char tmp[1024];
   va_list ap;
   va_start(ap, fmt);
@@ -145,18 +130,15 @@ enum MHD_Result srv__answer_json(srv_req *r, int status, const char *fmt, ...)
     return srv__problem(r, 500, "/problems/internal", "Internal error",
                         "response too long", NULL, NULL);
   char *body = malloc((size_t)n + 1);
-  if (body == NULL)
-    return MHD_NO;
+  if (body == NULL) return MHD_NO;
   memcpy(body, tmp, (size_t)n + 1);
   return srv__answer(r, status, SRV_JSON_TYPE, body, (size_t)n, true);
 }
 
-enum MHD_Result srv__answer_preflight(srv_req *r)
-{
+enum MHD_Result srv__answer_preflight(srv_req *r) {
   struct MHD_Response *resp =
       MHD_create_response_from_buffer(0, (void *)"", MHD_RESPMEM_PERSISTENT);
-  if (resp == NULL)
-    return MHD_NO;
+  if (resp == NULL) return MHD_NO;
   add_common_headers(r, resp, 204);
   const char *allow = srv__route_allowed_methods(r->route);
   MHD_add_response_header(resp, MHD_HTTP_HEADER_ALLOW, allow);

@@ -15,8 +15,7 @@
 
 /* ------------------------------------------------------- body budget */
 
-void srv__body_release(srv_req *r)
-{
+void srv__body_release(srv_req *r) {
   free(r->body);
   r->body = NULL;
   r->len = r->cap = 0;
@@ -26,14 +25,12 @@ void srv__body_release(srv_req *r)
 
 /* Count a body buffer of cap bytes in the budget of bodies in flight
  * (the whole daemon's): false, with nothing counted, if it does not fit. */
-static bool hold_body_bytes(srv_req *r, size_t cap)
-{
+static bool hold_body_bytes(srv_req *r, size_t cap) {
   srv_server *s = r->srv;
   size_t extra = cap > r->held ? cap - r->held : 0;
   size_t cur = atomic_load(&s->body_bytes);
   do {
-    if (cur + extra > s->cfg.body_memory)
-      return false;
+    if (cur + extra > s->cfg.body_memory) return false;
   } while (!atomic_compare_exchange_weak(&s->body_bytes, &cur, cur + extra));
   r->held += extra;
   return true;
@@ -42,8 +39,7 @@ static bool hold_body_bytes(srv_req *r, size_t cap)
 /* ---------------------------------------------------------- dispatch */
 
 /* The request is complete (headers and body): answer or hand it off. */
-static enum MHD_Result dispatch(srv_req *r)
-{
+static enum MHD_Result dispatch(srv_req *r) {
   srv_server *s = r->srv;
   if (r->too_large) {
     char detail[160];
@@ -62,38 +58,30 @@ static enum MHD_Result dispatch(srv_req *r)
                         NULL, NULL);
   }
   switch (r->route) {
-  case SRV_R_INDEX:
-    return srv__serve_file(r, "index.html");
-  case SRV_R_STATIC:
-    return srv__serve_file(r, r->static_name);
+  case SRV_R_INDEX: return srv__serve_file(r, "index.html");
+  case SRV_R_STATIC: return srv__serve_file(r, r->static_name);
   case SRV_R_HEALTHZ:
-    return srv__answer(r, 200, SRV_JSON_TYPE, (char *)"{\"status\":\"ok\"}",
-                       15, false);
+    return srv__answer(r, 200, SRV_JSON_TYPE, (char *)"{\"status\":\"ok\"}", 15,
+                       false);
   case SRV_R_READYZ:
     if (atomic_load(&s->draining))
       return srv__problem(r, 503, "/problems/shutting-down", "Shutting down",
                           "the service is stopping", NULL, NULL);
-    return srv__answer(r, 200, SRV_JSON_TYPE,
-                       (char *)"{\"status\":\"ready\"}", 18, false);
-  case SRV_R_METRICS:
-    return srv__serve_metrics(r);
+    return srv__answer(r, 200, SRV_JSON_TYPE, (char *)"{\"status\":\"ready\"}",
+                       18, false);
+  case SRV_R_METRICS: return srv__serve_metrics(r);
   case SRV_R_OPENAPI: {
     const char *doc = api_openapi_json();
-    return srv__answer(r, 200, SRV_JSON_TYPE, (char *)doc, strlen(doc),
-                       false);
+    return srv__answer(r, 200, SRV_JSON_TYPE, (char *)doc, strlen(doc), false);
   }
-  case SRV_R_JOB:
-    return srv__serve_job(r);
-  case SRV_R_JOB_RESULT:
-    return srv__serve_result(r);
+  case SRV_R_JOB: return srv__serve_job(r);
+  case SRV_R_JOB_RESULT: return srv__serve_result(r);
   case SRV_R_SIGNATURE:
   case SRV_R_RECONSTRUCT:
   case SRV_R_MORPH:
-  case SRV_R_JOBS:
-    return srv__hand_off(r);
+  case SRV_R_JOBS: return srv__hand_off(r);
   case SRV_R_OTHER:
-  case SRV_R_COUNT:
-    break;
+  case SRV_R_COUNT: break;
   }
   return srv__problem(r, 404, "/problems/not-found", "Not found",
                       "no such resource", NULL, NULL);
@@ -101,28 +89,23 @@ static enum MHD_Result dispatch(srv_req *r)
 
 /* ----------------------------------------------------------- headers */
 
-static bool json_content_type(const char *ct)
-{
+static bool json_content_type(const char *ct) {
   /* application/json, or any application/<x>+json, parameters allowed. */
   size_t n = strcspn(ct, ";");
-  while (n > 0 && (ct[n - 1] == ' ' || ct[n - 1] == '\t'))
-    n--;
-  if (n == 16 && strncasecmp(ct, "application/json", 16) == 0)
-    return true;
+  while (n > 0 && (ct[n - 1] == ' ' || ct[n - 1] == '\t')) n--;
+  if (n == 16 && strncasecmp(ct, "application/json", 16) == 0) return true;
   return n > 17 && strncasecmp(ct, "application/", 12) == 0 &&
          strncasecmp(ct + n - 5, "+json", 5) == 0;
 }
 
 /* The headers are in: refuse what can be refused before the body. Returns
  * MHD_YES with nothing queued to receive the body. */
-static enum MHD_Result on_headers(srv_req *r)
-{
+static enum MHD_Result on_headers(srv_req *r) {
   srv_server *s = r->srv;
   if (r->route == SRV_R_OTHER)
     return srv__problem(r, 404, "/problems/not-found", "Not found",
                         "no such resource", NULL, NULL);
-  if (strcmp(r->method, "OPTIONS") == 0)
-    return srv__answer_preflight(r);
+  if (strcmp(r->method, "OPTIONS") == 0) return srv__answer_preflight(r);
   if (!srv__route_method_allowed(r->route, r->method)) {
     char detail[128];
     snprintf(detail, sizeof detail, "%s is not allowed here; allowed: %s",
@@ -142,11 +125,10 @@ static enum MHD_Result on_headers(srv_req *r)
     }
     const char *accept = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND,
                                                      MHD_HTTP_HEADER_ACCEPT);
-    if (accept != NULL && (r->accept = strdup(accept)) == NULL)
-      return MHD_NO;
+    if (accept != NULL && (r->accept = strdup(accept)) == NULL) return MHD_NO;
   }
-  const char *cl = MHD_lookup_connection_value(
-      r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
+  const char *cl = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND,
+                                               MHD_HTTP_HEADER_CONTENT_LENGTH);
   if (cl != NULL) {
     char *end = NULL;
     unsigned long long n = strtoull(cl, &end, 10);
@@ -170,8 +152,7 @@ static enum MHD_Result on_headers(srv_req *r)
 /* -------------------------------------------------------------- body */
 
 /* Collect a body chunk (for compute routes) or count it (others). */
-static enum MHD_Result on_body(srv_req *r, const char *data, size_t size)
-{
+static enum MHD_Result on_body(srv_req *r, const char *data, size_t size) {
   srv_server *s = r->srv;
   if (srv_now() - r->t0 > s->cfg.request_time) {
     /* A client trickling its body cannot hold the connection: MHD's idle
@@ -185,14 +166,11 @@ static enum MHD_Result on_body(srv_req *r, const char *data, size_t size)
     srv__body_release(r);
     return MHD_YES;
   }
-  if (!srv__route_is_compute(r->route) || r->no_memory)
-    return MHD_YES;
+  if (!srv__route_is_compute(r->route) || r->no_memory) return MHD_YES;
   if (r->len + size + 1 > r->cap) {
     size_t ncap = r->cap ? r->cap : 4096;
-    while (ncap < r->len + size + 1)
-      ncap *= 2;
-    if (ncap > s->cfg.max_body + 1)
-      ncap = s->cfg.max_body + 1;
+    while (ncap < r->len + size + 1) ncap *= 2;
+    if (ncap > s->cfg.max_body + 1) ncap = s->cfg.max_body + 1;
     if (r->held >= r->len + size + 1 && ncap > r->held)
       ncap = r->held; /* the declared length, counted already */
     if (!hold_body_bytes(r, ncap)) {
@@ -221,10 +199,8 @@ static enum MHD_Result on_body(srv_req *r, const char *data, size_t size)
 /* The record of a request whose headers are in: r is the one the URI log
  * callback started (NULL if it ran out of memory). */
 static srv_req *req_new(srv_server *s, struct MHD_Connection *c,
-                        const char *url, const char *method, srv_req *r)
-{
-  if (r == NULL && (r = calloc(1, sizeof *r)) == NULL)
-    return NULL;
+                        const char *url, const char *method, srv_req *r) {
+  if (r == NULL && (r = calloc(1, sizeof *r)) == NULL) return NULL;
   r->begun = true;
   r->srv = s;
   r->conn = c;
@@ -250,8 +226,7 @@ static srv_req *req_new(srv_server *s, struct MHD_Connection *c,
 
 /* A request other than a probe on a reserved slot: every ordinary slot is
  * taken. */
-static enum MHD_Result reserved_refusal(srv_req *r)
-{
+static enum MHD_Result reserved_refusal(srv_req *r) {
   srv_metrics_reject(r->srv->metrics, "connections_full");
   return srv__problem(r, 503, "/problems/overloaded", "Overloaded",
                       "every connection slot is taken "
@@ -266,11 +241,9 @@ static enum MHD_Result reserved_refusal(srv_req *r)
  * requests on reserved slots and what on_headers refuses. */
 static enum MHD_Result on_first_call(srv_server *s, struct MHD_Connection *c,
                                      const char *url, const char *method,
-                                     const char *version, void **req_cls)
-{
+                                     const char *version, void **req_cls) {
   srv_req *r = req_new(s, c, url, method, *req_cls);
-  if (r == NULL)
-    return MHD_NO;
+  if (r == NULL) return MHD_NO;
   *req_cls = r;
   r->http11 = version != NULL && strcmp(version, "HTTP/1.1") == 0;
   srv_watch_header_done(srv__req_conn(r), r->t0);
@@ -283,8 +256,8 @@ static enum MHD_Result on_first_call(srv_server *s, struct MHD_Connection *c,
     return v.status == 501
                ? srv__problem(r, 501, "/problems/not-implemented",
                               "Not implemented", v.detail, NULL, NULL)
-               : srv__problem(r, 400, "/problems/bad-request",
-                              "Bad request", v.detail, NULL, NULL);
+               : srv__problem(r, 400, "/problems/bad-request", "Bad request",
+                              v.detail, NULL, NULL);
   }
   if (srv_conn_reserved(srv__req_conn(r)) && !srv__route_is_probe(r->route))
     return reserved_refusal(r);
@@ -294,8 +267,7 @@ static enum MHD_Result on_first_call(srv_server *s, struct MHD_Connection *c,
 enum MHD_Result srv__on_request(void *cls, struct MHD_Connection *c,
                                 const char *url, const char *method,
                                 const char *version, const char *upload,
-                                size_t *upload_size, void **req_cls)
-{
+                                size_t *upload_size, void **req_cls) {
   srv_server *s = cls;
   srv_req *r = *req_cls;
   if (r == NULL || !r->begun)
@@ -308,25 +280,21 @@ enum MHD_Result srv__on_request(void *cls, struct MHD_Connection *c,
     return on_body(r, upload, n);
   }
   switch (atomic_load(&r->phase)) {
-  case PH_BODY:
-    return dispatch(r);
+  case PH_BODY: return dispatch(r);
   case PH_READY:
     atomic_fetch_sub(&s->suspended, 1);
     r->counted = false;
     return srv__answer_api(r, &r->resp);
-  case PH_WAIT:     /* not reached: MHD does not call while suspended */
-  case PH_ANSWERED: /* already queued */
-    break;
+  case PH_WAIT: /* not reached: MHD does not call while suspended */
+  case PH_ANSWERED: /* already queued */ break;
   }
   return MHD_YES;
 }
 
-void *srv__on_uri(void *cls, const char *uri, struct MHD_Connection *c)
-{
+void *srv__on_uri(void *cls, const char *uri, struct MHD_Connection *c) {
   (void)c;
   srv_req *r = calloc(1, sizeof *r);
-  if (r == NULL)
-    return NULL;
+  if (r == NULL) return NULL;
   r->srv = cls;
   srv_http_target_scan(&r->target, uri);
   return r;

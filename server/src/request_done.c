@@ -10,11 +10,10 @@
 
 /* Why the connection was closed without a complete answer, or NULL. */
 static const char *closed_why(const srv_req *r,
-                              enum MHD_RequestTerminationCode toe)
-{
+                              enum MHD_RequestTerminationCode toe) {
   if (r->cut != NULL || toe == MHD_REQUEST_TERMINATED_COMPLETED_OK)
     return r->cut;
-  return toe == MHD_REQUEST_TERMINATED_TIMEOUT_REACHED    ? "idle timeout"
+  return toe == MHD_REQUEST_TERMINATED_TIMEOUT_REACHED   ? "idle timeout"
          : toe == MHD_REQUEST_TERMINATED_DAEMON_SHUTDOWN ? "shutdown"
          : toe == MHD_REQUEST_TERMINATED_CLIENT_ABORT    ? "client closed"
                                                          : "connection error";
@@ -22,8 +21,7 @@ static const char *closed_why(const srv_req *r,
 
 /* One access log line for r, which took dt seconds. */
 static void log_access(srv_server *s, const srv_req *r, double dt,
-                       const char *why)
-{
+                       const char *why) {
   char when[32];
   time_t now = time(NULL);
   struct tm tm;
@@ -39,13 +37,11 @@ static void log_access(srv_server *s, const srv_req *r, double dt,
 }
 
 void srv__on_completed(void *cls, struct MHD_Connection *c, void **req_cls,
-                       enum MHD_RequestTerminationCode toe)
-{
+                       enum MHD_RequestTerminationCode toe) {
   srv_server *s = cls;
   srv_req *r = *req_cls;
   (void)c;
-  if (r == NULL)
-    return;
+  if (r == NULL) return;
   *req_cls = NULL;
   if (!r->begun) { /* refused by libmicrohttpd before the handler ran */
     free(r);
@@ -53,14 +49,12 @@ void srv__on_completed(void *cls, struct MHD_Connection *c, void **req_cls,
   }
   /* A client that left while its request computed: MHD completes the
    * resumed connection without calling the handler again. */
-  if (r->counted)
-    atomic_fetch_sub(&s->suspended, 1);
+  if (r->counted) atomic_fetch_sub(&s->suspended, 1);
   srv_watch_request_done(srv__req_conn(r), srv_now());
   double dt = srv_now() - r->t0;
   const char *why = closed_why(r, toe);
   srv_metrics_observe(s->metrics, r->route, r->status ? r->status : 0, dt);
-  if (s->cfg.access_log)
-    log_access(s, r, dt, why);
+  if (s->cfg.access_log) log_access(s, r, dt, why);
   api_response_free(&r->resp);
   srv__body_release(r);
   free(r->accept);

@@ -10,11 +10,9 @@ static const char *const ALLOW_POST = "POST, OPTIONS";
 static const char *const ALLOW_JOB = "GET, DELETE, OPTIONS";
 static const char *const ALLOW_RESULT = "GET, OPTIONS";
 
-static bool static_name_ok(const char *n)
-{
+static bool static_name_ok(const char *n) {
   size_t k = 0;
-  if (n[0] == '\0' || n[0] == '.')
-    return false;
+  if (n[0] == '\0' || n[0] == '.') return false;
   for (; n[k]; k++) {
     char c = n[k];
     if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
@@ -25,8 +23,7 @@ static bool static_name_ok(const char *n)
   return true;
 }
 
-srv_route srv__route_parse(srv_req *r, const char *url)
-{
+srv_route srv__route_parse(srv_req *r, const char *url) {
   static const struct {
     const char *path;
     srv_route route;
@@ -47,8 +44,7 @@ srv_route srv__route_parse(srv_req *r, const char *url)
     url = path != NULL ? path : "/";
   }
   for (size_t i = 0; i < sizeof FIXED / sizeof FIXED[0]; i++)
-    if (strcmp(url, FIXED[i].path) == 0)
-      return FIXED[i].route;
+    if (strcmp(url, FIXED[i].path) == 0) return FIXED[i].route;
   const char *prefix = "/v1/jobs/";
   if (strncmp(url, prefix, strlen(prefix)) == 0) {
     const char *id = url + strlen(prefix);
@@ -58,10 +54,8 @@ srv_route srv__route_parse(srv_req *r, const char *url)
       return SRV_R_OTHER; /* cannot name a job: plain 404 */
     memcpy(r->job_id, id, n);
     r->job_id[n] = '\0';
-    if (slash == NULL)
-      return SRV_R_JOB;
-    if (strcmp(slash, "/result") == 0)
-      return SRV_R_JOB_RESULT;
+    if (slash == NULL) return SRV_R_JOB;
+    if (strcmp(slash, "/result") == 0) return SRV_R_JOB_RESULT;
     return SRV_R_OTHER;
   }
   if (url[0] == '/' && strchr(url + 1, '/') == NULL &&
@@ -72,48 +66,37 @@ srv_route srv__route_parse(srv_req *r, const char *url)
   return SRV_R_OTHER;
 }
 
-const char *srv__route_allowed_methods(srv_route route)
-{
+const char *srv__route_allowed_methods(srv_route route) {
   switch (route) {
   case SRV_R_SIGNATURE:
   case SRV_R_RECONSTRUCT:
   case SRV_R_MORPH:
-  case SRV_R_JOBS:
-    return ALLOW_POST;
-  case SRV_R_JOB:
-    return ALLOW_JOB;
-  case SRV_R_JOB_RESULT:
-    return ALLOW_RESULT;
-  default:
-    return ALLOW_GET;
+  case SRV_R_JOBS: return ALLOW_POST;
+  case SRV_R_JOB: return ALLOW_JOB;
+  case SRV_R_JOB_RESULT: return ALLOW_RESULT;
+  default: return ALLOW_GET;
   }
 }
 
-bool srv__route_method_allowed(srv_route route, const char *method)
-{
+bool srv__route_method_allowed(srv_route route, const char *method) {
   switch (route) {
   case SRV_R_SIGNATURE:
   case SRV_R_RECONSTRUCT:
   case SRV_R_MORPH:
-  case SRV_R_JOBS:
-    return strcmp(method, "POST") == 0;
+  case SRV_R_JOBS: return strcmp(method, "POST") == 0;
   case SRV_R_JOB:
     return strcmp(method, "GET") == 0 || strcmp(method, "DELETE") == 0;
-  case SRV_R_JOB_RESULT:
-    return strcmp(method, "GET") == 0;
-  default:
-    return strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0;
+  case SRV_R_JOB_RESULT: return strcmp(method, "GET") == 0;
+  default: return strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0;
   }
 }
 
-bool srv__route_is_compute(srv_route route)
-{
+bool srv__route_is_compute(srv_route route) {
   return route == SRV_R_SIGNATURE || route == SRV_R_RECONSTRUCT ||
          route == SRV_R_MORPH || route == SRV_R_JOBS;
 }
 
-bool srv__route_is_probe(srv_route route)
-{
+bool srv__route_is_probe(srv_route route) {
   return route == SRV_R_HEALTHZ || route == SRV_R_READYZ ||
          route == SRV_R_METRICS;
 }

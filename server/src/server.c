@@ -30,8 +30,7 @@
 /* Connections open and close: their watch records (watch.h). */
 static void on_connection(void *cls, struct MHD_Connection *c,
                           void **socket_context,
-                          enum MHD_ConnectionNotificationCode code)
-{
+                          enum MHD_ConnectionNotificationCode code) {
   srv_server *s = cls;
   if (code == MHD_CONNECTION_NOTIFY_STARTED) {
     const union MHD_ConnectionInfo *ci =
@@ -54,14 +53,12 @@ static const double ACCEPT_PAUSE = 0.25;
  * closes; an I/O thread without any would retry at once for ever ("at
  * FIRST connection"), so that thread, having nothing else to serve,
  * pauses here. */
-static void mhd_log(void *cls, const char *fmt, va_list ap)
-{
+static void mhd_log(void *cls, const char *fmt, va_list ap) {
   srv_server *s = cls;
   char msg[512];
   vsnprintf(msg, sizeof msg, fmt, ap);
   size_t n = strlen(msg);
-  while (n > 0 && msg[n - 1] == '\n')
-    msg[--n] = '\0';
+  while (n > 0 && msg[n - 1] == '\n') msg[--n] = '\0';
   unsigned long more = 0;
   if (srv_log_admit(s->logger, fmt, msg, &more)) {
     if (more > 0)
@@ -69,17 +66,14 @@ static void mhd_log(void *cls, const char *fmt, va_list ap)
     else
       fprintf(s->log, "kmorphd: http: %s\n", msg);
   }
-  if (strstr(fmt, "resource limit at FIRST") != NULL)
-    srv_sleep(ACCEPT_PAUSE);
+  if (strstr(fmt, "resource limit at FIRST") != NULL) srv_sleep(ACCEPT_PAUSE);
 }
 
 /* -------------------------------------------------------- life cycle */
 
-srv_server *srv_server_create(const srv_config *cfg, srv_log *logger)
-{
+srv_server *srv_server_create(const srv_config *cfg, srv_log *logger) {
   srv_server *s = calloc(1, sizeof *s);
-  if (s == NULL)
-    return NULL;
+  if (s == NULL) return NULL;
   s->cfg = *cfg;
   s->logger = logger;
   s->log = srv_log_stream(logger);
@@ -97,21 +91,21 @@ srv_server *srv_server_create(const srv_config *cfg, srv_log *logger)
   s->api.max_samples = cfg->max_samples;
   s->api.max_output_bytes = cfg->max_output;
   s->metrics = srv_metrics_create();
-  srv_watch_limits wl = {
-      .header_time = cfg->header_time,
-      .request_time = cfg->request_time,
-      .send_time = cfg->send_time,
-      .idle_time = (double)cfg->timeout,
-      /* a probe sends its few header bytes at once */
-      .reserved_header_time = cfg->header_time < 1.0 ? cfg->header_time : 1.0,
-      .normal = cfg->max_connections};
+  srv_watch_limits wl = {.header_time = cfg->header_time,
+                         .request_time = cfg->request_time,
+                         .send_time = cfg->send_time,
+                         .idle_time = (double)cfg->timeout,
+                         /* a probe sends its few header bytes at once */
+                         .reserved_header_time =
+                             cfg->header_time < 1.0 ? cfg->header_time : 1.0,
+                         .normal = cfg->max_connections};
   s->watch = srv_watch_create(&wl, s->log);
   s->store = srv_jobstore_memory_create(cfg->job_ttl, cfg->job_keep,
                                         cfg->result_memory);
-  s->jobs = s->store ? srv_jobs_create(s->store, cfg->max_jobs, cfg->job_time)
-                     : NULL;
-  s->pool = s->jobs ? srv_pool_create(cfg->workers, cfg->queue,
-                                      srv_jobs_work, s->jobs)
+  s->jobs =
+      s->store ? srv_jobs_create(s->store, cfg->max_jobs, cfg->job_time) : NULL;
+  s->pool = s->jobs ? srv_pool_create(cfg->workers, cfg->queue, srv_jobs_work,
+                                      s->jobs)
                     : NULL;
   if (s->metrics == NULL || s->pool == NULL || s->watch == NULL) {
     fprintf(s->log, "kmorphd: cannot create the compute pool (%u workers)\n",
@@ -122,8 +116,7 @@ srv_server *srv_server_create(const srv_config *cfg, srv_log *logger)
   return s;
 }
 
-int srv_server_start(srv_server *s)
-{
+int srv_server_start(srv_server *s) {
   struct sockaddr_storage ss;
   memset(&ss, 0, sizeof ss);
   unsigned flags = MHD_USE_AUTO_INTERNAL_THREAD | MHD_ALLOW_SUSPEND_RESUME |
@@ -144,10 +137,9 @@ int srv_server_start(srv_server *s)
   }
   s->daemon = MHD_start_daemon(
       flags, (uint16_t)s->cfg.port, NULL, NULL, &srv__on_request, s,
-      MHD_OPTION_EXTERNAL_LOGGER, &mhd_log, s,
-      MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&ss,
-      MHD_OPTION_THREAD_POOL_SIZE, (unsigned int)s->cfg.io_threads,
-      MHD_OPTION_CONNECTION_LIMIT,
+      MHD_OPTION_EXTERNAL_LOGGER, &mhd_log, s, MHD_OPTION_SOCK_ADDR,
+      (struct sockaddr *)&ss, MHD_OPTION_THREAD_POOL_SIZE,
+      (unsigned int)s->cfg.io_threads, MHD_OPTION_CONNECTION_LIMIT,
       (unsigned int)(s->cfg.max_connections + s->cfg.reserved),
       MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned int)s->cfg.per_ip,
       MHD_OPTION_CONNECTION_TIMEOUT, (unsigned int)s->cfg.timeout,
@@ -165,29 +157,26 @@ int srv_server_start(srv_server *s)
   return 0;
 }
 
-unsigned srv_server_port(const srv_server *s) { return s->port; }
+unsigned srv_server_port(const srv_server *s) {
+  return s->port;
+}
 
 /* Wait until cond(s) holds or the deadline passes; true if it held. */
 static bool wait_until(srv_server *s, bool (*cond)(srv_server *),
-                       double deadline)
-{
+                       double deadline) {
   for (;;) {
-    if (cond(s))
-      return true;
-    if (srv_now() >= deadline)
-      return false;
+    if (cond(s)) return true;
+    if (srv_now() >= deadline) return false;
     srv_sleep(0.01);
   }
 }
 
-static bool compute_idle(srv_server *s)
-{
+static bool compute_idle(srv_server *s) {
   return atomic_load(&s->suspended) == 0 && srv_jobs_live(s->jobs) == 0 &&
          srv_pool_depth(s->pool) == 0;
 }
 
-static bool requests_done(srv_server *s)
-{
+static bool requests_done(srv_server *s) {
   return atomic_load(&s->inflight) == 0;
 }
 
@@ -203,19 +192,15 @@ static const double ABORT_WAIT = 2.0;
  * connections not yet accepted are reset). The descriptor itself stays
  * open until the HTTP daemon stops, as libmicrohttpd's threads may still
  * hold its number. */
-static void stop_listening(srv_server *s)
-{
+static void stop_listening(srv_server *s) {
   s->quiesced_fd = MHD_quiesce_daemon(s->daemon);
-  if (s->quiesced_fd != MHD_INVALID_SOCKET)
-    shutdown(s->quiesced_fd, SHUT_RDWR);
+  if (s->quiesced_fd != MHD_INVALID_SOCKET) shutdown(s->quiesced_fd, SHUT_RDWR);
 }
 
-int srv_server_shutdown(srv_server *s)
-{
+int srv_server_shutdown(srv_server *s) {
   double deadline = srv_now() + s->cfg.shutdown_grace;
   atomic_store(&s->draining, true);
-  if (s->daemon == NULL)
-    return 0;
+  if (s->daemon == NULL) return 0;
   stop_listening(s);
   /* Jobs stop between frames; queued requests are answered 503 by the
    * workers; requests already computing have the grace to finish. */
@@ -243,22 +228,17 @@ int srv_server_shutdown(srv_server *s)
             (size_t)atomic_load(&s->inflight));
   MHD_stop_daemon(s->daemon);
   s->daemon = NULL;
-  if (s->quiesced_fd != MHD_INVALID_SOCKET)
-    close(s->quiesced_fd);
+  if (s->quiesced_fd != MHD_INVALID_SOCKET) close(s->quiesced_fd);
   s->quiesced_fd = MHD_INVALID_SOCKET;
   return 0;
 }
 
-void srv_server_destroy(srv_server *s)
-{
-  if (s == NULL)
-    return;
-  if (s->daemon != NULL)
-    MHD_stop_daemon(s->daemon);
+void srv_server_destroy(srv_server *s) {
+  if (s == NULL) return;
+  if (s->daemon != NULL) MHD_stop_daemon(s->daemon);
   srv_pool_destroy(s->pool);
   srv_jobs_destroy(s->jobs);
-  if (s->store)
-    s->store->ops->destroy(s->store);
+  if (s->store) s->store->ops->destroy(s->store);
   srv_metrics_destroy(s->metrics);
   srv_watch_destroy(s->watch); /* after the HTTP daemon: it closes records */
   free(s);

@@ -12,11 +12,9 @@
 
 /* ------------------------------------------------------------- files */
 
-static char *read_file(const char *path, size_t max, size_t *len)
-{
+static char *read_file(const char *path, size_t max, size_t *len) {
   FILE *f = fopen(path, "rb");
-  if (f == NULL)
-    return NULL;
+  if (f == NULL) return NULL;
   char *buf = malloc(max + 1);
   size_t n = buf ? fread(buf, 1, max + 1, f) : 0;
   fclose(f);
@@ -29,8 +27,7 @@ static char *read_file(const char *path, size_t max, size_t *len)
   return buf;
 }
 
-static const char *type_of(const char *name)
-{
+static const char *type_of(const char *name) {
   static const struct {
     const char *ext, *type;
   } T[] = {{".html", "text/html; charset=utf-8"},
@@ -45,8 +42,7 @@ static const char *type_of(const char *name)
   const char *dot = strrchr(name, '.');
   if (dot != NULL)
     for (size_t i = 0; i < sizeof T / sizeof T[0]; i++)
-      if (strcmp(dot, T[i].ext) == 0)
-        return T[i].type;
+      if (strcmp(dot, T[i].ext) == 0) return T[i].type;
   return NULL;
 }
 
@@ -70,18 +66,16 @@ static const char INDEX_HTML[] =
     "<a href=\"/metrics\"><code>/metrics</code></a></li>\n"
     "</ul>\n</body></html>\n";
 
-enum MHD_Result srv__serve_file(srv_req *r, const char *name)
-{
+enum MHD_Result srv__serve_file(srv_req *r, const char *name) {
   const char *type = type_of(name);
   char path[1024];
   size_t len = 0;
   char *body = NULL;
   if (type != NULL &&
-      (size_t)snprintf(path, sizeof path, "%s/%s", r->srv->cfg.web_root,
-                       name) < sizeof path)
+      (size_t)snprintf(path, sizeof path, "%s/%s", r->srv->cfg.web_root, name) <
+          sizeof path)
     body = read_file(path, (size_t)16 << 20, &len);
-  if (body != NULL)
-    return srv__answer(r, 200, type, body, len, true);
+  if (body != NULL) return srv__answer(r, 200, type, body, len, true);
   if (r->route == SRV_R_INDEX)
     return srv__answer(r, 200, "text/html; charset=utf-8", (char *)INDEX_HTML,
                        sizeof INDEX_HTML - 1, false);
@@ -91,8 +85,7 @@ enum MHD_Result srv__serve_file(srv_req *r, const char *name)
 
 /* ----------------------------------------------------------- metrics */
 
-enum MHD_Result srv__serve_metrics(srv_req *r)
-{
+enum MHD_Result srv__serve_metrics(srv_req *r) {
   srv_server *s = r->srv;
   static const char *const names[5] = {"queued", "running", "done", "failed",
                                        "cancelled"};
@@ -107,8 +100,7 @@ enum MHD_Result srv__serve_metrics(srv_req *r)
   const union MHD_ConnectionInfo *ci =
       MHD_get_connection_info(r->conn, MHD_CONNECTION_INFO_DAEMON);
   const union MHD_DaemonInfo *info =
-      ci ? MHD_get_daemon_info(ci->daemon,
-                               MHD_DAEMON_INFO_CURRENT_CONNECTIONS)
+      ci ? MHD_get_daemon_info(ci->daemon, MHD_DAEMON_INFO_CURRENT_CONNECTIONS)
          : NULL;
   g.connections = info ? info->num_connections : 0;
   s->store->ops->counts(s->store, srv_now(), g.jobs);
@@ -118,8 +110,7 @@ enum MHD_Result srv__serve_metrics(srv_req *r)
   g.job_state_names = names;
   size_t len = 0;
   char *text = srv_metrics_render(s->metrics, &g, &len);
-  if (text == NULL)
-    return MHD_NO;
+  if (text == NULL) return MHD_NO;
   return srv__answer(r, 200, "text/plain; version=0.0.4; charset=utf-8", text,
                      len, true);
 }

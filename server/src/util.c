@@ -7,26 +7,22 @@
 #include <sys/random.h>
 #include <time.h>
 
-double srv_now(void)
-{
+double srv_now(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
 }
 
-void srv_random_hex(char *out, size_t nhex)
-{
+void srv_random_hex(char *out, size_t nhex) {
   static const char digits[] = "0123456789abcdef";
   unsigned char buf[64];
   size_t need = (nhex + 1) / 2;
-  if (need > sizeof buf)
-    need = sizeof buf;
+  if (need > sizeof buf) need = sizeof buf;
   size_t got = 0;
   while (got < need) {
     ssize_t n = getrandom(buf + got, need - got, 0);
     if (n < 0) {
-      if (errno == EINTR)
-        continue;
+      if (errno == EINTR) continue;
       /* No kernel randomness (very old kernel or seccomp): fall back to
        * the clock so ids stay unique per process, if guessable. */
       struct timespec ts;
@@ -47,11 +43,9 @@ void srv_random_hex(char *out, size_t nhex)
   out[i] = '\0';
 }
 
-size_t srv_json_escape(char *dst, size_t cap, const char *src)
-{
+size_t srv_json_escape(char *dst, size_t cap, const char *src) {
   size_t o = 0;
-  if (cap == 0)
-    return 0;
+  if (cap == 0) return 0;
   for (const unsigned char *p = (const unsigned char *)src; *p; p++) {
     char esc[8];
     size_t n;
@@ -65,8 +59,7 @@ size_t srv_json_escape(char *dst, size_t cap, const char *src)
       esc[0] = (char)*p;
       n = 1;
     }
-    if (o + n >= cap)
-      break;
+    if (o + n >= cap) break;
     memcpy(dst + o, esc, n);
     o += n;
   }
@@ -74,26 +67,21 @@ size_t srv_json_escape(char *dst, size_t cap, const char *src)
   return o;
 }
 
-bool srv_request_id_ok(const char *s)
-{
+bool srv_request_id_ok(const char *s) {
   size_t n = 0;
-  if (s == NULL)
-    return false;
+  if (s == NULL) return false;
   for (; s[n]; n++) {
     char c = s[n];
     bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
               (c >= '0' && c <= '9') || c == '.' || c == '_' || c == ':' ||
               c == '-';
-    if (!ok || n >= 64)
-      return false;
+    if (!ok || n >= 64) return false;
   }
   return n > 0;
 }
 
-void srv_sleep(double seconds)
-{
-  if (seconds <= 0)
-    return;
+void srv_sleep(double seconds) {
+  if (seconds <= 0) return;
   struct timespec ts;
   ts.tv_sec = (time_t)seconds;
   ts.tv_nsec = (long)((seconds - (double)ts.tv_sec) * 1e9);

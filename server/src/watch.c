@@ -45,8 +45,7 @@ struct srv_watch {
 
 /* The 408 written on a socket whose request is late: made once, since it
  * is written from the sweep with nothing of the request known. */
-static int late_text(char *out, size_t cap)
-{
+static int late_text(char *out, size_t cap) {
   static const char body[] =
       "{\"type\":\"/problems/request-timeout\",\"title\":\"Request timeout\","
       "\"status\":408,\"detail\":\"the request did not arrive within the "
@@ -62,8 +61,7 @@ static int late_text(char *out, size_t cap)
                   sizeof body - 1, body);
 }
 
-static void cut(srv_watch *w, srv_conn *c, bool answer)
-{
+static void cut(srv_watch *w, srv_conn *c, bool answer) {
   if (answer) {
     ssize_t n = send(c->fd, w->late, w->late_len, MSG_NOSIGNAL | MSG_DONTWAIT);
     (void)n; /* a full send buffer: the client is not reading anyway */
@@ -77,12 +75,10 @@ static void cut(srv_watch *w, srv_conn *c, bool answer)
   c->deadline = 0;
 }
 
-static void sweep(srv_watch *w, double now)
-{
+static void sweep(srv_watch *w, double now) {
   size_t requests = 0, sends = 0;
   for (srv_conn *c = w->first; c; c = c->next) {
-    if (c->deadline == 0 || now < c->deadline)
-      continue;
+    if (c->deadline == 0 || now < c->deadline) continue;
     bool late_request = c->phase == CP_HEADER || c->phase == CP_BODY;
     cut(w, c, late_request);
     if (late_request)
@@ -97,8 +93,7 @@ static void sweep(srv_watch *w, double now)
             requests, sends);
 }
 
-static void *sweeper(void *arg)
-{
+static void *sweeper(void *arg) {
   srv_watch *w = arg;
   pthread_mutex_lock(&w->mu);
   while (!w->stopping) {
@@ -116,11 +111,9 @@ static void *sweeper(void *arg)
   return NULL;
 }
 
-srv_watch *srv_watch_create(const srv_watch_limits *limits, FILE *log)
-{
+srv_watch *srv_watch_create(const srv_watch_limits *limits, FILE *log) {
   srv_watch *w = calloc(1, sizeof *w);
-  if (w == NULL)
-    return NULL;
+  if (w == NULL) return NULL;
   w->lim = *limits;
   w->log = log;
   w->late_len = (size_t)late_text(w->late, sizeof w->late);
@@ -135,10 +128,8 @@ srv_watch *srv_watch_create(const srv_watch_limits *limits, FILE *log)
   return w;
 }
 
-void srv_watch_destroy(srv_watch *w)
-{
-  if (w == NULL)
-    return;
+void srv_watch_destroy(srv_watch *w) {
+  if (w == NULL) return;
   pthread_mutex_lock(&w->mu);
   w->stopping = true;
   pthread_cond_broadcast(&w->cv);
@@ -154,16 +145,13 @@ void srv_watch_destroy(srv_watch *w)
   free(w);
 }
 
-static double header_time(const srv_conn *c)
-{
+static double header_time(const srv_conn *c) {
   return c->reserved ? c->w->lim.reserved_header_time : c->w->lim.header_time;
 }
 
-srv_conn *srv_watch_open(srv_watch *w, int fd, double now)
-{
+srv_conn *srv_watch_open(srv_watch *w, int fd, double now) {
   srv_conn *c = calloc(1, sizeof *c);
-  if (c == NULL)
-    return NULL;
+  if (c == NULL) return NULL;
   c->w = w;
   c->fd = fd;
   c->phase = CP_HEADER;
@@ -172,37 +160,33 @@ srv_conn *srv_watch_open(srv_watch *w, int fd, double now)
   c->reserved = w->open >= w->lim.normal;
   c->deadline = now + header_time(c);
   c->next = w->first;
-  if (w->first)
-    w->first->prev = c;
+  if (w->first) w->first->prev = c;
   w->first = c;
   w->open++;
   pthread_mutex_unlock(&w->mu);
   return c;
 }
 
-void srv_watch_close(srv_watch *w, srv_conn *c)
-{
-  if (c == NULL)
-    return;
+void srv_watch_close(srv_watch *w, srv_conn *c) {
+  if (c == NULL) return;
   pthread_mutex_lock(&w->mu);
   if (c->prev)
     c->prev->next = c->next;
   else
     w->first = c->next;
-  if (c->next)
-    c->next->prev = c->prev;
+  if (c->next) c->next->prev = c->prev;
   w->open--;
   pthread_mutex_unlock(&w->mu);
   free(c);
 }
 
-bool srv_conn_reserved(const srv_conn *c) { return c != NULL && c->reserved; }
+bool srv_conn_reserved(const srv_conn *c) {
+  return c != NULL && c->reserved;
+}
 
 /* Move c to phase p with deadline d (0 = none), unless the sweep cut it. */
-static void set_phase(srv_conn *c, conn_phase p, double d)
-{
-  if (c == NULL)
-    return;
+static void set_phase(srv_conn *c, conn_phase p, double d) {
+  if (c == NULL) return;
   pthread_mutex_lock(&c->w->mu);
   if (c->phase != CP_CUT) {
     c->phase = p;
@@ -214,29 +198,26 @@ static void set_phase(srv_conn *c, conn_phase p, double d)
 /* The request time counts from the connection's start for its first
  * request, and from the header's arrival for later ones (when their
  * first byte came is not known). */
-void srv_watch_header_done(srv_conn *c, double now)
-{
+void srv_watch_header_done(srv_conn *c, double now) {
   if (c != NULL)
     set_phase(c, CP_BODY,
               (c->kept_alive ? now : c->start) + c->w->lim.request_time);
 }
 
-void srv_watch_body_done(srv_conn *c) { set_phase(c, CP_COMPUTE, 0); }
+void srv_watch_body_done(srv_conn *c) {
+  set_phase(c, CP_COMPUTE, 0);
+}
 
-void srv_watch_answer_queued(srv_conn *c, double now)
-{
-  if (c != NULL)
-    set_phase(c, CP_SENDING, now + c->w->lim.send_time);
+void srv_watch_answer_queued(srv_conn *c, double now) {
+  if (c != NULL) set_phase(c, CP_SENDING, now + c->w->lim.send_time);
 }
 
 /* The next request on a kept-alive connection may wait the idle time
  * before its first byte (libmicrohttpd's timeout closes an idle one), and
  * then has the header time: libmicrohttpd does not say when that byte
  * came, so the deadline is their sum from the end of this request. */
-void srv_watch_request_done(srv_conn *c, double now)
-{
-  if (c == NULL)
-    return;
+void srv_watch_request_done(srv_conn *c, double now) {
+  if (c == NULL) return;
   pthread_mutex_lock(&c->w->mu);
   if (c->phase != CP_CUT) {
     c->phase = CP_HEADER;
@@ -247,8 +228,7 @@ void srv_watch_request_done(srv_conn *c, double now)
   pthread_mutex_unlock(&c->w->mu);
 }
 
-void srv_watch_counts(srv_watch *w, size_t *late_request, size_t *late_send)
-{
+void srv_watch_counts(srv_watch *w, size_t *late_request, size_t *late_send) {
   pthread_mutex_lock(&w->mu);
   *late_request = w->late_request;
   *late_send = w->late_send;

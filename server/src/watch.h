@@ -34,7 +34,7 @@ typedef struct srv_watch_limits {
   double send_time;    /* seconds to deliver one answer */
   double idle_time;    /* keep-alive wait before a next request starts */
   double reserved_header_time; /* header time on a reserved slot */
-  unsigned normal;     /* open connections beyond which slots are reserved */
+  unsigned normal; /* open connections beyond which slots are reserved */
 } srv_watch_limits;
 
 typedef struct srv_watch srv_watch;

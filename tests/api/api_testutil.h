@@ -18,8 +18,8 @@
 /* One request through api_handle with the default limits (cfg NULL) or
  * the given ones; the parsed body (NULL unless JSON) in *json. */
 static inline int at_call_cfg(const api_config *cfg, api_route route,
-                              const char *body, size_t len,
-                              api_response *res, cJSON **json) {
+                              const char *body, size_t len, api_response *res,
+                              cJSON **json) {
   api_config def;
   api_request req;
   if (cfg == NULL) {
@@ -40,8 +40,7 @@ static inline int at_call_cfg(const api_config *cfg, api_route route,
     *json = NULL;
     if (strstr(res->content_type, "json") != NULL) {
       *json = cJSON_ParseWithLength(res->body, res->length);
-      if (*json == NULL)
-        print_error("response is not JSON: %s\n", res->body);
+      if (*json == NULL) print_error("response is not JSON: %s\n", res->body);
       assert_non_null(*json);
     }
   }
@@ -83,8 +82,8 @@ static inline cJSON *at_expect_problem_cfg(const api_config *cfg,
     const cJSON *m = cJSON_GetObjectItemCaseSensitive(e0, "message");
     assert_true(cJSON_IsString(p));
     if (strcmp(p->valuestring, pointer) != 0)
-      print_error("pointer \"%s\", expected \"%s\"; body: %s\n",
-                  p->valuestring, pointer, res.body);
+      print_error("pointer \"%s\", expected \"%s\"; body: %s\n", p->valuestring,
+                  pointer, res.body);
     assert_string_equal(p->valuestring, pointer);
     assert_true(cJSON_IsString(m) && m->valuestring[0] != '\0');
   }
@@ -109,8 +108,7 @@ static inline cJSON *at_expect_json(api_route route, const char *body) {
   api_response res;
   cJSON *j = NULL;
   int st = at_call(route, body, &res, &j);
-  if (st != 200)
-    print_error("status %d: %s\n", st, res.body);
+  if (st != 200) print_error("status %d: %s\n", st, res.body);
   assert_int_equal(st, 200);
   assert_string_equal(res.content_type, "application/json");
   api_response_free(&res);
@@ -130,8 +128,8 @@ static inline void at_printf(at_buf *b, const char *fmt, ...) {
   for (;;) {
     size_t room = b->cap - b->n;
     va_start(ap, fmt);
-    int w = vsnprintf(b->s != NULL ? b->s + b->n : NULL, b->s != NULL ? room : 0,
-                      fmt, ap);
+    int w = vsnprintf(b->s != NULL ? b->s + b->n : NULL,
+                      b->s != NULL ? room : 0, fmt, ap);
     va_end(ap);
     assert_true(w >= 0);
     if (b->s != NULL && (size_t)w < room) {
@@ -157,8 +155,7 @@ static inline void at_bspline_json(at_buf *b, int degree, size_t n,
   at_printf(b, "]");
   if (w != NULL) {
     at_printf(b, ",\"weights\":[");
-    for (size_t i = 0; i < n; i++)
-      at_printf(b, "%s%.17g", i ? "," : "", w[i]);
+    for (size_t i = 0; i < n; i++) at_printf(b, "%s%.17g", i ? "," : "", w[i]);
     at_printf(b, "]");
   }
   at_printf(b, ",\"closed\":%s}", closed ? "true" : "false");
@@ -234,8 +231,7 @@ static inline void at_curve_point(const at_curve *c, double t, double p[2]) {
   const double *u = c->knots;
   size_t span = (size_t)k;
   double d[2 * 16];
-  while (span + 1 < c->n && t >= u[span + 1])
-    span++;
+  while (span + 1 < c->n && t >= u[span + 1]) span++;
   for (int j = 0; j <= k; j++) {
     d[2 * j] = c->cp[2 * (span - (size_t)k + (size_t)j)];
     d[2 * j + 1] = c->cp[2 * (span - (size_t)k + (size_t)j) + 1];

@@ -22,8 +22,8 @@ static inline void st_parse(const char *d, km_curve *c) {
   size_t off = 0;
   char msg[256];
   km_curve_init(c);
-  km_status st = api_svg_parse_path(d, strlen(d), 1e-9, c, &off, msg,
-                                    sizeof msg);
+  km_status st =
+      api_svg_parse_path(d, strlen(d), 1e-9, c, &off, msg, sizeof msg);
   if (st != KM_OK)
     print_error("parsing \"%s\" failed at offset %zu: %s\n", d, off, msg);
   assert_status(st, KM_OK);
@@ -108,8 +108,10 @@ static inline double st_dist_s(const st_samples *s, const double p[2]) {
     double d2 = hypot(q2[0] - p[0], q2[1] - p[1]);
     if (d1 < best) best = d1;
     if (d2 < best) best = d2;
-    if (d1 < d2) hi = m2;
-    else lo = m1;
+    if (d1 < d2)
+      hi = m2;
+    else
+      lo = m1;
   }
   return best;
 }
@@ -174,7 +176,9 @@ static inline void st_load_shapes(st_shapes *s) {
   assert_int_equal(s->n, 6);
 }
 
-static inline void st_free_shapes(st_shapes *s) { cJSON_Delete(s->root); }
+static inline void st_free_shapes(st_shapes *s) {
+  cJSON_Delete(s->root);
+}
 
 /* Signed curvature (x'y'' - x''y') / |C'|^3 from the curve's own rational
  * derivatives. */

@@ -39,8 +39,7 @@ static void expect_stopped(const api_response *res) {
   assert_non_null(j);
   assert_string_equal(cJSON_GetObjectItem(j, "type")->valuestring,
                       "/problems/stopped");
-  assert_string_equal(cJSON_GetObjectItem(j, "title")->valuestring,
-                      "Stopped");
+  assert_string_equal(cJSON_GetObjectItem(j, "title")->valuestring, "Stopped");
   assert_string_equal(cJSON_GetObjectItem(j, "detail")->valuestring,
                       "the computation was stopped before it finished");
   assert_int_equal(cJSON_GetObjectItem(j, "status")->valueint, 503);
@@ -58,15 +57,15 @@ static char *wavy_curve_json(size_t n, int waves, double amp) {
                           "\"knots\":[0,0,0,0");
   for (size_t i = 1; i < n - 3; i++)
     len += (size_t)snprintf(s + len, cap - len, ",%zu", i);
-  len += (size_t)snprintf(s + len, cap - len, ",%zu,%zu,%zu,%zu],",
-                          n - 3, n - 3, n - 3, n - 3);
+  len += (size_t)snprintf(s + len, cap - len, ",%zu,%zu,%zu,%zu],", n - 3,
+                          n - 3, n - 3, n - 3);
   len += (size_t)snprintf(s + len, cap - len, "\"control_points\":[");
   for (size_t i = 0; i < n; i++) {
-    double a = 2 * 3.14159265358979323846 * (double)(i % (n - 1)) /
-               (double)(n - 1);
+    double a =
+        2 * 3.14159265358979323846 * (double)(i % (n - 1)) / (double)(n - 1);
     double r = 1 + amp * sin(waves * a);
-    len += (size_t)snprintf(s + len, cap - len, "%s[%.17g,%.17g]",
-                            i ? "," : "", r * cos(a), r * sin(a));
+    len += (size_t)snprintf(s + len, cap - len, "%s[%.17g,%.17g]", i ? "," : "",
+                            r * cos(a), r * sin(a));
   }
   snprintf(s + len, cap - len, "]}");
   return s;
@@ -89,8 +88,7 @@ static void stop_gives_503_stopped_on_every_route(void **state) {
   (void)state;
   char *curve = wavy_curve_json(200, 7, 0.2);
   char sigbody[1 << 16];
-  snprintf(sigbody, sizeof sigbody, "{\"curve\":%s,\"tolerance\":1e-9}",
-           curve);
+  snprintf(sigbody, sizeof sigbody, "{\"curve\":%s,\"tolerance\":1e-9}", curve);
   char *morph = morph_body(200, ",\"tolerance\":1e-8,\"frames\":4");
   /* a signature to reconstruct, from the signature route itself */
   api_response res;
@@ -111,9 +109,8 @@ static void stop_gives_503_stopped_on_every_route(void **state) {
   for (size_t c = 0; c < 3; c++) {
     /* how many questions the whole request asks when never stopped */
     countdown never = {1L << 40, 0};
-    assert_int_equal(call_with_stop(cases[c].route, cases[c].body, &never,
-                                    &res),
-                     200);
+    assert_int_equal(
+        call_with_stop(cases[c].route, cases[c].body, &never, &res), 200);
     api_response_free(&res);
     assert_true(never.asked >= 2);
     long ks[3] = {0, never.asked / 2, never.asked - 1};
@@ -173,8 +170,7 @@ static const char circle_square[] =
  * predicted size and the limit of 64 MiB. */
 static void huge_answer_is_refused_before_work(void **state) {
   (void)state;
-  const char *extras[] = {"", ",\"include\":[\"svg_d\"]",
-                          ",\"metrics\":false"};
+  const char *extras[] = {"", ",\"include\":[\"svg_d\"]", ",\"metrics\":false"};
   for (size_t k = 0; k < 3; k++) {
     char body[1024];
     snprintf(body, sizeof body, circle_square, extras[k]);
@@ -221,8 +217,7 @@ static void prediction_bounds_the_real_answer(void **state) {
     req.body = body;
     req.length = strlen(body);
     int st = api_morph_prepare(NULL, &req, 100, &plan, &err);
-    if (st != 0)
-      print_error("%s: %s\n", extras[k], err.body);
+    if (st != 0) print_error("%s: %s\n", extras[k], err.body);
     assert_int_equal(st, 0);
     size_t predicted = api_morph_predicted_bytes(plan);
     assert_int_equal(api_morph_result(plan, &out), 200);
@@ -249,15 +244,14 @@ static void reconstruct_answer_is_held_to_the_limit(void **state) {
   api_response res;
   api_config_default(&cfg);
   assert_int_equal(cfg.max_output_bytes, 64u * 1024u * 1024u);
-  assert_int_equal(at_call_cfg(&cfg, API_ROUTE_RECONSTRUCT, body,
-                               strlen(body), &res, NULL),
-                   200);
+  assert_int_equal(
+      at_call_cfg(&cfg, API_ROUTE_RECONSTRUCT, body, strlen(body), &res, NULL),
+      200);
   size_t real = res.length;
   api_response_free(&res);
   cfg.max_output_bytes = real / 2;
-  cJSON *j =
-      at_expect_problem_cfg(&cfg, API_ROUTE_RECONSTRUCT, body, 422,
-                            "/tolerance");
+  cJSON *j = at_expect_problem_cfg(&cfg, API_ROUTE_RECONSTRUCT, body, 422,
+                                   "/tolerance");
   assert_string_equal(cJSON_GetObjectItem(j, "type")->valuestring,
                       "/problems/limit-exceeded");
   cJSON_Delete(j);

@@ -16,11 +16,9 @@ typedef struct cli_env {
 static int setup(void **state) {
   static cli_env env;
   env.cli = getenv("KMORPH_CLI");
-  if (env.cli == NULL || env.cli[0] == '\0')
-    env.cli = "build/kmorph";
+  if (env.cli == NULL || env.cli[0] == '\0') env.cli = "build/kmorph";
   snprintf(env.dir, sizeof env.dir, "/tmp/kmorph-cli-XXXXXX");
-  if (mkdtemp(env.dir) == NULL)
-    return -1;
+  if (mkdtemp(env.dir) == NULL) return -1;
   *state = &env;
   return 0;
 }
@@ -69,8 +67,7 @@ static void cli_signature_of_a_circle_succeeds(void **state) {
   cJSON *j = cJSON_Parse(out);
   assert_non_null(j);
   const cJSON *sig = cJSON_GetObjectItem(j, "signature");
-  assert_rel(cJSON_GetObjectItem(sig, "length")->valuedouble, 8 * M_PI,
-             1e-10);
+  assert_rel(cJSON_GetObjectItem(sig, "length")->valuedouble, 8 * M_PI, 1e-10);
   const cJSON *e;
   cJSON_ArrayForEach(e, cJSON_GetObjectItem(j, "samples")) {
     assert_close(cJSON_GetArrayItem(e, 1)->valuedouble, 0.25, 1e-9);
@@ -83,8 +80,7 @@ static void cli_signature_of_a_circle_succeeds(void **state) {
   assert_non_null(strstr(out, "\n  \"signature\": {"));
   j = cJSON_Parse(out);
   assert_non_null(j);
-  assert_rel(cJSON_GetObjectItem(cJSON_GetObjectItem(j, "signature"),
-                                 "length")
+  assert_rel(cJSON_GetObjectItem(cJSON_GetObjectItem(j, "signature"), "length")
                  ->valuedouble,
              8 * M_PI, 1e-10);
   cJSON_Delete(j);
@@ -107,9 +103,8 @@ static void cli_problem_exits_1_with_problem_json(void **state) {
   assert_non_null(j);
   assert_int_equal(cJSON_GetObjectItem(j, "status")->valueint, 422);
   assert_string_equal(
-      cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(j, "errors"),
-                                             0),
-                          "pointer")
+      cJSON_GetObjectItem(
+          cJSON_GetArrayItem(cJSON_GetObjectItem(j, "errors"), 0), "pointer")
           ->valuestring,
       "/signature/length");
   cJSON_Delete(j);

@@ -16,9 +16,10 @@
 static void malformed_json_is_400(void **state) {
   (void)state;
   static const char *const bad[] = {
-      "{",           "{\"curve\":}", "[1,]",        "{\"a\":1} x",
-      "{\"a\":NaN}", "{'a':1}",      "{\"a\":01}",  "{\"a\":1.}",
-      "",            "   ",          "{\"a\":\"\\x\"}", "{\"a\":tru}",
+      "{",           "{\"curve\":}",    "[1,]",
+      "{\"a\":1} x", "{\"a\":NaN}",     "{'a':1}",
+      "{\"a\":01}",  "{\"a\":1.}",      "",
+      "   ",         "{\"a\":\"\\x\"}", "{\"a\":tru}",
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     cJSON *j = at_expect_problem(SIG, bad[i], 400, NULL);
@@ -60,12 +61,9 @@ static void body_without_nul_is_read_to_its_length(void **state) {
   cJSON *j;
   int st = at_call_cfg(NULL, SIG, body, 7, &res, &j);
   assert_int_equal(st, 422);
-  const cJSON *p =
-      cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(
-                                           cJSON_GetObjectItemCaseSensitive(
-                                               j, "errors"),
-                                           0),
-                                       "pointer");
+  const cJSON *p = cJSON_GetObjectItemCaseSensitive(
+      cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(j, "errors"), 0),
+      "pointer");
   assert_string_equal(p->valuestring, "/curve");
   cJSON_Delete(j);
   api_response_free(&res);
@@ -76,11 +74,9 @@ static char *nested(size_t depth) {
   size_t n = 0;
   assert_non_null(s);
   n += (size_t)sprintf(s, "{\"a\":");
-  for (size_t i = 1; i < depth; i++)
-    s[n++] = '[';
+  for (size_t i = 1; i < depth; i++) s[n++] = '[';
   s[n++] = '1';
-  for (size_t i = 1; i < depth; i++)
-    s[n++] = ']';
+  for (size_t i = 1; i < depth; i++) s[n++] = ']';
   s[n++] = '}';
   s[n] = '\0';
   return s;
@@ -136,9 +132,8 @@ static void body_over_the_limit_is_413(void **state) {
   api_config cfg;
   api_config_default(&cfg);
   cfg.max_body_bytes = 16;
-  cJSON_Delete(at_expect_problem_cfg(&cfg, SIG,
-                                     "{\"curve\":{\"type\":\"points\"}}", 413,
-                                     NULL));
+  cJSON_Delete(at_expect_problem_cfg(
+      &cfg, SIG, "{\"curve\":{\"type\":\"points\"}}", 413, NULL));
 }
 
 static void unknown_route_is_404(void **state) {
@@ -177,11 +172,9 @@ static void missing_and_mistyped_fields_name_the_field(void **state) {
              CURVE_HEAD GOOD_KNOTS
              ",\"control_points\":[[0,0],[1,2],[3],[4,1],[5,0]]}}",
              422, "/curve/control_points/2");
-  at_problem(SIG,
-             CURVE_HEAD "\"knots\":[0,0,0,0,null,1,1,1,1]," GOOD_CP "}}",
+  at_problem(SIG, CURVE_HEAD "\"knots\":[0,0,0,0,null,1,1,1,1]," GOOD_CP "}}",
              422, "/curve/knots/4");
-  at_problem(SIG,
-             CURVE_HEAD GOOD_KNOTS "," GOOD_CP ",\"closed\":\"no\"}}", 422,
+  at_problem(SIG, CURVE_HEAD GOOD_KNOTS "," GOOD_CP ",\"closed\":\"no\"}}", 422,
              "/curve/closed");
   at_problem(SIG, "{\"curve\":{\"type\":\"svg\",\"d\":5}}", 422, "/curve/d");
   at_problem(SIG, "{\"curve\":{\"type\":\"points\",\"points\":[[0,0]]}}", 422,
@@ -201,9 +194,8 @@ static void non_finite_numbers_are_422(void **state) {
   at_problem(SIG,
              CURVE_HEAD "\"knots\":[0,0,0,0,0.5,1,1,1,-1e999]," GOOD_CP "}}",
              422, "/curve/knots/8");
-  at_problem(SIG,
-             CURVE_HEAD GOOD_KNOTS "," GOOD_CP "},\"tolerance\":1e400}", 422,
-             "/tolerance");
+  at_problem(SIG, CURVE_HEAD GOOD_KNOTS "," GOOD_CP "},\"tolerance\":1e400}",
+             422, "/tolerance");
 }
 
 static void bad_svg_path_names_d_and_the_offset(void **state) {
@@ -224,13 +216,13 @@ static void bad_svg_path_names_d_and_the_offset(void **state) {
 static void decreasing_knot_is_named(void **state) {
   (void)state;
   cJSON *j = at_expect_problem(
-      SIG, CURVE_HEAD "\"knots\":[0,0,0,0,0.6,0.5,1,1,1,1],"
-                      "\"control_points\":[[0,0],[1,2],[3,3],[4,1],[5,0],"
-                      "[6,1]]}}",
+      SIG,
+      CURVE_HEAD "\"knots\":[0,0,0,0,0.6,0.5,1,1,1,1],"
+                 "\"control_points\":[[0,0],[1,2],[3,3],[4,1],[5,0],"
+                 "[6,1]]}}",
       422, "/curve/knots/5");
-  assert_string_equal(
-      cJSON_GetObjectItemCaseSensitive(j, "type")->valuestring,
-      "/problems/invalid-curve");
+  assert_string_equal(cJSON_GetObjectItemCaseSensitive(j, "type")->valuestring,
+                      "/problems/invalid-curve");
   cJSON_Delete(j);
 }
 
@@ -259,16 +251,13 @@ static void degree_out_of_range_is_named(void **state) {
 static void non_positive_weight_is_named(void **state) {
   (void)state;
   at_problem(SIG,
-             CURVE_HEAD GOOD_KNOTS "," GOOD_CP
-             ",\"weights\":[1,1,0,1,1]}}",
+             CURVE_HEAD GOOD_KNOTS "," GOOD_CP ",\"weights\":[1,1,0,1,1]}}",
              422, "/curve/weights/2");
   at_problem(SIG,
-             CURVE_HEAD GOOD_KNOTS "," GOOD_CP
-             ",\"weights\":[1,1,1,-2,1]}}",
+             CURVE_HEAD GOOD_KNOTS "," GOOD_CP ",\"weights\":[1,1,1,-2,1]}}",
              422, "/curve/weights/3");
-  at_problem(SIG,
-             CURVE_HEAD GOOD_KNOTS "," GOOD_CP ",\"weights\":[1,1,1]}}", 422,
-             "/curve/weights");
+  at_problem(SIG, CURVE_HEAD GOOD_KNOTS "," GOOD_CP ",\"weights\":[1,1,1]}}",
+             422, "/curve/weights");
 }
 
 static void closed_curve_that_does_not_close_is_named(void **state) {
@@ -280,15 +269,13 @@ static void closed_curve_that_does_not_close_is_named(void **state) {
 static void cusp_is_422_invalid_curve(void **state) {
   (void)state;
   /* C'(1/2) = 0 and C' changes sign there: the tangent reverses. */
-  cJSON *j = at_expect_problem(
-      SIG,
-      "{\"curve\":{\"type\":\"bspline\",\"degree\":3,"
-      "\"knots\":[0,0,0,0,1,1,1,1],"
-      "\"control_points\":[[0,0],[2,2],[0,2],[2,0]]}}",
-      422, NULL);
-  assert_string_equal(
-      cJSON_GetObjectItemCaseSensitive(j, "type")->valuestring,
-      "/problems/invalid-curve");
+  cJSON *j = at_expect_problem(SIG,
+                               "{\"curve\":{\"type\":\"bspline\",\"degree\":3,"
+                               "\"knots\":[0,0,0,0,1,1,1,1],"
+                               "\"control_points\":[[0,0],[2,2],[0,2],[2,0]]}}",
+                               422, NULL);
+  assert_string_equal(cJSON_GetObjectItemCaseSensitive(j, "type")->valuestring,
+                      "/problems/invalid-curve");
   /* The curve, or a part of it, is named. */
   const cJSON *e0 =
       cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(j, "errors"), 0);
@@ -303,12 +290,11 @@ static void control_points_above_the_limit_are_422(void **state) {
   api_config cfg;
   api_config_default(&cfg);
   cfg.max_control_points = 4;
-  cJSON *j = at_expect_problem_cfg(&cfg, SIG, CURVE_HEAD GOOD_KNOTS
-                                   "," GOOD_CP "}}",
-                                   422, "/curve/control_points");
-  assert_string_equal(
-      cJSON_GetObjectItemCaseSensitive(j, "type")->valuestring,
-      "/problems/limit-exceeded");
+  cJSON *j =
+      at_expect_problem_cfg(&cfg, SIG, CURVE_HEAD GOOD_KNOTS "," GOOD_CP "}}",
+                            422, "/curve/control_points");
+  assert_string_equal(cJSON_GetObjectItemCaseSensitive(j, "type")->valuestring,
+                      "/problems/limit-exceeded");
   cJSON_Delete(j);
 }
 
@@ -316,19 +302,19 @@ static void control_points_above_the_limit_are_422(void **state) {
  * turns it may make: the unit circle at 1e-9 needs some 250 cubic pieces
  * (h = (384 tol)^(1/4) = 0.025), 500 control points; kappa falling from
  * 1e5 to -2 over 4 units turns (1e5 - 2) 2 / (2 pi) = 31,830 times. */
-#define UNIT_CIRCLE_SIG                                                    \
-  "{\"length\":6.283185307179586,\"start\":{\"point\":[1,0],"              \
-  "\"angle\":1.5707963267948966},\"kappa\":{\"degree\":0,\"knots\":[0,"     \
+#define UNIT_CIRCLE_SIG                                                        \
+  "{\"length\":6.283185307179586,\"start\":{\"point\":[1,0],"                  \
+  "\"angle\":1.5707963267948966},\"kappa\":{\"degree\":0,\"knots\":[0,"        \
   "6.283185307179586],\"coefficients\":[1]},\"closed\":true}"
 static void answers_and_turns_above_the_limits_are_422(void **state) {
   (void)state;
   api_config cfg;
   api_config_default(&cfg);
   cfg.max_control_points = 400;
-  cJSON *j = at_expect_problem_cfg(
-      &cfg, API_ROUTE_RECONSTRUCT,
-      "{\"signature\":" UNIT_CIRCLE_SIG ",\"tolerance\":1e-9}", 422,
-      "/tolerance");
+  cJSON *j = at_expect_problem_cfg(&cfg, API_ROUTE_RECONSTRUCT,
+                                   "{\"signature\":" UNIT_CIRCLE_SIG
+                                   ",\"tolerance\":1e-9}",
+                                   422, "/tolerance");
   assert_string_equal(cJSON_GetObjectItemCaseSensitive(j, "type")->valuestring,
                       "/problems/limit-exceeded");
   cJSON_Delete(j);
@@ -336,8 +322,8 @@ static void answers_and_turns_above_the_limits_are_422(void **state) {
   api_response res;
   j = NULL;
   const char *ok = "{\"signature\":" UNIT_CIRCLE_SIG ",\"tolerance\":1e-9}";
-  assert_int_equal(at_call_cfg(&cfg, API_ROUTE_RECONSTRUCT, ok, strlen(ok), &res, &j),
-                   200);
+  assert_int_equal(
+      at_call_cfg(&cfg, API_ROUTE_RECONSTRUCT, ok, strlen(ok), &res, &j), 200);
   const cJSON *cp = cJSON_GetObjectItemCaseSensitive(
       cJSON_GetObjectItemCaseSensitive(j, "curve"), "control_points");
   assert_true(cJSON_GetArraySize(cp) >= 500 && cJSON_GetArraySize(cp) <= 2000);
@@ -362,8 +348,8 @@ static void bad_tolerance_and_samples_are_named(void **state) {
   (void)state;
   at_problem(SIG, CURVE_HEAD GOOD_KNOTS "," GOOD_CP "},\"tolerance\":0}", 422,
              "/tolerance");
-  at_problem(SIG, CURVE_HEAD GOOD_KNOTS "," GOOD_CP "},\"tolerance\":-1}",
-             422, "/tolerance");
+  at_problem(SIG, CURVE_HEAD GOOD_KNOTS "," GOOD_CP "},\"tolerance\":-1}", 422,
+             "/tolerance");
   at_problem(SIG, CURVE_HEAD GOOD_KNOTS "," GOOD_CP "},\"tolerance\":\"1\"}",
              422, "/tolerance");
   at_problem(SIG, CURVE_HEAD GOOD_KNOTS "," GOOD_CP "},\"samples\":1}", 422,
@@ -377,8 +363,8 @@ static void bad_tolerance_and_samples_are_named(void **state) {
 /* ---------------------------------------------------------- reconstruct */
 
 #define SIG_HEAD "{\"signature\":{\"length\":6.283185307179586,"
-#define KAPPA_OK                                                              \
-  "\"kappa\":{\"degree\":1,\"knots\":[0,0,6.283185307179586,"               \
+#define KAPPA_OK                                                               \
+  "\"kappa\":{\"degree\":1,\"knots\":[0,0,6.283185307179586,"                  \
   "6.283185307179586],\"coefficients\":[1,1]}"
 
 static void signature_errors_are_named(void **state) {

@@ -15,8 +15,10 @@
 
 #define MORPH API_ROUTE_MORPH
 
-#define CIRCLE1 "{\"type\":\"svg\",\"d\":\"M 1 0 A 1 1 0 1 1 -1 0 A 1 1 0 1 1 1 0 Z\"}"
-#define CIRCLE2 "{\"type\":\"svg\",\"d\":\"M 2 0 A 2 2 0 1 1 -2 0 A 2 2 0 1 1 2 0 Z\"}"
+#define CIRCLE1                                                                \
+  "{\"type\":\"svg\",\"d\":\"M 1 0 A 1 1 0 1 1 -1 0 A 1 1 0 1 1 1 0 Z\"}"
+#define CIRCLE2                                                                \
+  "{\"type\":\"svg\",\"d\":\"M 2 0 A 2 2 0 1 1 -2 0 A 2 2 0 1 1 2 0 Z\"}"
 
 /* The default tolerance: 1e-5 of the longer input (the circle of radius 2). */
 #define TOL (1e-5 * 4 * M_PI)
@@ -72,9 +74,8 @@ static const cJSON *frame_at(const cJSON *j, int i) {
  * "interior knot ... multiplicity above degree + 1". */
 static void a_match_from_the_start_to_the_end_answers_200(void **state) {
   (void)state;
-  const char *body =
-      "{\"from\":" CIRCLE1 ",\"to\":" CIRCLE2
-      ",\"frames\":5,\"matches\":[[1e-300,0.9999999999999999]]}";
+  const char *body = "{\"from\":" CIRCLE1 ",\"to\":" CIRCLE2
+                     ",\"frames\":5,\"matches\":[[1e-300,0.9999999999999999]]}";
   cJSON *j = morph_ok(body);
   assert_int_equal(cJSON_GetArraySize(cJSON_GetObjectItem(j, "frames")), 5);
   for (int i = 0; i < 5; i++) {
@@ -82,7 +83,8 @@ static void a_match_from_the_start_to_the_end_answers_200(void **state) {
     double off = off_circle(frame_at(j, i), 1.0 + t); /* checks the knots */
     if (i == 0 || i == 4) assert_le(off, 2 * TOL);
   }
-  const cJSON *used = cJSON_GetArrayItem(cJSON_GetObjectItem(j, "matches_used"), 0);
+  const cJSON *used =
+      cJSON_GetArrayItem(cJSON_GetObjectItem(j, "matches_used"), 0);
   assert_close(cJSON_GetArrayItem(used, 0)->valuedouble, 1e-300, 0);
   assert_close(cJSON_GetArrayItem(used, 1)->valuedouble, 0.9999999999999999, 0);
   cJSON_Delete(j);
@@ -113,7 +115,8 @@ static void matches_next_to_the_ends_keep_the_circle(void **state) {
                "\"matches\":%s}",
                deg, matches[k]);
       cJSON *j = morph_ok(body);
-      for (int i = 0; i < 5; i++) assert_le(off_circle(frame_at(j, i), 1.0 + times[i]), 2 * TOL);
+      for (int i = 0; i < 5; i++)
+        assert_le(off_circle(frame_at(j, i), 1.0 + times[i]), 2 * TOL);
       cJSON_Delete(j);
     }
 }
@@ -128,7 +131,8 @@ static void paper_blend_beside_an_end_answers_200(void **state) {
       "{\"from\":{\"type\":\"svg\",\"d\":\"M 0.05 0 A 0.05 0.05 0 1 1 -0.05 0 "
       "A 0.05 0.05 0 1 1 0.05 0 Z\"},\"to\":{\"type\":\"svg\",\"d\":\"M 0.1 0 "
       "A 0.1 0.1 0 1 1 -0.1 0 A 0.1 0.1 0 1 1 0.1 0 Z\"},\"frames\":5,"
-      "\"blend\":\"paper\",\"matches\":[[1e-300,0.5],[0.5,0.9999999999999999]]}";
+      "\"blend\":\"paper\",\"matches\":[[1e-300,0.5],[0.5,0.9999999999999999]]"
+      "}";
   cJSON *j = morph_ok(body);
   for (int i = 0; i < 5; i++) {
     double off = off_circle(frame_at(j, i), i == 0 ? 0.05 : 0.1);

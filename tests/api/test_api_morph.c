@@ -9,18 +9,17 @@
 #define MORPH API_ROUTE_MORPH
 
 /* Two open curves; validation tests add one bad option to them. */
-#define FROM                                                                  \
-  "\"from\":{\"type\":\"bspline\",\"degree\":1,\"knots\":[0,0,1,1],"          \
+#define FROM                                                                   \
+  "\"from\":{\"type\":\"bspline\",\"degree\":1,\"knots\":[0,0,1,1],"           \
   "\"control_points\":[[0,0],[1,0]]}"
-#define TO                                                                    \
-  "\"to\":{\"type\":\"bspline\",\"degree\":1,\"knots\":[0,0,1,1],"            \
+#define TO                                                                     \
+  "\"to\":{\"type\":\"bspline\",\"degree\":1,\"knots\":[0,0,1,1],"             \
   "\"control_points\":[[0,0],[0,2]]}"
 #define BOTH "{" FROM "," TO
 
 static void frame_counts_are_validated(void **state) {
   (void)state;
-  cJSON *j = at_expect_problem(MORPH, BOTH ",\"frames\":1001}", 422,
-                               "/frames");
+  cJSON *j = at_expect_problem(MORPH, BOTH ",\"frames\":1001}", 422, "/frames");
   assert_string_equal(cJSON_GetObjectItem(j, "type")->valuestring,
                       "/problems/limit-exceeded");
   cJSON_Delete(j);
@@ -87,15 +86,14 @@ static void matches_are_validated(void **state) {
 static void svg_options_are_validated(void **state) {
   (void)state;
   at_problem(MORPH, BOTH ",\"svg\":[]}", 422, "/svg");
-  at_problem(MORPH, BOTH ",\"svg\":{\"layout\":\"grid\"}}", 422,
-             "/svg/layout");
+  at_problem(MORPH, BOTH ",\"svg\":{\"layout\":\"grid\"}}", 422, "/svg/layout");
   at_problem(MORPH, BOTH ",\"svg\":{\"width\":-1}}", 422, "/svg/width");
   at_problem(MORPH, BOTH ",\"svg\":{\"duration\":0}}", 422, "/svg/duration");
   /* Colours are copied into markup: nothing that could close an attribute
    * or open an element gets through. */
   at_problem(MORPH,
-             BOTH ",\"svg\":{\"stroke\":\"red\\\"/><script>x</script>\"}}",
-             422, "/svg/stroke");
+             BOTH ",\"svg\":{\"stroke\":\"red\\\"/><script>x</script>\"}}", 422,
+             "/svg/stroke");
   at_problem(MORPH, BOTH ",\"svg\":{\"from_color\":\"\"}}", 422,
              "/svg/from_color");
 }
@@ -113,12 +111,12 @@ static void curves_are_validated_under_their_side(void **state) {
              "\"length\":-1}}}",
              422, "/from/signature/length");
   /* A cusp in `to` is reported under /to. */
-  cJSON *j = at_expect_problem(
-      MORPH,
-      "{" FROM ",\"to\":{\"type\":\"bspline\",\"degree\":3,"
-      "\"knots\":[0,0,0,0,1,1,1,1],"
-      "\"control_points\":[[0,0],[2,2],[0,2],[2,0]]}}",
-      422, NULL);
+  cJSON *j =
+      at_expect_problem(MORPH,
+                        "{" FROM ",\"to\":{\"type\":\"bspline\",\"degree\":3,"
+                        "\"knots\":[0,0,0,0,1,1,1,1],"
+                        "\"control_points\":[[0,0],[2,2],[0,2],[2,0]]}}",
+                        422, NULL);
   const cJSON *p = cJSON_GetObjectItem(
       cJSON_GetArrayItem(cJSON_GetObjectItem(j, "errors"), 0), "pointer");
   assert_true(strncmp(p->valuestring, "/to", 3) == 0);
@@ -189,8 +187,8 @@ static void circle_to_circle_stays_a_circle(void **state) {
     assert_close(metric(f, "self_intersections"), 0, 0);
     assert_le(metric(f, "closure_gap"), 1e-6);
     assert_le(circle_deviation(f, r), 1e-5);
-    assert_true(cJSON_IsTrue(cJSON_GetObjectItem(
-        cJSON_GetObjectItem(f, "curve"), "closed")));
+    assert_true(cJSON_IsTrue(
+        cJSON_GetObjectItem(cJSON_GetObjectItem(f, "curve"), "closed")));
   }
   assert_true(cJSON_IsArray(cJSON_GetObjectItem(j, "matches_used")));
   cJSON_Delete(j);
@@ -199,8 +197,7 @@ static void circle_to_circle_stays_a_circle(void **state) {
 
 static void times_choose_the_frames(void **state) {
   (void)state;
-  char *body =
-      circles_request(1.0, 3.0, ",\"times\":[0.25],\"metrics\":true");
+  char *body = circles_request(1.0, 3.0, ",\"times\":[0.25],\"metrics\":true");
   cJSON *j = morph_ok(body);
   const cJSON *frames = cJSON_GetObjectItem(j, "frames");
   assert_int_equal(cJSON_GetArraySize(frames), 1);
@@ -226,8 +223,7 @@ static void metrics_false_omits_metrics(void **state) {
 
 static void linear_method_starts_and_ends_at_the_inputs(void **state) {
   (void)state;
-  char *body =
-      circles_request(1.0, 2.0, ",\"frames\":5,\"method\":\"linear\"");
+  char *body = circles_request(1.0, 2.0, ",\"frames\":5,\"method\":\"linear\"");
   cJSON *j = morph_ok(body);
   assert_string_equal(cJSON_GetObjectItem(j, "method")->valuestring, "linear");
   const cJSON *frames = cJSON_GetObjectItem(j, "frames");
@@ -235,11 +231,10 @@ static void linear_method_starts_and_ends_at_the_inputs(void **state) {
   /* Two concentric circles with the same parameterisation: every
    * control point of frame t is (1 + t) times that of frame 0, and the
    * weights are those of frame 0. */
-  const cJSON *c0 = cJSON_GetObjectItem(cJSON_GetArrayItem(frames, 0),
-                                        "curve");
+  const cJSON *c0 = cJSON_GetObjectItem(cJSON_GetArrayItem(frames, 0), "curve");
   for (int i = 1; i < 5; i++) {
-    const cJSON *ci = cJSON_GetObjectItem(cJSON_GetArrayItem(frames, i),
-                                          "curve");
+    const cJSON *ci =
+        cJSON_GetObjectItem(cJSON_GetArrayItem(frames, i), "curve");
     double scale = 1.0 + 0.25 * i;
     const cJSON *p0 = cJSON_GetObjectItem(c0, "control_points");
     const cJSON *pi = cJSON_GetObjectItem(ci, "control_points");
@@ -255,8 +250,7 @@ static void linear_method_starts_and_ends_at_the_inputs(void **state) {
     double *w0 = at_numbers(cJSON_GetObjectItem(c0, "weights"), &n0);
     double *wi = at_numbers(cJSON_GetObjectItem(ci, "weights"), &ni);
     assert_int_equal(n0, ni);
-    for (size_t k = 0; k < n0; k++)
-      assert_close(wi[k], w0[k], 1e-15);
+    for (size_t k = 0; k < n0; k++) assert_close(wi[k], w0[k], 1e-15);
     free(w0);
     free(wi);
   }
@@ -317,9 +311,10 @@ static void animate_d_paths_share_one_structure(void **state) {
 
 static void svg_is_returned_when_asked(void **state) {
   (void)state;
-  char *body = circles_request(
-      1.0, 2.0, ",\"frames\":3,\"format\":\"svg\",\"svg\":{\"layout\":"
-                "\"overlay\",\"stroke\":\"#336699\"}");
+  char *body =
+      circles_request(1.0, 2.0,
+                      ",\"frames\":3,\"format\":\"svg\",\"svg\":{\"layout\":"
+                      "\"overlay\",\"stroke\":\"#336699\"}");
   api_response res;
   assert_int_equal(at_call(MORPH, body, &res, NULL), 200);
   assert_string_equal(res.content_type, "image/svg+xml");
@@ -364,9 +359,8 @@ static void prepared_plan_renders_the_same_result(void **state) {
   req.body = body;
   req.length = strlen(body);
   assert_int_equal(api_handle(&cfg, &req, &sync), 200);
-  assert_int_equal(api_morph_prepare(&cfg, &req, cfg.max_frames_job, &plan,
-                                     &err),
-                   0);
+  assert_int_equal(
+      api_morph_prepare(&cfg, &req, cfg.max_frames_job, &plan, &err), 0);
   assert_non_null(plan);
   assert_int_equal(api_morph_frame_count(plan), 6);
   for (size_t i = 6; i-- > 0;)
@@ -399,9 +393,8 @@ static void plan_names_the_member_that_chose_the_frames(void **state) {
     req.route = MORPH;
     req.body = bodies[k][0];
     req.length = strlen(bodies[k][0]);
-    assert_int_equal(api_morph_prepare(&cfg, &req, cfg.max_frames_sync, &plan,
-                                       &err),
-                     0);
+    assert_int_equal(
+        api_morph_prepare(&cfg, &req, cfg.max_frames_sync, &plan, &err), 0);
     assert_string_equal(api_morph_frames_pointer(plan), bodies[k][1]);
     api_morph_plan_free(plan);
     api_response_free(&err);

@@ -51,8 +51,7 @@ static bool oom_problem(const char *body) {
 static oom_outcome outcome_of(const api_response *r, char *why) {
   bool problem = r->content_type != NULL &&
                  strcmp(r->content_type, "application/problem+json") == 0;
-  if (r->status == 200)
-    return OOM_RAN_OK;
+  if (r->status == 200) return OOM_RAN_OK;
   /* one failed allocation leaves memory for the problem; with every later
    * one failing too it may be the fallback (type, title and status of a
    * 503) or, without a byte to hold that, no body */
@@ -98,8 +97,7 @@ static oom_outcome run_request(void *ctx, char *why) {
   req.length = strlen(c->body);
   req.accept = c->accept;
   req.request_id = "oom-1";
-  if (c->prepared)
-    return run_prepared(&req, why);
+  if (c->prepared) return run_prepared(&req, why);
   api_handle(NULL, &req, &out);
   got = outcome_of(&out, why);
   api_response_free(&out);
@@ -130,8 +128,7 @@ static void reconstruct_route_answers_503_when_out_of_memory(void **state) {
       "\"kappa\":{\"degree\":1,\"knots\":[0,0,5,5],\"coefficients\":[0,5]},"
       "\"closed\":false},\"tolerance\":1e-4,\"include\":[\"svg_d\"]}";
   (void)state;
-  both_loops("POST /v1/reconstruct", API_ROUTE_RECONSTRUCT, NULL, false,
-             body);
+  both_loops("POST /v1/reconstruct", API_ROUTE_RECONSTRUCT, NULL, false, body);
 }
 
 static void morph_json_answers_503_when_out_of_memory(void **state) {
@@ -151,8 +148,7 @@ static void morph_open_matches_answers_503_when_out_of_memory(void **state) {
            "{\"from\":%s,\"to\":%s,\"frames\":3,\"metrics\":true,"
            "\"matches\":[[0.3,0.4]],\"tolerance\":1e-3}",
            arch, wave);
-  both_loops("POST /v1/morph open matches", API_ROUTE_MORPH, NULL, false,
-             body);
+  both_loops("POST /v1/morph open matches", API_ROUTE_MORPH, NULL, false, body);
 }
 
 static void morph_linear_auto_answers_503_when_out_of_memory(void **state) {
@@ -167,8 +163,7 @@ static void morph_linear_auto_answers_503_when_out_of_memory(void **state) {
            "{\"from\":%s,\"to\":%s,\"frames\":2,\"matches\":\"auto\","
            "\"tolerance\":1e-3}",
            circle, diamond);
-  both_loops("POST /v1/morph auto matches", API_ROUTE_MORPH, NULL, false,
-             body);
+  both_loops("POST /v1/morph auto matches", API_ROUTE_MORPH, NULL, false, body);
 }
 
 static void morph_svg_answers_503_when_out_of_memory(void **state) {
@@ -182,8 +177,7 @@ static void morph_svg_answers_503_when_out_of_memory(void **state) {
 }
 
 static void morph_svg_layouts_answer_503_when_out_of_memory(void **state) {
-  static const char *const layouts[] = {"overlay", "animate",
-                                        "curvature_plot"};
+  static const char *const layouts[] = {"overlay", "animate", "curvature_plot"};
   char body[1024], name[64];
   (void)state;
   for (size_t i = 0; i < sizeof layouts / sizeof layouts[0]; i++) {

@@ -29,13 +29,13 @@
 #define SQ_0 SQUARE_AT(0, 1)
 #define SQ_3 SQUARE_AT(3, 4)
 #define SQ_6 SQUARE_AT(6, 7)
-#define RING_SHAPE                                                            \
-  "{\"type\":\"shape\",\"fill_rule\":\"nonzero\",\"contours\":["             \
-  "{\"type\":\"svg\",\"d\":\"" OUTER_D "\"},"                                 \
+#define RING_SHAPE                                                             \
+  "{\"type\":\"shape\",\"fill_rule\":\"nonzero\",\"contours\":["               \
+  "{\"type\":\"svg\",\"d\":\"" OUTER_D "\"},"                                  \
   "{\"type\":\"svg\",\"d\":\"" INNER_D "\"}]}"
 /* The unit square with its lower left corner at (x0, 0); x1 = x0 + 1. */
-#define SQUARE_AT(x0, x1)                                                     \
-  "{\"type\":\"bspline\",\"degree\":1,\"knots\":[0,0,1,2,3,4,4],"             \
+#define SQUARE_AT(x0, x1)                                                      \
+  "{\"type\":\"bspline\",\"degree\":1,\"knots\":[0,0,1,2,3,4,4],"              \
   "\"control_points\":[[" #x0 ",0],[" #x1 ",0],[" #x1 ",1],[" #x0 ",1],[" #x0  \
   ",0]],\"closed\":true}"
 
@@ -60,8 +60,7 @@ static double radius_error(const cJSON *c, double r) {
 
 static const cJSON *member(const cJSON *o, const char *key) {
   const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
-  if (v == NULL)
-    print_error("no member \"%s\"\n", key);
+  if (v == NULL) print_error("no member \"%s\"\n", key);
   assert_non_null(v);
   return v;
 }
@@ -92,11 +91,9 @@ static void ring_to_ring_keeps_both_contours(void **state) {
       double r = k == 0 ? 2.0 : 1.0;
       assert_true(cJSON_IsObject(c));
       assert_true(cJSON_IsTrue(member(c, "closed")));
-      assert_true(fabs(member(c, "length")->valuedouble - 2 * PI * r) <
-                  1e-5);
+      assert_true(fabs(member(c, "length")->valuedouble - 2 * PI * r) < 1e-5);
       /* the ends are the inputs: circles of radius 2 and 1 */
-      if (t == 0 || t == 1)
-        assert_true(radius_error(c, r) < 1e-5);
+      if (t == 0 || t == 1) assert_true(radius_error(c, r) < 1e-5);
     }
     assert_int_equal(cJSON_GetArraySize(member(m, "contours")), 2);
     assert_int_equal(member(m, "mutual_intersections")->valueint, 0);
@@ -139,8 +136,7 @@ static char *glyph_d(const char *id) {
   }
   cJSON_Delete(root);
   free(text);
-  if (d == NULL)
-    print_error("no glyph %s\n", id);
+  if (d == NULL) print_error("no glyph %s\n", id);
   assert_non_null(d);
   return d;
 }
@@ -161,8 +157,7 @@ static char *glyph_request(const char *from, const char *to,
 
 static void o_to_c_loses_the_hole_at_the_end(void **state) {
   (void)state;
-  char *body = glyph_request("dejavu-sans/O", "dejavu-sans/C",
-                             ",\"frames\":5");
+  char *body = glyph_request("dejavu-sans/O", "dejavu-sans/C", ",\"frames\":5");
   cJSON *j = at_expect_json(MORPH, body);
   const cJSON *used = member(j, "contour_matches_used");
   const cJSON *frames = member(j, "frames");
@@ -182,14 +177,13 @@ static void o_to_c_loses_the_hole_at_the_end(void **state) {
   const cJSON *last = cJSON_GetArrayItem(frames, 4);
   assert_true(member(last, "t")->valuedouble == 1.0);
   for (int k = 0; k < slots; k++)
-    assert_true(cJSON_IsObject(cJSON_GetArrayItem(member(first, "contours"),
-                                                  k)));
-  assert_true(cJSON_IsNull(cJSON_GetArrayItem(member(last, "contours"),
-                                              hole)));
-  assert_true(cJSON_IsObject(cJSON_GetArrayItem(member(last, "contours"),
-                                                paired)));
-  assert_true(cJSON_IsNull(cJSON_GetArrayItem(
-      member(member(last, "metrics"), "contours"), hole)));
+    assert_true(
+        cJSON_IsObject(cJSON_GetArrayItem(member(first, "contours"), k)));
+  assert_true(cJSON_IsNull(cJSON_GetArrayItem(member(last, "contours"), hole)));
+  assert_true(
+      cJSON_IsObject(cJSON_GetArrayItem(member(last, "contours"), paired)));
+  assert_true(cJSON_IsNull(
+      cJSON_GetArrayItem(member(member(last, "metrics"), "contours"), hole)));
   cJSON_Delete(j);
   free(body);
 }
@@ -197,11 +191,9 @@ static void o_to_c_loses_the_hole_at_the_end(void **state) {
 static void json_shape_is_the_svg_shape(void **state) {
   (void)state;
   api_response a, b;
-  at_call(MORPH, "{\"from\":" RING ",\"to\":" RING ",\"frames\":3}", &a,
-          NULL);
-  at_call(MORPH,
-          "{\"from\":" RING_SHAPE ",\"to\":" RING_SHAPE ",\"frames\":3}", &b,
-          NULL);
+  at_call(MORPH, "{\"from\":" RING ",\"to\":" RING ",\"frames\":3}", &a, NULL);
+  at_call(MORPH, "{\"from\":" RING_SHAPE ",\"to\":" RING_SHAPE ",\"frames\":3}",
+          &b, NULL);
   assert_int_equal(a.status, 200);
   assert_int_equal(b.status, 200);
   assert_int_equal(a.length, b.length);
@@ -212,9 +204,9 @@ static void json_shape_is_the_svg_shape(void **state) {
 
 static void a_circle_against_a_ring_is_a_shape_of_one(void **state) {
   (void)state;
-  cJSON *j = at_expect_json(
-      MORPH, "{\"from\":{\"type\":\"svg\",\"d\":\"" OUTER_D "\"},\"to\":" RING
-             ",\"frames\":2}");
+  cJSON *j =
+      at_expect_json(MORPH, "{\"from\":{\"type\":\"svg\",\"d\":\"" OUTER_D
+                            "\"},\"to\":" RING ",\"frames\":2}");
   const cJSON *used = member(j, "contour_matches_used");
   assert_int_equal(cJSON_GetArraySize(used), 2);
   const cJSON *f0 = cJSON_GetArrayItem(member(j, "frames"), 0);
@@ -259,8 +251,8 @@ static void caller_pairs_are_used_and_checked(void **state) {
              ",\"contour_matches\":[[null,null]]}",
              422, "/contour_matches/0");
   at_problem(MORPH,
-             "{\"from\":" RING ",\"to\":" RING ",\"contour_matches\":[]}",
-             422, "/contour_matches");
+             "{\"from\":" RING ",\"to\":" RING ",\"contour_matches\":[]}", 422,
+             "/contour_matches");
 }
 
 /* ---- errors name the contour ---- */
@@ -269,24 +261,25 @@ static void bad_contours_are_named(void **state) {
   (void)state;
   /* an open contour, a zero-length one, a signature, a shape in a shape */
   at_problem(MORPH,
-             "{\"to\":" RING ",\"from\":{\"type\":\"shape\",\"contours\":["
-             SQ(0) "," SQ(3) ",{\"type\":\"svg\",\"d\":\"M 7 0 L 8 "
-             "0 L 8 1\"}]}}",
+             "{\"to\":" RING ",\"from\":{\"type\":\"shape\",\"contours\":[" SQ(
+                 0) "," SQ(3) ",{\"type\":\"svg\",\"d\":\"M 7 0 L 8 "
+                              "0 L 8 1\"}]}}",
              422, "/from/contours/2");
   at_problem(MORPH,
-             "{\"to\":" RING ",\"from\":{\"type\":\"shape\",\"contours\":["
-             SQ(0) ",{\"type\":\"svg\",\"d\":\"M 5 5 L 5 5 Z\"}]}}",
+             "{\"to\":" RING ",\"from\":{\"type\":\"shape\",\"contours\":[" SQ(
+                 0) ",{\"type\":\"svg\",\"d\":\"M 5 5 L 5 5 Z\"}]}}",
              422, "/from/contours/1/d");
   at_problem(MORPH,
-             "{\"to\":" RING ",\"from\":{\"type\":\"shape\",\"contours\":["
-             SQ(0) "," RING "]}}",
+             "{\"to\":" RING
+             ",\"from\":{\"type\":\"shape\",\"contours\":[" SQ(0) "," RING
+                                                                  "]}}",
              422, "/from/contours/1");
   at_problem(MORPH,
              "{\"to\":" RING ",\"from\":{\"type\":\"shape\",\"contours\":[]}}",
              422, "/from/contours");
   at_problem(MORPH,
-             "{\"to\":" RING ",\"from\":{\"type\":\"shape\",\"contours\":["
-             SQ(0) "],\"fill_rule\":\"winding\"}}",
+             "{\"to\":" RING ",\"from\":{\"type\":\"shape\",\"contours\":[" SQ(
+                 0) "],\"fill_rule\":\"winding\"}}",
              422, "/from/fill_rule");
   /* the single-curve side of a compound morph must be closed */
   at_problem(MORPH,
@@ -301,8 +294,10 @@ static void subpath_offsets_are_given(void **state) {
   const char *d = OUTER_D " M 5 5 L 6 5 L 6 6";
   size_t off = (size_t)(strchr(d + 1, 'M') - d);
   char body[512], want[64];
-  snprintf(body, sizeof body, "{\"from\":{\"type\":\"svg\",\"d\":\"%s\"},"
-                              "\"to\":" RING "}", d);
+  snprintf(body, sizeof body,
+           "{\"from\":{\"type\":\"svg\",\"d\":\"%s\"},"
+           "\"to\":" RING "}",
+           d);
   cJSON *j = at_expect_problem(MORPH, body, 422, "/from/d");
   snprintf(want, sizeof want, "offset %zu", off);
   const char *msg = member(j, "detail")->valuestring;
@@ -314,8 +309,10 @@ static void subpath_offsets_are_given(void **state) {
   /* a subpath of zero length */
   d = OUTER_D " M 5 5 L 5 5 Z";
   off = (size_t)(strchr(d + 1, 'M') - d);
-  snprintf(body, sizeof body, "{\"from\":{\"type\":\"svg\",\"d\":\"%s\"},"
-                              "\"to\":" RING "}", d);
+  snprintf(body, sizeof body,
+           "{\"from\":{\"type\":\"svg\",\"d\":\"%s\"},"
+           "\"to\":" RING "}",
+           d);
   j = at_expect_problem(MORPH, body, 422, "/from/d");
   msg = member(j, "detail")->valuestring;
   assert_non_null(strstr(msg, want));
@@ -330,7 +327,8 @@ static void contours_past_the_limit_are_refused(void **state) {
   cfg.max_contours = 2;
   cJSON *j = at_expect_problem_cfg(
       &cfg, MORPH,
-      "{\"to\":" RING ",\"from\":{\"type\":\"shape\",\"contours\":[" SQ(0) "," SQ(3) "," SQ(6) "]}}",
+      "{\"to\":" RING ",\"from\":{\"type\":\"shape\",\"contours\":[" SQ(
+          0) "," SQ(3) "," SQ(6) "]}}",
       422, "/from/contours/2");
   assert_string_equal(member(j, "type")->valuestring,
                       "/problems/limit-exceeded");
@@ -353,8 +351,8 @@ static void what_shapes_do_not_take_is_named(void **state) {
              "\"svg\":{\"layout\":\"overlay\"}}",
              422, "/svg/layout");
   at_problem(MORPH,
-             "{\"from\":" RING ",\"to\":" RING ",\"matches\":[[0.5,0.5]]}",
-             422, "/matches");
+             "{\"from\":" RING ",\"to\":" RING ",\"matches\":[[0.5,0.5]]}", 422,
+             "/matches");
   at_problem(MORPH,
              "{\"from\":" RING ",\"to\":{\"type\":\"signature\","
              "\"signature\":{\"length\":6.283185307179586,\"start\":{"
@@ -363,10 +361,10 @@ static void what_shapes_do_not_take_is_named(void **state) {
              "\"coefficients\":[1]}}}}",
              422, "/to");
   /* contour pairs without a shape */
-  at_problem(MORPH,
-             "{\"from\":" SQ(0) ",\"to\":" SQ(3)
-             ",\"contour_matches\":[[0,0]]}",
-             422, "/contour_matches");
+  at_problem(
+      MORPH,
+      "{\"from\":" SQ(0) ",\"to\":" SQ(3) ",\"contour_matches\":[[0,0]]}", 422,
+      "/contour_matches");
 }
 
 /* ---- SVG documents ---- */
@@ -415,9 +413,10 @@ static void svg_filmstrip_fills_every_frame(void **state) {
   api_response_free(&res);
   at_call(MORPH,
           "{\"from\":{\"type\":\"shape\",\"fill_rule\":\"evenodd\","
-          "\"contours\":[" SQ(0) "," SQ(3) "]},\"to\":{\"type\":"
-          "\"shape\",\"fill_rule\":\"evenodd\",\"contours\":[" SQ(0) ","
-          SQ(3) "]},\"frames\":2,\"format\":\"svg\"}",
+          "\"contours\":[" SQ(0) "," SQ(
+              3) "]},\"to\":{\"type\":"
+                 "\"shape\",\"fill_rule\":\"evenodd\",\"contours\":[" SQ(
+                     0) "," SQ(3) "]},\"frames\":2,\"format\":\"svg\"}",
           &res, NULL);
   assert_int_equal(res.status, 200);
   assert_int_equal(check_paths(res.body, "evenodd", two, 2), 2);
@@ -500,9 +499,10 @@ static void prepared_shapes_give_the_same_answer(void **state) {
  * and a limit below the bound is refused before any frame. */
 static void answers_stay_within_their_bound(void **state) {
   (void)state;
-  static const char *const pairs[][2] = {
-      {"dejavu-sans/O", "dejavu-sans/C"}, {"dejavu-sans/i", "dejavu-sans/l"},
-      {"dejavu-sans/8", "dejavu-sans/3"}, {"dejavu-sans/e", "dejavu-sans/c"}};
+  static const char *const pairs[][2] = {{"dejavu-sans/O", "dejavu-sans/C"},
+                                         {"dejavu-sans/i", "dejavu-sans/l"},
+                                         {"dejavu-sans/8", "dejavu-sans/3"},
+                                         {"dejavu-sans/e", "dejavu-sans/c"}};
   for (size_t k = 0; k < sizeof pairs / sizeof pairs[0]; k++) {
     char *body = glyph_request(pairs[k][0], pairs[k][1],
                                ",\"frames\":7,\"include\":[\"svg_d\"]");
@@ -520,8 +520,8 @@ static void answers_stay_within_their_bound(void **state) {
     size_t bound = api_morph_predicted_bytes(plan);
     assert_int_equal(api_morph_result(plan, &res), 200);
     if (bound < res.length)
-      print_error("%s -> %s: %zu bytes, bound %zu\n", pairs[k][0],
-                  pairs[k][1], res.length, bound);
+      print_error("%s -> %s: %zu bytes, bound %zu\n", pairs[k][0], pairs[k][1],
+                  res.length, bound);
     assert_true(bound >= res.length);
     api_morph_plan_free(plan);
     api_response_free(&res);
@@ -551,13 +551,12 @@ static void a_ring_has_one_signature_per_contour(void **state) {
     const cJSON *s = cJSON_GetArrayItem(sigs, k), *p;
     assert_true(fabs(member(s, "length")->valuedouble - 2 * PI * r) < 1e-9);
     cJSON_ArrayForEach(p, cJSON_GetArrayItem(samples, k))
-      assert_true(fabs(cJSON_GetArrayItem(p, 1)->valuedouble - kappa) <
-                  1e-6);
+        assert_true(fabs(cJSON_GetArrayItem(p, 1)->valuedouble - kappa) < 1e-6);
   }
   cJSON_Delete(j);
   at_problem(SIGNATURE,
-             "{\"curve\":{\"type\":\"shape\",\"contours\":[" SQ(0)
-             ",{\"type\":\"points\",\"points\":[[0,0],[1,0],[1,1]]}]}}",
+             "{\"curve\":{\"type\":\"shape\",\"contours\":[" SQ(
+                 0) ",{\"type\":\"points\",\"points\":[[0,0],[1,0],[1,1]]}]}}",
              422, "/curve/contours/1");
 }
 
@@ -579,7 +578,8 @@ static void one_subpath_answers_as_one_curve(void **state) {
   assert_null(cJSON_GetObjectItemCaseSensitive(j, "contour_matches_used"));
   cJSON_Delete(j);
   at_call(MORPH,
-          "{\"from\":{\"type\":\"svg\",\"d\":\"" OUTER_D "\"},\"to\":" SQ(0) ",\"frames\":2}",
+          "{\"from\":{\"type\":\"svg\",\"d\":\"" OUTER_D
+          "\"},\"to\":" SQ(0) ",\"frames\":2}",
           &a, NULL);
   at_call(MORPH,
           "{\"from\":{\"type\":\"svg\",\"d\":\"" OUTER_D " M 9 9\"},"

@@ -11,8 +11,7 @@ static cJSON *signature_of(const char *body) {
 
 static double num(const cJSON *o, const char *key) {
   const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
-  if (!cJSON_IsNumber(v))
-    print_error("member %s is not a number\n", key);
+  if (!cJSON_IsNumber(v)) print_error("member %s is not a number\n", key);
   assert_true(cJSON_IsNumber(v));
   return v->valuedouble;
 }
@@ -35,8 +34,8 @@ static void circle_signature_has_kappa_one_over_r(void **state) {
   assert_true(cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(sig, "closed")));
   const cJSON *start = cJSON_GetObjectItemCaseSensitive(sig, "start");
   size_t np;
-  double *pt = at_numbers(cJSON_GetObjectItemCaseSensitive(start, "point"),
-                          &np);
+  double *pt =
+      at_numbers(cJSON_GetObjectItemCaseSensitive(start, "point"), &np);
   assert_int_equal(np, 2);
   assert_close(pt[0], 1.0 + r, 1e-12);
   assert_close(pt[1], -3.0, 1e-12);
@@ -62,10 +61,9 @@ static void circle_signature_has_kappa_one_over_r(void **state) {
    * [0, L]. */
   const cJSON *kappa = cJSON_GetObjectItemCaseSensitive(sig, "kappa");
   size_t nk, nc;
-  double *k = at_numbers(cJSON_GetObjectItemCaseSensitive(kappa, "knots"),
-                         &nk);
-  double *c = at_numbers(
-      cJSON_GetObjectItemCaseSensitive(kappa, "coefficients"), &nc);
+  double *k = at_numbers(cJSON_GetObjectItemCaseSensitive(kappa, "knots"), &nk);
+  double *c =
+      at_numbers(cJSON_GetObjectItemCaseSensitive(kappa, "coefficients"), &nc);
   assert_int_equal(nk, nc + (size_t)num(kappa, "degree") + 1);
   assert_close(k[0], 0, 0);
   assert_rel(k[nk - 1], 2 * M_PI * r, 1e-10);
@@ -87,9 +85,8 @@ static void clockwise_circle_has_negative_kappa(void **state) {
   cJSON_ArrayForEach(e, cJSON_GetObjectItemCaseSensitive(j, "samples")) {
     assert_close(cJSON_GetArrayItem(e, 1)->valuedouble, -1.0 / r, 1e-9);
   }
-  assert_close(
-      num(cJSON_GetObjectItemCaseSensitive(j, "signature"), "turning"),
-      -2 * M_PI, 1e-9);
+  assert_close(num(cJSON_GetObjectItemCaseSensitive(j, "signature"), "turning"),
+               -2 * M_PI, 1e-9);
   cJSON_Delete(j);
   free(b.s);
 }
@@ -116,11 +113,10 @@ static void square_signature_has_four_right_angle_corners(void **state) {
   (void)state;
   /* A closed counter-clockwise square of side 2: straight sides, a turn of
    * pi/2 at every vertex (the seam's at s = length), turning 2 pi. */
-  cJSON *j = signature_of(
-      "{\"curve\":{\"type\":\"bspline\",\"degree\":1,"
-      "\"knots\":[0,0,1,2,3,4,4],"
-      "\"control_points\":[[0,0],[2,0],[2,2],[0,2],[0,0]],"
-      "\"closed\":true}}");
+  cJSON *j = signature_of("{\"curve\":{\"type\":\"bspline\",\"degree\":1,"
+                          "\"knots\":[0,0,1,2,3,4,4],"
+                          "\"control_points\":[[0,0],[2,0],[2,2],[0,2],[0,0]],"
+                          "\"closed\":true}}");
   const cJSON *sig = cJSON_GetObjectItemCaseSensitive(j, "signature");
   assert_close(num(sig, "length"), 8.0, 1e-12);
   assert_close(num(sig, "turning"), 2 * M_PI, 1e-12);
@@ -148,8 +144,8 @@ static void signature_input_is_returned_as_given(void **state) {
   assert_close(num(sig, "length"), 5.0, 0);
   /* kappa = s on [0, 5]: turning = 25 / 2. */
   assert_close(num(sig, "turning"), 12.5, 1e-12);
-  const cJSON *e = cJSON_GetArrayItem(
-      cJSON_GetObjectItemCaseSensitive(j, "samples"), 1);
+  const cJSON *e =
+      cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(j, "samples"), 1);
   assert_close(cJSON_GetArrayItem(e, 0)->valuedouble, 2.5, 1e-15);
   assert_close(cJSON_GetArrayItem(e, 1)->valuedouble, 2.5, 1e-12);
   cJSON_Delete(j);
@@ -160,8 +156,8 @@ static void svg_path_signature_has_its_corner(void **state) {
   /* Two sides of a 3-4-5 right angle, drawn in SVG: length 7, straight
    * pieces, one corner of +pi/2 at s = 3 (y points down in SVG data, but
    * the service works in the coordinates as given). */
-  cJSON *j = signature_of(
-      "{\"curve\":{\"type\":\"svg\",\"d\":\"M 0 0 h 3 v 4\"}}");
+  cJSON *j =
+      signature_of("{\"curve\":{\"type\":\"svg\",\"d\":\"M 0 0 h 3 v 4\"}}");
   const cJSON *sig = cJSON_GetObjectItemCaseSensitive(j, "signature");
   assert_close(num(sig, "length"), 7.0, 1e-12);
   const cJSON *corners = cJSON_GetObjectItemCaseSensitive(sig, "corners");
@@ -178,8 +174,7 @@ static void unknown_top_level_fields_are_ignored(void **state) {
       "{\"comment\":[1,{\"x\":null}],\"curve\":{\"type\":\"bspline\","
       "\"degree\":1,\"knots\":[0,0,1,1],\"control_points\":[[0,0],[0,3]],"
       "\"colour\":\"red\"}}");
-  assert_close(num(cJSON_GetObjectItemCaseSensitive(j, "signature"),
-                   "length"),
+  assert_close(num(cJSON_GetObjectItemCaseSensitive(j, "signature"), "length"),
                3.0, 1e-12);
   cJSON_Delete(j);
 }
@@ -195,8 +190,8 @@ static void numbers_round_trip_through_json(void **state) {
             "\"coefficients\":[0]}}}}",
             x, x);
   cJSON *j = signature_of(b.s);
-  assert_true(num(cJSON_GetObjectItemCaseSensitive(j, "signature"),
-                  "length") == x);
+  assert_true(num(cJSON_GetObjectItemCaseSensitive(j, "signature"), "length") ==
+              x);
   cJSON_Delete(j);
   free(b.s);
 }

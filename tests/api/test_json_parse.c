@@ -22,20 +22,17 @@ static size_t heap_now, heap_peak, heap_blocks;
 /* Each block carries its size in front of it. */
 static void *counting_malloc(size_t n) {
   max_align_t *b = malloc(sizeof(max_align_t) + n);
-  if (b == NULL)
-    return NULL;
+  if (b == NULL) return NULL;
   *(size_t *)(void *)b = n;
   heap_now += n + 16;
   heap_blocks++;
-  if (heap_now > heap_peak)
-    heap_peak = heap_now;
+  if (heap_now > heap_peak) heap_peak = heap_now;
   return b + 1;
 }
 
 static void counting_free(void *p) {
   max_align_t *b;
-  if (p == NULL)
-    return;
+  if (p == NULL) return;
   b = (max_align_t *)p - 1;
   heap_now -= *(size_t *)(void *)b + 16;
   free(b);
@@ -56,8 +53,7 @@ static const char *detail_of(const cJSON *problem) {
 }
 
 /* The answer to body is 400 malformed-json whose detail is want. */
-static void expect_detail(api_route route, const char *body,
-                          const char *want) {
+static void expect_detail(api_route route, const char *body, const char *want) {
   cJSON *j = at_expect_problem(route, body, 400, NULL);
   const cJSON *t = cJSON_GetObjectItemCaseSensitive(j, "type");
   assert_string_equal(t->valuestring, "/problems/malformed-json");
@@ -150,8 +146,7 @@ static void repeat_among_many_members_is_found(void **state) {
   size_t at;
   char want[200];
   at_printf(&b, "{");
-  for (int i = 0; i < 50000; i++)
-    at_printf(&b, "\"k%d\":\"%0100d\",", i, i);
+  for (int i = 0; i < 50000; i++) at_printf(&b, "\"k%d\":\"%0100d\",", i, i);
   at = b.n;
   at_printf(&b, "\"k0\":1}");
   snprintf(want, sizeof want,
@@ -186,8 +181,8 @@ static void packed_arrays_read_exact_values(void **state) {
   api__ctx_init(&ctx, &cfg);
   cJSON *root = api__parse_body(&ctx, body, strlen(body));
   assert_non_null(root);
-  assert_true(api__point_array(&ctx, cJSON_GetObjectItem(root, "p"), "/p",
-                               10, &pts, &np));
+  assert_true(api__point_array(&ctx, cJSON_GetObjectItem(root, "p"), "/p", 10,
+                               &pts, &np));
   assert_true(api__num_array(&ctx, cJSON_GetObjectItem(root, "n"), "/n", 10,
                              &nums, &nn));
   assert_int_equal(np, 3);
@@ -204,8 +199,8 @@ static void packed_arrays_read_exact_values(void **state) {
   cJSON_Delete(root);
 }
 
-#define CP_CURVE(cp)                                                        \
-  "{\"curve\":{\"type\":\"bspline\",\"degree\":1,\"knots\":[0,0,1,2,3,3],"  \
+#define CP_CURVE(cp)                                                           \
+  "{\"curve\":{\"type\":\"bspline\",\"degree\":1,\"knots\":[0,0,1,2,3,3],"     \
   "\"control_points\":" cp "}}"
 
 static void bad_control_points_are_named_as_before(void **state) {
@@ -292,44 +287,38 @@ static char *big_body(size_t limit, void (*member)(at_buf *, int),
 
 static void rows_member(at_buf *b, int i) {
   at_printf(b, "\"p%d\":[", i);
-  for (int k = 0; k < 10000; k++)
-    at_printf(b, "%s[0,0]", k ? "," : "");
+  for (int k = 0; k < 10000; k++) at_printf(b, "%s[0,0]", k ? "," : "");
   at_printf(b, "]");
 }
 
 static void flat_member(at_buf *b, int i) {
   at_printf(b, "\"p%d\":[", i);
-  for (int k = 0; k < 10000; k++)
-    at_printf(b, "%s%d", k ? "," : "", k % 10);
+  for (int k = 0; k < 10000; k++) at_printf(b, "%s%d", k ? "," : "", k % 10);
   at_printf(b, "]");
 }
 
 static void long_string_member(at_buf *b, int i) {
   at_printf(b, "\"s%d\":\"", i);
-  for (int k = 0; k < 1000; k++)
-    at_printf(b, "M0 0L1 0L1 1Z ");
+  for (int k = 0; k < 1000; k++) at_printf(b, "M0 0L1 0L1 1Z ");
   at_printf(b, "\"");
 }
 
 static void short_strings_member(at_buf *b, int i) {
   at_printf(b, "\"s%d\":[", i);
-  for (int k = 0; k < 10000; k++)
-    at_printf(b, "%s\"a\"", k ? "," : "");
+  for (int k = 0; k < 10000; k++) at_printf(b, "%s\"a\"", k ? "," : "");
   at_printf(b, "]");
 }
 
 static void objects_member(at_buf *b, int i) {
   at_printf(b, "\"o%d\":{", i);
-  for (int k = 0; k < 10000; k++)
-    at_printf(b, "%s\"k%d\":0", k ? "," : "", k);
+  for (int k = 0; k < 10000; k++) at_printf(b, "%s\"k%d\":0", k ? "," : "", k);
   at_printf(b, "}");
 }
 
 /* numbers that cannot be packed: the array ends in null */
 static void unpacked_numbers_member(at_buf *b, int i) {
   at_printf(b, "\"m%d\":[", i);
-  for (int k = 0; k < 9999; k++)
-    at_printf(b, "0,");
+  for (int k = 0; k < 9999; k++) at_printf(b, "0,");
   at_printf(b, "null]");
 }
 
@@ -380,8 +369,8 @@ static void string_dense_body_takes_about_its_size(void **state) {
 
 static void costly_bodies_are_413_before_any_tree(void **state) {
   (void)state;
-  void (*const costly[])(at_buf *, int) = {
-      short_strings_member, objects_member, unpacked_numbers_member};
+  void (*const costly[])(at_buf *, int) = {short_strings_member, objects_member,
+                                           unpacked_numbers_member};
   for (size_t i = 0; i < sizeof costly / sizeof costly[0]; i++) {
     double f;
     size_t blocks;

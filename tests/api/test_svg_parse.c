@@ -125,8 +125,7 @@ static void check_pairs(const pair *t, size_t n) {
   }
 }
 
-static void real_icon_and_glyph_paths_equal_their_absolute_forms(
-    void **state) {
+static void real_icon_and_glyph_paths_equal_their_absolute_forms(void **state) {
   (void)state;
   check_pairs(REAL, sizeof REAL / sizeof REAL[0]);
 }
@@ -162,8 +161,8 @@ static void real_paths_have_the_expected_pieces(void **state) {
     km_curve_eval_side(&c, k, -1, 1, l);
     km_curve_eval_side(&c, k, 1, 1, r);
     double cr = l[1][0] * r[1][1] - l[1][1] * r[1][0];
-    assert_close(cr / (hypot(l[1][0], l[1][1]) * hypot(r[1][0], r[1][1])),
-                 0.0, 1e-12);
+    assert_close(cr / (hypot(l[1][0], l[1][1]) * hypot(r[1][0], r[1][1])), 0.0,
+                 1e-12);
   }
   km_curve_free(&c);
   /* pie: 270-degree arc in 3 pieces and two lines, rational */
@@ -226,8 +225,8 @@ static void shapes_fixture_paths_match_their_bsplines(void **state) {
 
 /* A full circle written as two A commands: curvature 1/r from the rational
  * derivatives, every point at distance r from the centre. */
-static void circle_from_two_arc_commands_has_curvature_one_over_r(
-    void **state) {
+static void
+circle_from_two_arc_commands_has_curvature_one_over_r(void **state) {
   (void)state;
   const char *ds[] = {"M20,100 A80,80 0 1,1 180,100 A80,80 0 1,1 20,100 Z",
                       "M20 100a80 80 0 1 0 160 0a80 80 0 1 0-160 0z"};
@@ -271,7 +270,7 @@ typedef struct bad {
   size_t len;         /* 0: strlen(d) */
   const char *marker; /* expected offset = where this occurs; NULL = end */
   km_status status;
-  const char *says;   /* part of the message */
+  const char *says; /* part of the message */
 } bad;
 
 static const bad BAD[] = {
@@ -317,8 +316,10 @@ static void bad_path_data_is_refused_with_the_offset(void **state) {
     const bad *b = &BAD[i];
     size_t len = b->len ? b->len : strlen(b->d);
     size_t want;
-    if (!b->marker) want = len;
-    else if (!*b->marker) want = strlen(b->d); /* at the embedded NUL */
+    if (!b->marker)
+      want = len;
+    else if (!*b->marker)
+      want = strlen(b->d); /* at the embedded NUL */
     else {
       /* the last occurrence, so "M2" is not found in "M0" */
       const char *at = NULL, *p = b->d;
@@ -330,8 +331,8 @@ static void bad_path_data_is_refused_with_the_offset(void **state) {
     km_curve_init(&c);
     size_t off = 12345;
     char msg[256] = "";
-    km_status st = api_svg_parse_path(b->d, len, 1e-9, &c, &off, msg,
-                                      sizeof msg);
+    km_status st =
+        api_svg_parse_path(b->d, len, 1e-9, &c, &off, msg, sizeof msg);
     if (st != b->status || off != want || !strstr(msg, b->says)) {
       print_error("\"%s\": status %d offset %zu \"%s\"; expected status %d "
                   "offset %zu and a message saying \"%s\"\n",

@@ -29,7 +29,8 @@ static const char *PNG_PY =
     "    n, typ = struct.unpack('>I4s', data[pos:pos + 8])\n"
     "    body = data[pos + 8:pos + 8 + n]; pos += 12 + n\n"
     "    if typ == b'IHDR':\n"
-    "        w, h, depth, ctype, _, _, inter = struct.unpack('>IIBBBBB', body)\n"
+    "        w, h, depth, ctype, _, _, inter = struct.unpack('>IIBBBBB', "
+    "body)\n"
     "    elif typ == b'IDAT':\n"
     "        idat += body\n"
     "assert depth == 8 and inter == 0\n"
@@ -37,9 +38,11 @@ static const char *PNG_PY =
     "raw = zlib.decompress(idat); stride = w * bpp\n"
     "prev = bytearray(stride); i = 0; dark = 0; red = 0; rowd = rowr = 0\n"
     "for y in range(h):\n"
-    "    f = raw[i]; line = bytearray(raw[i + 1:i + 1 + stride]); i += 1 + stride\n"
+    "    f = raw[i]; line = bytearray(raw[i + 1:i + 1 + stride]); i += 1 + "
+    "stride\n"
     "    if f == 2:\n"
-    "        line = bytearray(prev) if not any(line) else bytearray((u + v) & 255 for u, v in zip(line, prev))\n"
+    "        line = bytearray(prev) if not any(line) else bytearray((u + v) & "
+    "255 for u, v in zip(line, prev))\n"
     "    elif f in (1, 3, 4):\n"
     "        for x in range(stride):\n"
     "            a = line[x - bpp] if x >= bpp else 0\n"
@@ -47,15 +50,19 @@ static const char *PNG_PY =
     "            if f == 1: line[x] = (line[x] + a) & 255\n"
     "            elif f == 3: line[x] = (line[x] + (a + b) // 2) & 255\n"
     "            else:\n"
-    "                p = a + b - c; pa = abs(p - a); pb = abs(p - b); pc = abs(p - c)\n"
-    "                pr = a if pa <= pb and pa <= pc else (b if pb <= pc else c)\n"
+    "                p = a + b - c; pa = abs(p - a); pb = abs(p - b); pc = "
+    "abs(p - c)\n"
+    "                pr = a if pa <= pb and pa <= pc else (b if pb <= pc else "
+    "c)\n"
     "                line[x] = (line[x] + pr) & 255\n"
     "    if y == 0 or line != prev:\n"
     "        chans = [line[k::bpp] for k in range(bpp)]\n"
     "        if bpp < 3: chans = [chans[0]] * 3 + chans[1:]\n"
     "        alpha = chans[3] if len(chans) > 3 else [255] * w\n"
-    "        rowd = sum(1 for r, g, b, a in zip(chans[0], chans[1], chans[2], alpha) if a and min(r, g, b) < 200)\n"
-    "        rowr = sum(1 for r, g, b, a in zip(chans[0], chans[1], chans[2], alpha) if a and r > 200 and g < 60 and b < 60)\n"
+    "        rowd = sum(1 for r, g, b, a in zip(chans[0], chans[1], chans[2], "
+    "alpha) if a and min(r, g, b) < 200)\n"
+    "        rowr = sum(1 for r, g, b, a in zip(chans[0], chans[1], chans[2], "
+    "alpha) if a and r > 200 and g < 60 and b < 60)\n"
     "    dark += rowd; red += rowr\n"
     "    prev = line\n"
     "print(w, h, dark, red)\n";
@@ -121,9 +128,8 @@ static image check_document_opt(const char *doc, bool decode) {
   st = run(cmd, line, sizeof line);
   if (st != 0) print_error("png decoder: %s\n", line);
   assert_int_equal(st, 0);
-  assert_int_equal(sscanf(line, "%d %d %ld %ld", &im.w, &im.h, &im.dark,
-                          &im.red),
-                   4);
+  assert_int_equal(
+      sscanf(line, "%d %d %ld %ld", &im.w, &im.h, &im.dark, &im.red), 4);
   unlink(svg);
   unlink(png);
   unlink(py);
@@ -217,8 +223,8 @@ static void every_layout_is_well_formed_and_renders(void **state) {
 }
 
 /* Without signatures the plot computes them; one frame alone works too. */
-static void curvature_plot_without_signatures_and_single_frames_render(
-    void **state) {
+static void
+curvature_plot_without_signatures_and_single_frames_render(void **state) {
   (void)state;
   frames fr;
   load_frames(&fr, false);
@@ -281,13 +287,16 @@ static void size_stroke_and_colour_options_are_honoured(void **state) {
 }
 
 /* Option strings go into attributes: markup in them must not escape. */
-static void hostile_option_strings_keep_the_document_well_formed(
-    void **state) {
+static void hostile_option_strings_keep_the_document_well_formed(void **state) {
   (void)state;
   frames fr;
   load_frames(&fr, false);
-  const char *evil[] = {"\"/><script>alert(1)</script><x a=\"", "&amp;&",
-                        "<", "red\" onload=\"x", "\x01\x02", ""};
+  const char *evil[] = {"\"/><script>alert(1)</script><x a=\"",
+                        "&amp;&",
+                        "<",
+                        "red\" onload=\"x",
+                        "\x01\x02",
+                        ""};
   for (size_t i = 0; i < sizeof evil / sizeof evil[0]; i++) {
     for (int layout = 0; layout < 4; layout++) {
       api_svg_options o;

@@ -118,8 +118,7 @@ static void quintic_exports_within_the_stated_bound(void **state) {
   const double cp[] = {0, 0, 2, 5, 4, -1, 7, 6, 9, 0, 11, 4, 14, 2};
   km_curve c, back;
   km_curve_init(&c);
-  assert_status(km_curve_create(&c, 5, 7, knots, cp, NULL, false, NULL),
-                KM_OK);
+  assert_status(km_curve_create(&c, 5, 7, knots, cp, NULL, false, NULL), KM_OK);
   const double tols[] = {1e-1, 1e-3, 1e-6};
   for (int k = 0; k < 3; k++) {
     double bound = -1;
@@ -200,8 +199,7 @@ static void fixed_pieces_are_uniform_in_arc_length(void **state) {
     double v[2 + 6 * 50];
     const char *p = strchr(d, 'M') + 1;
     for (size_t i = 0; i < nums; i++) {
-      while (*p && !(isdigit((unsigned char)*p) || *p == '-' || *p == '.'))
-        p++;
+      while (*p && !(isdigit((unsigned char)*p) || *p == '-' || *p == '.')) p++;
       char *end;
       v[i] = strtod(p, &end);
       p = end;
@@ -225,8 +223,7 @@ static void fixed_pieces_are_uniform_in_arc_length(void **state) {
 
 /* Frames of different shapes written with one piece count share one
  * command structure, and an open curve gets no Z unless asked. */
-static void fixed_pieces_give_one_structure_for_different_shapes(
-    void **state) {
+static void fixed_pieces_give_one_structure_for_different_shapes(void **state) {
   (void)state;
   st_shapes s;
   st_load_shapes(&s);
@@ -258,8 +255,8 @@ static void fixed_pieces_give_one_structure_for_different_shapes(
  * ordinary sizes, and the printing error respects the budget. */
 static void numbers_are_compact_and_within_budget(void **state) {
   (void)state;
-  const double xs[] = {0, 20, -100, 0.5, 123.456789, 1e-7, -3.25e9, 1e15,
-                       7.0 / 3.0};
+  const double xs[] = {0,    20,      -100, 0.5,      123.456789,
+                       1e-7, -3.25e9, 1e15, 7.0 / 3.0};
   const double budgets[] = {0, 1e-3, 0.25};
   for (int b = 0; b < 3; b++)
     for (size_t i = 0; i < sizeof xs / sizeof xs[0]; i++) {

@@ -80,13 +80,13 @@ static void eval_bezier_t_t2_t3_is_exact(void **state) {
   km_curve_free(&c);
 }
 
-static void eval_polynomial_on_nonuniform_knots_matches_closed_form(
-    void **state) {
+static void
+eval_polynomial_on_nonuniform_knots_matches_closed_form(void **state) {
   (void)state;
   /* interior knots of multiplicity 1, 2 and 3 (a C0 knot that the
    * polynomial crosses smoothly) */
-  const double kn[15] = {-1, -1, -1, -1, -0.4, 0.3, 0.3, 0.9,
-                         0.9, 0.9, 1.1, 2, 2, 2, 2};
+  const double kn[15] = {-1,  -1,  -1,  -1, -0.4, 0.3, 0.3, 0.9,
+                         0.9, 0.9, 1.1, 2,  2,    2,   2};
   double cp[2 * 11];
   size_t n = poly_curve_points(PX, PY, 3, 3, kn, 15, cp);
   km_curve c;
@@ -189,8 +189,8 @@ static void eval_rational_quadratic_matches_quotient_rule(void **state) {
   km_curve_free(&c);
 }
 
-static void eval_nurbs_circle_has_radius_orthogonal_tangent_and_curvature(
-    void **state) {
+static void
+eval_nurbs_circle_has_radius_orthogonal_tangent_and_curvature(void **state) {
   (void)state;
   const double R = 2.5, ox = 1.0, oy = -2.0;
   double kn[12], cp[18], w[9];
@@ -219,7 +219,8 @@ static void eval_nurbs_circle_has_radius_orthogonal_tangent_and_curvature(
     /* constant curvature: d/dt [cross / |C'|^3] = 0 */
     double cross3 = d[1][0] * d[3][1] - d[3][0] * d[1][1];
     double dk = (cross3 * c11 - 3.0 * cross * c12);
-    assert_close(dk / pow(sp, 5), 0.0, 1e-11 * (m3 / (sp * sp) + m2 * m2 / (sp * sp * sp)));
+    assert_close(dk / pow(sp, 5), 0.0,
+                 1e-11 * (m3 / (sp * sp) + m2 * m2 / (sp * sp * sp)));
   }
   km_curve_free(&c);
 }
@@ -301,7 +302,10 @@ static void length_of_line_with_uneven_speed_is_the_distance(void **state) {
     double s = 3.0 * i / 30.0, lo = 0, hi = 1;
     for (int it = 0; it < 200; it++) {
       double mid = 0.5 * (lo + hi);
-      if (bern3(f, mid) < s) lo = mid; else hi = mid;
+      if (bern3(f, mid) < s)
+        lo = mid;
+      else
+        hi = mid;
     }
     double t = km_curve_param_at_length(&c, s);
     assert_close(t, 0.5 * (lo + hi), 1e-10);
@@ -316,8 +320,7 @@ static void length_of_line_with_uneven_speed_is_the_distance(void **state) {
   assert_close(km_curve_length(&c), 4.0 * sqrt(2.0), 1e-13 * 4.0);
   /* positions along the line: 0, 1, 1.5, 4 at t = 0, 1, 3, 4, so t = 0.5
    * is at 0.5 and t = 3.5 at 2.75 */
-  assert_close(km_curve_length_between(&c, 0.5, 3.5), 2.25 * sqrt(2.0),
-               1e-12);
+  assert_close(km_curve_length_between(&c, 0.5, 3.5), 2.25 * sqrt(2.0), 1e-12);
   /* derivatives above the degree vanish */
   double d[4][2];
   km_curve_eval(&c, 2.0, 3, d);
@@ -382,8 +385,8 @@ static void length_of_parabola_matches_asinh_closed_form(void **state) {
   assert_close(km_curve_length(&c), L, 1e-12 * L);
   for (int i = 0; i <= 25; i++) {
     double ta = 0.4 * i / 25.0, tb = 0.4 + 0.6 * i / 25.0;
-    double want = parabola_length(-0.5 + 2 * tb) -
-                  parabola_length(-0.5 + 2 * ta);
+    double want =
+        parabola_length(-0.5 + 2 * tb) - parabola_length(-0.5 + 2 * ta);
     assert_close(km_curve_length_between(&c, ta, tb), want, 1e-12 * L);
   }
   for (int i = 0; i <= 25; i++) {
@@ -436,8 +439,8 @@ static void length_of_a_point_curve_is_zero(void **state) {
   km_curve_free(&c);
 }
 
-static void rational_segment_leaving_a_degenerate_leg_has_its_length(
-    void **state) {
+static void
+rational_segment_leaving_a_degenerate_leg_has_its_length(void **state) {
   (void)state;
   /* the segment of curvecases.h, its boundary layer narrower as w1 grows;
    * 1e-8 is a third of the rounding floor of a signature at 1e6 */
@@ -494,8 +497,7 @@ static const struct CMUnitTest tests[] = {
     cmocka_unit_test(length_of_parabola_matches_asinh_closed_form),
     cmocka_unit_test(param_at_length_clamps_to_the_ends),
     cmocka_unit_test(length_of_a_point_curve_is_zero),
-    cmocka_unit_test(
-        rational_segment_leaving_a_degenerate_leg_has_its_length),
+    cmocka_unit_test(rational_segment_leaving_a_degenerate_leg_has_its_length),
     cmocka_unit_test(hairpin_length_counts_its_tip),
 };
 

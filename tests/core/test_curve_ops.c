@@ -367,8 +367,7 @@ static void make_compatible_gives_same_degree_and_knots(void **state) {
   assert_non_null(oa.w);
   assert_non_null(ob.w);
   for (size_t i = 0; i < oa.n; i++) assert_true(oa.w[i] == 1.0);
-  assert_memory_equal(oa.knots, ob.knots,
-                      (oa.n + 4) * sizeof(double));
+  assert_memory_equal(oa.knots, ob.knots, (oa.n + 4) * sizeof(double));
   assert_true(oa.knots[0] == 0.0 && oa.knots[oa.n + 3] == 1.0);
   assert_is_poly(&oa, 0, 1);
   assert_on_circle(&ob, 999);

@@ -33,7 +33,8 @@ static double dist_to_curve(const km_curve *c, const double p[2]) {
     double x1 = b - g * (b - a), x2 = a + g * (b - a), d1[1][2], d2[1][2];
     km_curve_eval(c, x1, 0, d1);
     km_curve_eval(c, x2, 0, d2);
-    if (hypot(d1[0][0] - p[0], d1[0][1] - p[1]) < hypot(d2[0][0] - p[0], d2[0][1] - p[1]))
+    if (hypot(d1[0][0] - p[0], d1[0][1] - p[1]) <
+        hypot(d2[0][0] - p[0], d2[0][1] - p[1]))
       b = x2;
     else
       a = x1;
@@ -78,7 +79,8 @@ static void dense_smooth_samples_need_few_control_points(void **state) {
   free(p);
 }
 
-static void points_on_a_cubic_need_a_small_fraction_of_the_points(void **state) {
+static void
+points_on_a_cubic_need_a_small_fraction_of_the_points(void **state) {
   (void)state;
   /* points of x = u, y = u^3 - u with uniform u: one cubic traces them,
    * though not in chord-length parameter, so a fit at 1e-3 needs a few
@@ -142,7 +144,8 @@ static void closed_points_are_fitted_with_a_smooth_seam(void **state) {
   double cross = a[1][0] * b[1][1] - a[1][1] * b[1][0];
   double dot = a[1][0] * b[1][0] + a[1][1] * b[1][1];
   assert_true(dot > 0);
-  assert_true(fabs(cross) <= 1e-12 * hypot(a[1][0], a[1][1]) * hypot(b[1][0], b[1][1]));
+  assert_true(fabs(cross) <=
+              1e-12 * hypot(a[1][0], a[1][1]) * hypot(b[1][0], b[1][1]));
   km_curve_free(&c);
   free(p);
 }

@@ -21,8 +21,8 @@ static void make_fn(km_fn *f, int p, size_t n, const double *knots,
 
 /* f(x) = 1 - 2x + x^2/2 + x^3/4 on [-1, 2] */
 static const double F3[4] = {1.0, -2.0, 0.5, 0.25};
-static const double KN3[12] = {-1, -1,  -1,  -1,  -0.4, 0.3,
-                              0.3, 1.1, 2.0, 2.0, 2.0,  2.0};
+static const double KN3[12] = {-1,  -1,  -1,  -1,  -0.4, 0.3,
+                               0.3, 1.1, 2.0, 2.0, 2.0,  2.0};
 
 static void make_poly_fn(km_fn *f, const double *a, int deg, int p,
                          const double *knots, size_t nk) {
@@ -51,8 +51,8 @@ static void fn_eval_matches_polynomial_and_its_derivatives(void **state) {
   km_fn_free(&f);
 
   /* the same cubic as a degree-6 spline */
-  const double k6[16] = {-1, -1, -1, -1, -1, -1, -1, 0, 0.5,
-                         2, 2, 2, 2, 2, 2, 2};
+  const double k6[16] = {-1,  -1, -1, -1, -1, -1, -1, 0,
+                         0.5, 2,  2,  2,  2,  2,  2,  2};
   make_poly_fn(&f, F3, 3, 6, k6, 16);
   for (int i = 0; i <= 100; i++) {
     double x = -1.0 + 3.0 * i / 100.0, d[4];
@@ -151,8 +151,8 @@ static void antiderivative_stays_continuous_across_a_jump(void **state) {
   assert_status(km_fn_antiderivative(&F, &f, 0.0, &err), KM_OK);
   for (int i = 0; i <= 100; i++) {
     double x = 2.0 * i / 100.0;
-    double want = x <= 1.0 ? x * x * x / 3
-                           : 1.0 / 3 + 5 * (x - 1) - 0.5 * (x * x - 1);
+    double want =
+        x <= 1.0 ? x * x * x / 3 : 1.0 / 3 + 5 * (x - 1) - 0.5 * (x * x - 1);
     assert_close(km_fn_value(&F, x), want, 1e-13);
   }
   km_fn_free(&F);
@@ -207,10 +207,11 @@ static void blend_equals_pointwise_formula_on_different_knots(void **state) {
     for (int i = 0; i <= 997; i++) {
       /* 997 is prime: the samples avoid the breakpoints' exact images */
       double r = i / 997.0;
-      double want = wa * km_fn_value(&a, cases[ci].a0 +
-                                             r * (cases[ci].a1 - cases[ci].a0)) +
-                    wb * km_fn_value(&b, cases[ci].b0 +
-                                             r * (cases[ci].b1 - cases[ci].b0));
+      double want =
+          wa * km_fn_value(&a,
+                           cases[ci].a0 + r * (cases[ci].a1 - cases[ci].a0)) +
+          wb *
+              km_fn_value(&b, cases[ci].b0 + r * (cases[ci].b1 - cases[ci].b0));
       assert_close(km_fn_value(&out, u0 + r * (u1 - u0)), want, 1e-12 * 4);
     }
     km_fn_free(&out);
@@ -334,7 +335,8 @@ static void fn_create_rejects_bad_input(void **state) {
   km_error err;
   km_fn_init(&f);
   const double kn[8] = {0, 0, 0, 0, 1, 1, 1, 1}, c[4] = {1, 2, 3, 4};
-  assert_status(km_fn_create(&f, KM_MAX_FN_DEGREE + 1, 4, kn, c, &err), KM_EDEGREE);
+  assert_status(km_fn_create(&f, KM_MAX_FN_DEGREE + 1, 4, kn, c, &err),
+                KM_EDEGREE);
   assert_status(km_fn_create(&f, -1, 4, kn, c, &err), KM_EDEGREE);
   assert_status(km_fn_create(&f, 3, 3, kn, c, &err), KM_ECOUNT);
   const double bad[8] = {0, 0, 0, 0, 1, 1, 1, 0.5};

@@ -218,8 +218,8 @@ static void too_few_distinct_points_are_degenerate(void **state) {
   assert_memory_equal(&c, &before, sizeof c);
 }
 
-static void closed_interpolant_passes_through_points_and_is_c2_at_seam(
-    void **state) {
+static void
+closed_interpolant_passes_through_points_and_is_c2_at_seam(void **state) {
   (void)state;
   const size_t sizes[] = {3, 4, 7, 40};
   for (int s = 0; s < 4; s++) {

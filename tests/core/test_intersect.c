@@ -85,8 +85,8 @@ static void figure_eight_crosses_once(void **state) {
   km_curve_free(&c);
   /* a clamped cubic figure-eight written by hand */
   double knots[] = {0, 0, 0, 0, 1, 2, 3, 4, 5, 6, 7, 7, 7, 7};
-  double cp[] = {0, 0, 2, 2, 4, 2, 4, -2, 2, -2, -2, 2, -4, 2, -4, -2, -2, -2,
-                 0, 0};
+  double cp[] = {0,  0, 2,  2, 4,  2,  4,  -2, 2, -2,
+                 -2, 2, -4, 2, -4, -2, -2, -2, 0, 0};
   c = make(3, 10, knots, cp, NULL, true);
   assert_int_equal(km_curve_self_intersections(&c, 1e-10), 1);
   km_curve_free(&c);
@@ -120,8 +120,8 @@ static void circles_do_not_cross_themselves(void **state) {
  * pieces. */
 static km_curve parabola_over_line(double shift) {
   double knots[] = {0, 0, 0, 1, 1, 2, 2, 3, 3, 3};
-  double cp[] = {-2, 0, 0, 0, 2, 0, 2, 2 - shift / 2, 2, 4 - shift,
-                 0, -4 - shift, -2, 4 - shift};
+  double cp[] = {-2, 0,         0, 0,          2,  0,        2, 2 - shift / 2,
+                 2,  4 - shift, 0, -4 - shift, -2, 4 - shift};
   return make(2, 7, knots, cp, NULL, false);
 }
 
@@ -196,7 +196,8 @@ static void star_polygons_cross_p_times_q_minus_one(void **state) {
     knots[p + 2] = p;
     km_curve c = make(1, (size_t)p + 1, knots, pts, NULL, true);
     long n = km_curve_self_intersections(&c, 1e-10);
-    if (n != (long)p * (q - 1)) print_error("{%d/%d}: %ld crossings\n", p, q, n);
+    if (n != (long)p * (q - 1))
+      print_error("{%d/%d}: %ld crossings\n", p, q, n);
     assert_int_equal(n, (long)p * (q - 1));
     km_curve_free(&c);
     free(pts);
@@ -232,8 +233,8 @@ static void crossing_at_the_seam_counts_once(void **state) {
 static void count_is_invariant_under_rigid_motion(void **state) {
   (void)state;
   double knots[] = {0, 0, 0, 0, 1, 2, 3, 4, 5, 6, 7, 7, 7, 7};
-  double cp[] = {0, 0, 2, 2, 4, 2, 4, -2, 2, -2, -2, 2, -4, 2, -4, -2, -2, -2,
-                 0, 0};
+  double cp[] = {0,  0, 2,  2, 4,  2,  4,  -2, 2, -2,
+                 -2, 2, -4, 2, -4, -2, -2, -2, 0, 0};
   km_curve c = make(3, 10, knots, cp, NULL, true), t;
   for (int k = 0; k < 8; k++) {
     assert_status(km_curve_transform(&t, &c, 0.37 * k, 1e3 * k, -7.0 * k, NULL),

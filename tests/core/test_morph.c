@@ -38,7 +38,8 @@ static void pl_signature(km_signature *sig, double L, double x0, double y0,
   double knots[64];
   assert_true(nc >= 2 && nc + 2 <= 64);
   knots[0] = 0.0;
-  for (size_t i = 0; i < nc; i++) knots[i + 1] = L * (double)i / (double)(nc - 1);
+  for (size_t i = 0; i < nc; i++)
+    knots[i + 1] = L * (double)i / (double)(nc - 1);
   knots[nc] = knots[nc + 1] = L; /* L i / (nc-1) may round off L */
   km_fn kappa;
   km_error err;
@@ -83,8 +84,12 @@ static double pl_theta(double s, const void *ctx) {
   return th;
 }
 
-static double pl_cos(double s, const void *ctx) { return cos(pl_theta(s, ctx)); }
-static double pl_sin(double s, const void *ctx) { return sin(pl_theta(s, ctx)); }
+static double pl_cos(double s, const void *ctx) {
+  return cos(pl_theta(s, ctx));
+}
+static double pl_sin(double s, const void *ctx) {
+  return sin(pl_theta(s, ctx));
+}
 
 /* n + 1 exact points at s = L j / n; corners must lie on that grid (their
  * turn applies from the right, so each sub-interval sees a smooth theta). */
@@ -94,7 +99,8 @@ static double *pl_points(const pl_exact *e, size_t n) {
   p[0] = e->x0;
   p[1] = e->y0;
   for (size_t j = 1; j <= n; j++) {
-    double a = e->L * (double)(j - 1) / (double)n, b = e->L * (double)j / (double)n;
+    double a = e->L * (double)(j - 1) / (double)n,
+           b = e->L * (double)j / (double)n;
     /* a hair inside so a corner at b is not seen inside [a, b] */
     double bi = b - 1e-15 * e->L;
     p[2 * j] = p[2 * j - 2] + tu_integrate(pl_cos, e, a, bi, 1);
@@ -159,7 +165,8 @@ static void spiral_inputs(km_signature *a, km_signature *b) {
   assert_close(km_fn_value(&b->kappa, 3.0), -1.5, 1e-15);
 }
 
-static void spiral_curvature_frames_never_exceed_the_inputs_curvature(void **state) {
+static void
+spiral_curvature_frames_never_exceed_the_inputs_curvature(void **state) {
   (void)state;
   km_signature sa, sb;
   spiral_inputs(&sa, &sb);
@@ -290,7 +297,8 @@ static void spiral_end_frames_are_the_exact_spirals(void **state) {
   double qa, qb;
   double *Pa = cornu_points(1.0, 4.0, 4000, &qa);
   double *Pb = cornu_points(-0.5, 4.0, 4000, &qb);
-  const km_anchor anchors[3] = {KM_ANCHOR_FIT, KM_ANCHOR_START, KM_ANCHOR_CENTROID};
+  const km_anchor anchors[3] = {KM_ANCHOR_FIT, KM_ANCHOR_START,
+                                KM_ANCHOR_CENTROID};
   for (int an = 0; an < 3; an++) {
     km_morph_options o;
     km_morph_options_default(&o);
@@ -369,7 +377,8 @@ static void planned_spiral_frames_are_the_exact_blended_spirals(void **state) {
       km_curve_eval(&c, t0 + s, 0, q);
       worst = fmax(worst, hypot(q[0][0] - x, q[0][1] - y));
     }
-    if (worst > tol) print_error("t = %g: %.3g from the exact frame\n", t, worst);
+    if (worst > tol)
+      print_error("t = %g: %.3g from the exact frame\n", t, worst);
     assert_le(worst, tol);
     km_curve_free(&c);
   }
@@ -393,7 +402,8 @@ static void rsig_random(rsig *r, uint64_t *seed) {
   r->nc = 2 + (size_t)(tu_rand(seed) * 10);
   r->L = tu_uniform(seed, 1.0, 6.0);
   r->kmax = tu_uniform(seed, 0.2, 2.0);
-  for (size_t i = 0; i < r->nc; i++) r->coef[i] = tu_uniform(seed, -r->kmax, r->kmax);
+  for (size_t i = 0; i < r->nc; i++)
+    r->coef[i] = tu_uniform(seed, -r->kmax, r->kmax);
   size_t peak = (size_t)(tu_rand(seed) * (double)r->nc);
   r->coef[peak] = tu_rand(seed) < 0.5 ? r->kmax : -r->kmax;
   r->ncorners = (size_t)(tu_rand(seed) * 3);
@@ -475,7 +485,8 @@ static void curvature_bound_holds_for_curve_inputs(void **state) {
     double tol = 1e-5 * fmax(km_curve_length(&ca), km_curve_length(&cb));
     assert_status(km_signature_compute(&ca, 0.1 * tol, &sa, &err), KM_OK);
     assert_status(km_signature_compute(&cb, 0.1 * tol, &sb, &err), KM_OK);
-    double kmax = fmax(km_signature_max_abs_kappa(&sa), km_signature_max_abs_kappa(&sb));
+    double kmax =
+        fmax(km_signature_max_abs_kappa(&sa), km_signature_max_abs_kappa(&sb));
     double pairs[10];
     km_morph_options o;
     km_morph_options_default(&o);
@@ -539,7 +550,8 @@ static void every_frame_has_the_interpolated_length(void **state) {
   }
 }
 
-static void end_frames_of_random_pairs_are_the_inputs_where_they_stand(void **state) {
+static void
+end_frames_of_random_pairs_are_the_inputs_where_they_stand(void **state) {
   (void)state;
   uint64_t seed = 0xabcdef01ULL;
   for (int trial = 0; trial < 6; trial++) {
@@ -549,8 +561,8 @@ static void end_frames_of_random_pairs_are_the_inputs_where_they_stand(void **st
     for (int k = 0; k < 2; k++) {
       rsig_random(&r[k], &seed);
       rsig_make(&r[k], &s[k]);
-      pl_exact e = {r[k].L, r[k].x0, r[k].y0, r[k].angle, r[k].coef, r[k].nc,
-                    r[k].corners, r[k].ncorners};
+      pl_exact e = {r[k].L,    r[k].x0, r[k].y0,      r[k].angle,
+                    r[k].coef, r[k].nc, r[k].corners, r[k].ncorners};
       P[k] = pl_points(&e, 64 * 40);
       double h = r[k].L / (64 * 40);
       qerr[k] = h * h * r[k].kmax / 8;
@@ -658,7 +670,8 @@ static void check_g2_at_matches(km_blend blend) {
          * inputs' kappa has slope <= 2 kmax nc / L) */
         double kl = km_fn_value(&f.sig.kappa, s - eps);
         double kr = km_fn_value(&f.sig.kappa, s + eps);
-        double slope = 4 * kmax * 12 / fmin(ra.L, rb.L) * (1 + ra.L / rb.L + rb.L / ra.L);
+        double slope =
+            4 * kmax * 12 / fmin(ra.L, rb.L) * (1 + ra.L / rb.L + rb.L / ra.L);
         double jump = fabs(kr - kl);
         checked++;
         if (jump > 2 * eps * slope + 1e-9 * kmax) {
@@ -685,7 +698,8 @@ static void matched_segments_join_with_g2_under_the_paper_blend(void **state) {
   check_g2_at_matches(KM_BLEND_PAPER);
 }
 
-static void matched_segments_join_with_g2_under_the_turning_blend(void **state) {
+static void
+matched_segments_join_with_g2_under_the_turning_blend(void **state) {
   (void)state;
   check_g2_at_matches(KM_BLEND_TURNING);
 }
@@ -725,7 +739,8 @@ static void matched_arcs_have_continuous_curvature(void **state) {
   km_signature_free(&sa);
   km_signature_free(&sb);
   /* asserted after freeing, so a failure leaks nothing */
-  for (int blend = 0; blend < 2; blend++) assert_close(kl[blend], kr[blend], 1e-9);
+  for (int blend = 0; blend < 2; blend++)
+    assert_close(kl[blend], kr[blend], 1e-9);
   /* the paper's formula gives (1-t) 1 + t / 2 on both sides */
   assert_close(kl[1], 0.75, 1e-12);
 }
@@ -786,7 +801,8 @@ static void proportional_matches_give_the_global_morph(void **state) {
         assert_le(max_pointwise(&f.c, &g.c), 2 * tol);
         for (int j = 0; j <= 50; j++) {
           double s = f.sig.length * j / 50.0;
-          assert_close(km_fn_value(&g.sig.kappa, s), km_fn_value(&f.sig.kappa, s),
+          assert_close(km_fn_value(&g.sig.kappa, s),
+                       km_fn_value(&f.sig.kappa, s),
                        1e-9 * (1 + fabs(km_fn_value(&f.sig.kappa, s))));
         }
         frame_free(&f);
@@ -863,7 +879,8 @@ static void placed_spirals(km_signature *sa, km_signature *sb) {
   pl_signature(sb, 3.0, 5, 2, 1.2, kb, 2, NULL, 0, false);
 }
 
-static void anchor_start_moves_the_start_point_on_a_straight_line(void **state) {
+static void
+anchor_start_moves_the_start_point_on_a_straight_line(void **state) {
   (void)state;
   km_signature sa, sb;
   placed_spirals(&sa, &sb);
@@ -891,7 +908,8 @@ static void anchor_start_moves_the_start_point_on_a_straight_line(void **state) 
   km_signature_free(&sb);
 }
 
-static void anchor_centroid_moves_the_centroid_on_a_straight_line(void **state) {
+static void
+anchor_centroid_moves_the_centroid_on_a_straight_line(void **state) {
   (void)state;
   km_signature sa, sb;
   placed_spirals(&sa, &sb);
@@ -916,8 +934,9 @@ static void anchor_centroid_moves_the_centroid_on_a_straight_line(void **state) 
     curve_centroid(&f.c, c);
     double want[2] = {(1 - t) * c0[0] + t * c1[0], (1 - t) * c0[1] + t * c1[1]};
     if (hypot(c[0] - want[0], c[1] - want[1]) > 2 * tol)
-      print_error("t = %g: centroid (%.9f, %.9f), the line's point (%.9f, %.9f)\n",
-                  t, c[0], c[1], want[0], want[1]);
+      print_error(
+          "t = %g: centroid (%.9f, %.9f), the line's point (%.9f, %.9f)\n", t,
+          c[0], c[1], want[0], want[1]);
     assert_le(hypot(c[0] - want[0], c[1] - want[1]), 2 * tol);
     frame_free(&f);
   }
@@ -928,7 +947,8 @@ static void anchor_centroid_moves_the_centroid_on_a_straight_line(void **state) 
 
 /* fit: the end frames are the inputs where they stand (not moved toward
  * each other), here for inputs far apart and turned. */
-static void anchor_fit_keeps_the_end_frames_where_the_inputs_stand(void **state) {
+static void
+anchor_fit_keeps_the_end_frames_where_the_inputs_stand(void **state) {
   (void)state;
   km_signature sa, sb;
   placed_spirals(&sa, &sb);
@@ -938,7 +958,8 @@ static void anchor_fit_keeps_the_end_frames_where_the_inputs_stand(void **state)
   assert_int_equal(o.anchor, KM_ANCHOR_FIT);
   km_morph *m = morph_new(&A, &B, &o);
   double ka[2] = {0.0, 4.0}, kb[2] = {0.0, -2.0};
-  pl_exact ea = {4.0, 0, 0, 0.0, ka, 2, NULL, 0}, eb = {3.0, 5, 2, 1.2, kb, 2, NULL, 0};
+  pl_exact ea = {4.0, 0, 0, 0.0, ka, 2, NULL, 0},
+           eb = {3.0, 5, 2, 1.2, kb, 2, NULL, 0};
   double *Pa = pl_points(&ea, 3000), *Pb = pl_points(&eb, 3000);
   double qa = pow(4.0 / 3000, 2) * 4 / 8, qb = pow(3.0 / 3000, 2) * 2 / 8;
   double tol = 1e-5 * 4.0;
@@ -989,7 +1010,8 @@ static void different_turning_numbers_are_rejected_naming_both(void **state) {
   assert_status(km_morph_create(&m, &A, &B, &o, &err), KM_ETURNING);
   assert_null(m);
   assert_int_equal(err.code, KM_ETURNING);
-  if (!message_has_integer(err.message, 1) || !message_has_integer(err.message, 2))
+  if (!message_has_integer(err.message, 1) ||
+      !message_has_integer(err.message, 2))
     print_error("message: %s\n", err.message);
   assert_true(message_has_integer(err.message, 1));
   assert_true(message_has_integer(err.message, 2));
@@ -1064,14 +1086,14 @@ static void invalid_matches_are_rejected_with_their_index(void **state) {
     size_t n;
     long bad;
   } cases[] = {
-      {{0.5, 0.5, 0.4, 0.6, 0, 0}, 2, 1},         /* decreasing on a */
-      {{0.2, 0.5, 0.4, 0.5, 0, 0}, 2, 1},         /* repeated on b */
-      {{0.0, 0.5, 0, 0, 0, 0}, 1, 0},             /* r = 0 */
-      {{0.3, 0.3, 0.6, 1.0, 0, 0}, 2, 1},         /* r = 1 */
-      {{0.3, 0.3, 0.6, 0.7, 1.2, 0.8}, 3, 2},     /* outside */
-      {{0.3, -0.1, 0, 0, 0, 0}, 1, 0},            /* negative */
-      {{0.3, 0.3, NAN, 0.5, 0, 0}, 2, 1},         /* not a number */
-      {{0.3, 0.3, 0.5, INFINITY, 0, 0}, 2, 1},    /* infinite */
+      {{0.5, 0.5, 0.4, 0.6, 0, 0}, 2, 1},      /* decreasing on a */
+      {{0.2, 0.5, 0.4, 0.5, 0, 0}, 2, 1},      /* repeated on b */
+      {{0.0, 0.5, 0, 0, 0, 0}, 1, 0},          /* r = 0 */
+      {{0.3, 0.3, 0.6, 1.0, 0, 0}, 2, 1},      /* r = 1 */
+      {{0.3, 0.3, 0.6, 0.7, 1.2, 0.8}, 3, 2},  /* outside */
+      {{0.3, -0.1, 0, 0, 0, 0}, 1, 0},         /* negative */
+      {{0.3, 0.3, NAN, 0.5, 0, 0}, 2, 1},      /* not a number */
+      {{0.3, 0.3, 0.5, INFINITY, 0, 0}, 2, 1}, /* infinite */
   };
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
     km_morph_options o;
@@ -1140,7 +1162,8 @@ static const struct CMUnitTest tests[] = {
     cmocka_unit_test(curvature_bound_holds_for_random_pairs_and_matches),
     cmocka_unit_test(curvature_bound_holds_for_curve_inputs),
     cmocka_unit_test(every_frame_has_the_interpolated_length),
-    cmocka_unit_test(end_frames_of_random_pairs_are_the_inputs_where_they_stand),
+    cmocka_unit_test(
+        end_frames_of_random_pairs_are_the_inputs_where_they_stand),
     cmocka_unit_test(end_frames_of_curve_inputs_trace_the_inputs),
     cmocka_unit_test(matched_segments_join_with_g2_under_the_paper_blend),
     cmocka_unit_test(matched_segments_join_with_g2_under_the_turning_blend),

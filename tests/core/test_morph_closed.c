@@ -147,7 +147,8 @@ static long polyline_crossings(const km_curve *c, size_t total) {
   long n = 0;
   for (size_t a = 0; a < ns; a++) {
     for (size_t b = a + 1; b < ns && S[b].xmin <= S[a].xmax; b++) {
-      size_t ia = S[a].i, ib = S[b].i, lo = ia < ib ? ia : ib, hi = ia < ib ? ib : ia;
+      size_t ia = S[a].i, ib = S[b].i, lo = ia < ib ? ia : ib,
+             hi = ia < ib ? ib : ia;
       if (hi - lo <= 1 || (c->closed && lo == 0 && hi == ns - 1)) continue;
       double rx = S[a].x1 - S[a].x0, ry = S[a].y1 - S[a].y0;
       double qx = S[b].x1 - S[b].x0, qy = S[b].y1 - S[b].y0;
@@ -257,7 +258,8 @@ static void paper_closures_keep_their_seam_promise(void **state) {
           assert_true(f.c.closed);
           seam_side(&f.c, 1, p0, &a0, &k0);
           seam_side(&f.c, -1, p1, &a1, &k1);
-          assert_close(hypot(p1[0] - p0[0], p1[1] - p0[1]), 0.0, 1e-12 * f.sig.length);
+          assert_close(hypot(p1[0] - p0[0], p1[1] - p0[1]), 0.0,
+                       1e-12 * f.sig.length);
           if (how[h] != KM_CLOSURE_C0) {
             if (fabs(tu_wrap(a1 - a0)) > 1e-9)
               print_error("pair %d, closure %d, degree %d, t = %g: tangent "
@@ -305,7 +307,8 @@ static void circles_of_radius_one_and_two_morph_through_circles(void **state) {
     assert_le(f.mt.closure_gap, 1e-9 * 2 * M_PI * r);
     assert_rel(f.mt.length, 2 * M_PI * r, 1e-9);
     for (int j = 0; j <= 200; j++)
-      assert_close(km_fn_value(&f.sig.kappa, f.sig.length * j / 200.0), 1 / r, 1e-9 / r);
+      assert_close(km_fn_value(&f.sig.kappa, f.sig.length * j / 200.0), 1 / r,
+                   1e-9 / r);
     assert_close(total_turning(&f.sig), 2 * M_PI, 1e-9);
     assert_frame_closes(&f, "circles", t);
     /* every point of the curve at distance r from the centroid */
@@ -340,7 +343,8 @@ static void paper_blend_on_circles_shows_the_turning_defect(void **state) {
     o.closure = how[h];
     km_morph *m = morph_new(&A, &B, &o);
     for (int i = 1; i <= 3; i++) {
-      double t = i / 4.0, La = 2 * M_PI, Lb = 4 * M_PI, Lt = (1 - t) * La + t * Lb;
+      double t = i / 4.0, La = 2 * M_PI, Lb = 4 * M_PI,
+             Lt = (1 - t) * La + t * Lb;
       double want = Lt * ((1 - t) * 2 * M_PI / La + t * 2 * M_PI / Lb);
       frame f;
       frame_get(m, t, &f);
@@ -406,9 +410,11 @@ static void matched_corners_blend_as_turning_jumps(void **state) {
         int hit = -1;
         for (int k = 0; k < 4; k++) {
           double want = (1 - t) * ra[k] * 6 + t * rb[k] * 4;
-          if (fabs(s - want) <= 1e-9 * Lt || (k == 3 && fabs(s) <= 1e-9 * Lt)) hit = k;
+          if (fabs(s - want) <= 1e-9 * Lt || (k == 3 && fabs(s) <= 1e-9 * Lt))
+            hit = k;
         }
-        if (hit < 0) print_error("t = %g: unexpected corner at s = %.12g\n", t, s);
+        if (hit < 0)
+          print_error("t = %g: unexpected corner at s = %.12g\n", t, s);
         assert_true(hit >= 0);
         /* the turning blend weighs turns by (1-t) and t; the paper's
          * formula scales them by segment lengths, so only places count */
@@ -438,32 +444,32 @@ static void square_corners_fade_into_a_smooth_star(void **state) {
   km_morph_input A = {&sq, NULL}, B = {&st, NULL};
   double Lb = km_curve_length(&st);
   for (int pass = 0; pass < 2; pass++) {
-  km_morph_options o;
-  km_morph_options_default(&o);
-  if (pass == 0) o.closure = KM_CLOSURE_NONE;
-  km_morph *m = morph_new(&A, &B, &o);
-  for (int i = 0; i <= 4; i++) {
-    double t = i / 4.0, Lt = (1 - t) * 8 + t * Lb, want = (1 - t) * M_PI / 2;
-    frame f;
-    frame_get(m, t, &f);
-    if (pass == 1) assert_frame_closes(&f, "square to star", t);
-    size_t found = 0;
-    double sum = 0.0;
-    for (size_t c = 0; c < f.sig.ncorners; c++) {
-      if (fabs(f.sig.corners[c].turn) < 1e-9) continue;
-      double r = f.sig.corners[c].s / Lt;
-      assert_close(fmod(r * 8, 2.0), 1.0, 1e-9);
-      if (pass == 0) assert_close(f.sig.corners[c].turn, want, 1e-9);
-      assert_close(f.sig.corners[c].turn, want, 0.5 * want);
-      sum += f.sig.corners[c].turn;
-      found++;
+    km_morph_options o;
+    km_morph_options_default(&o);
+    if (pass == 0) o.closure = KM_CLOSURE_NONE;
+    km_morph *m = morph_new(&A, &B, &o);
+    for (int i = 0; i <= 4; i++) {
+      double t = i / 4.0, Lt = (1 - t) * 8 + t * Lb, want = (1 - t) * M_PI / 2;
+      frame f;
+      frame_get(m, t, &f);
+      if (pass == 1) assert_frame_closes(&f, "square to star", t);
+      size_t found = 0;
+      double sum = 0.0;
+      for (size_t c = 0; c < f.sig.ncorners; c++) {
+        if (fabs(f.sig.corners[c].turn) < 1e-9) continue;
+        double r = f.sig.corners[c].s / Lt;
+        assert_close(fmod(r * 8, 2.0), 1.0, 1e-9);
+        if (pass == 0) assert_close(f.sig.corners[c].turn, want, 1e-9);
+        assert_close(f.sig.corners[c].turn, want, 0.5 * want);
+        sum += f.sig.corners[c].turn;
+        found++;
+      }
+      assert_close(sum, 4 * want, 1e-9);
+      assert_int_equal(found, t < 1 ? 4 : 0);
+      assert_int_equal(f.mt.self_intersections, 0);
+      frame_free(&f);
     }
-    assert_close(sum, 4 * want, 1e-9);
-    assert_int_equal(found, t < 1 ? 4 : 0);
-    assert_int_equal(f.mt.self_intersections, 0);
-    frame_free(&f);
-  }
-  km_morph_free(m);
+    km_morph_free(m);
   }
   km_curve_free(&sq);
   km_curve_free(&st);
@@ -500,7 +506,8 @@ static void polygons_morph_through_polygons(void **state) {
       double t = i / 20.0;
       frame f;
       frame_get(m, t, &f);
-      assert_frame_closes(&f, am ? "square to L, auto matches" : "square to L", t);
+      assert_frame_closes(&f, am ? "square to L, auto matches" : "square to L",
+                          t);
       if (f.mt.max_abs_kappa > 1e-9)
         print_error("t = %g, auto %d: max |kappa| %.3g on a polygon frame\n", t,
                     am, f.mt.max_abs_kappa);
@@ -546,10 +553,12 @@ static void closed_frames_respect_the_curvature_bound(void **state) {
   for (int pr = 0; pr < 2; pr++) {
     km_signature sa, sb;
     km_error err;
-    double tol = 1e-5 * fmax(km_curve_length(from[pr]), km_curve_length(to[pr]));
+    double tol =
+        1e-5 * fmax(km_curve_length(from[pr]), km_curve_length(to[pr]));
     assert_status(km_signature_compute(from[pr], 0.1 * tol, &sa, &err), KM_OK);
     assert_status(km_signature_compute(to[pr], 0.1 * tol, &sb, &err), KM_OK);
-    double kmax = fmax(km_signature_max_abs_kappa(&sa), km_signature_max_abs_kappa(&sb));
+    double kmax =
+        fmax(km_signature_max_abs_kappa(&sa), km_signature_max_abs_kappa(&sb));
     for (int trial = 0; trial < 6; trial++) {
       double pairs[6];
       size_t n = (size_t)(trial / 2);
@@ -611,7 +620,8 @@ static void distorting_match_closes_within_the_curvature_bound(void **state) {
   double tol = 1e-5 * fmax(km_curve_length(&c), km_curve_length(&e));
   assert_status(km_signature_compute(&c, 0.1 * tol, &sa, NULL), KM_OK);
   assert_status(km_signature_compute(&e, 0.1 * tol, &sb, NULL), KM_OK);
-  double kmax = fmax(km_signature_max_abs_kappa(&sa), km_signature_max_abs_kappa(&sb));
+  double kmax =
+      fmax(km_signature_max_abs_kappa(&sa), km_signature_max_abs_kappa(&sb));
   /* the ellipse has semi-axes 2 and 1: its largest curvature is 2/1^2 */
   assert_close(kmax, 2.0, 1e-4);
   const double pairs[2] = {0.06, 0.77};
@@ -647,7 +657,8 @@ static void distorting_match_closes_within_the_curvature_bound(void **state) {
 /* identity preservation on a closed pair: proportional matches give the
  * frames of no matches (the ellipse's start already aligns with the
  * circle's, so no start is moved either way) */
-static void proportional_matches_on_a_closed_pair_give_the_global_morph(void **state) {
+static void
+proportional_matches_on_a_closed_pair_give_the_global_morph(void **state) {
   (void)state;
   km_curve c, e;
   circle_and_ellipse(&c, &e);
@@ -804,7 +815,8 @@ static void fixture_pairs_with_auto_matches_degree_5_and_linear(void **state) {
         assert_int_equal(km_morph_matches_used(m, pr, nm), nm);
         for (size_t i = 0; i < nm; i++) {
           assert_true(pr[2 * i] > (i ? pr[2 * i - 2] : 0.0) && pr[2 * i] < 1.0);
-          assert_true(pr[2 * i + 1] > (i ? pr[2 * i - 1] : 0.0) && pr[2 * i + 1] < 1.0);
+          assert_true(pr[2 * i + 1] > (i ? pr[2 * i - 1] : 0.0) &&
+                      pr[2 * i + 1] < 1.0);
         }
         free(pr);
       }
@@ -962,7 +974,8 @@ static void planned_default_frames_of_the_fixture_pairs(void **state) {
       long poly = polyline_crossings(&f, 6000);
       if (n != 0 || poly != 0) {
         print_error("%s: planned frame t = %g crosses itself %ld times (its "
-                    "dense polyline %ld times)\n", PAIRS[p], t, n, poly);
+                    "dense polyline %ld times)\n",
+                    PAIRS[p], t, n, poly);
         failures++;
       }
       if (i == 0 || i == 20) {
@@ -1020,7 +1033,8 @@ static void planned_and_reconstructed_frames_agree(void **state) {
       }
       if (worst > 2 * tol)
         print_error("%s, t = %g: planned and reconstructed frames %.3g apart "
-                    "(tolerance %.3g)\n", PAIRS[p], t, worst, tol);
+                    "(tolerance %.3g)\n",
+                    PAIRS[p], t, worst, tol);
       assert_le(worst, 2 * tol);
       km_curve_free(&f);
       frame_free(&g);
@@ -1053,8 +1067,10 @@ static void congruent_shapes_morph_through_congruent_frames(void **state) {
     assert_rel(f.mt.length, L, 1e-9);
     /* corners: same count, places and turns as frame 0 */
     size_t n0 = 0, n1 = 0;
-    for (size_t c = 0; c < f0.sig.ncorners; c++) n0 += fabs(f0.sig.corners[c].turn) > 1e-6;
-    for (size_t c = 0; c < f.sig.ncorners; c++) n1 += fabs(f.sig.corners[c].turn) > 1e-6;
+    for (size_t c = 0; c < f0.sig.ncorners; c++)
+      n0 += fabs(f0.sig.corners[c].turn) > 1e-6;
+    for (size_t c = 0; c < f.sig.ncorners; c++)
+      n1 += fabs(f.sig.corners[c].turn) > 1e-6;
     assert_int_equal(n1, n0);
     frame_free(&f);
   }
@@ -1108,10 +1124,14 @@ static void reversed_copy_morphs_through_the_shape_itself(void **state) {
  * morph into a circle-like blob - and the count says so. */
 static void sharp_tips_are_not_counted_as_crossings(void **state) {
   (void)state;
-  const double from[4][6] = {{0, 0, 50, -40, 100, 0}, {150, 40, 100, 100, 100, 100},
-                             {100, 100, 40, 140, 0, 100}, {-40, 60, 0, 0, 0, 0}};
-  const double to[4][6] = {{30, -30, 70, -30, 100, 0}, {130, 30, 130, 70, 100, 100},
-                           {70, 130, 30, 130, 0, 100}, {-30, 70, -30, 30, 0, 0}};
+  const double from[4][6] = {{0, 0, 50, -40, 100, 0},
+                             {150, 40, 100, 100, 100, 100},
+                             {100, 100, 40, 140, 0, 100},
+                             {-40, 60, 0, 0, 0, 0}};
+  const double to[4][6] = {{30, -30, 70, -30, 100, 0},
+                           {130, 30, 130, 70, 100, 100},
+                           {70, 130, 30, 130, 0, 100},
+                           {-30, 70, -30, 30, 0, 0}};
   const double(*shape[2])[6] = {from, to};
   km_curve c[2];
   for (int k = 0; k < 2; k++) {
@@ -1119,8 +1139,9 @@ static void sharp_tips_are_not_counted_as_crossings(void **state) {
     km_path_init(&p);
     assert_status(km_path_move_to(&p, 0, 0, NULL), KM_OK);
     for (int i = 0; i < 4; i++)
-      assert_status(km_path_cubic_to(&p, shape[k][i][0], shape[k][i][1], shape[k][i][2],
-                                     shape[k][i][3], shape[k][i][4], shape[k][i][5], NULL),
+      assert_status(km_path_cubic_to(&p, shape[k][i][0], shape[k][i][1],
+                                     shape[k][i][2], shape[k][i][3],
+                                     shape[k][i][4], shape[k][i][5], NULL),
                     KM_OK);
     assert_status(km_path_close(&p, NULL), KM_OK);
     km_curve_init(&c[k]);
@@ -1167,7 +1188,8 @@ static void a_curve_looping_twice_is_rejected_against_a_circle(void **state) {
   assert_status(km_morph_create(&m, &A, &B, &o, &err), KM_ETURNING);
   assert_null(m);
   /* both numbers are named, as whole integers */
-  if (!message_has_integer(err.message, 1) || !message_has_integer(err.message, 2))
+  if (!message_has_integer(err.message, 1) ||
+      !message_has_integer(err.message, 2))
     print_error("message: %s\n", err.message);
   assert_true(message_has_integer(err.message, 1));
   assert_true(message_has_integer(err.message, 2));
@@ -1187,7 +1209,8 @@ static const struct CMUnitTest tests[] = {
     cmocka_unit_test(polygons_morph_through_polygons),
     cmocka_unit_test(closed_frames_respect_the_curvature_bound),
     cmocka_unit_test(distorting_match_closes_within_the_curvature_bound),
-    cmocka_unit_test(proportional_matches_on_a_closed_pair_give_the_global_morph),
+    cmocka_unit_test(
+        proportional_matches_on_a_closed_pair_give_the_global_morph),
     cmocka_unit_test(fixture_pairs_end_frames_length_and_closure),
     cmocka_unit_test(fixture_pairs_with_auto_matches_degree_5_and_linear),
     cmocka_unit_test(fixture_pairs_default_frames_do_not_self_intersect),

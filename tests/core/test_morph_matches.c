@@ -27,7 +27,8 @@
 #include "morphutil.h"
 #include "testmain.h"
 
-#define ONE_MINUS 0.99999999999999989 /* 1 - 2^-53, the largest double below 1 */
+#define ONE_MINUS                                                              \
+  0.99999999999999989 /* 1 - 2^-53, the largest double below 1 */
 
 static const double TIMES[] = {0.0, 1e-300, 0.25, 0.5, 0.75, ONE_MINUS, 1.0};
 #define NTIMES (sizeof TIMES / sizeof TIMES[0])
@@ -187,8 +188,8 @@ static void assert_circles(const setup *s, const double *pairs, size_t n,
  * tolerances of the frame of the morph with `near` (the same matches a
  * little further in); the frames at t = 0 and 1 are the inputs; the morph
  * and its frames take under a quarter second. */
-static void assert_near(const setup *s, const double *pairs,
-                        const double *near, size_t n, double slack) {
+static void assert_near(const setup *s, const double *pairs, const double *near,
+                        size_t n, double slack) {
   km_curve ca, cb, ca2, cb2;
   double tol;
   double t0 = now_seconds();
@@ -229,7 +230,8 @@ static const setup TURNING[] = {
 
 /* Proportional matches at 1e-300, at 1 - 2^-53 and two within 2^-53 of
  * each other are the identity correspondence: the circle of radius 1 + t. */
-static void proportional_matches_next_to_the_ends_keep_the_circle(void **state) {
+static void
+proportional_matches_next_to_the_ends_keep_the_circle(void **state) {
   (void)state;
   const double at0[2] = {1e-300, 1e-300};
   const double at1[2] = {ONE_MINUS, ONE_MINUS};

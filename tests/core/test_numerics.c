@@ -58,8 +58,10 @@ static void bern_eval_is_within_its_rounding_bound(void **state) {
     for (int trial = 0; trial < 200; trial++) {
       double c[22];
       for (int j = 0; j <= d; j++) c[j] = tu_uniform(&rng, -3.0, 3.0);
-      double u = trial == 0 ? 0.0 : trial == 1 ? 1.0 : trial == 2 ? 0.5
-                                                : tu_uniform(&rng, 0.0, 1.0);
+      double u = trial == 0   ? 0.0
+                 : trial == 1 ? 1.0
+                 : trial == 2 ? 0.5
+                              : tu_uniform(&rng, 0.0, 1.0);
       long double sum = 0.0L, abs_sum = 0.0L;
       for (int j = 0; j <= d; j++) {
         long double b = 1.0L;
@@ -70,7 +72,8 @@ static void bern_eval_is_within_its_rounding_bound(void **state) {
         abs_sum += fabsl(c[j] * b);
       }
       double got = km__bern_eval(c, d, u);
-      assert_true(fabsl(got - sum) <= (2 * d + 2) * 1.12e-16L * abs_sum + 1e-300);
+      assert_true(fabsl(got - sum) <=
+                  (2 * d + 2) * 1.12e-16L * abs_sum + 1e-300);
       if (trial == 0) assert_true(got == c[0]);
       if (trial == 1) assert_true(got == c[d]);
     }
@@ -97,21 +100,27 @@ static void bezier_span_evaluation_agrees_with_de_boor(void **state) {
         }
         size_t nk = N + (size_t)p + 1;
         for (size_t i = 0; i < nk; i++)
-          kn[i] = i <= (size_t)p ? 0.0 : i >= N ? (double)(N - p) : (double)(i - (size_t)p);
+          kn[i] = i <= (size_t)p ? 0.0
+                  : i >= N       ? (double)(N - p)
+                                 : (double)(i - (size_t)p);
         km_curve c;
         km_curve_init(&c);
-        assert_status(km_curve_create(&c, p, N, kn, cp, rational ? w : NULL, false, NULL), KM_OK);
+        assert_status(
+            km_curve_create(&c, p, N, kn, cp, rational ? w : NULL, false, NULL),
+            KM_OK);
         for (size_t i = (size_t)p; i < N; i++) {
           km__bspan sp;
           km__bspan_make(&sp, &c, i);
           for (int k = 0; k <= 10; k++) {
-            double t = kn[i] + (kn[i + 1] - kn[i]) * k / 10.0, pos[2], der[2], d[2][2];
+            double t = kn[i] + (kn[i + 1] - kn[i]) * k / 10.0, pos[2], der[2],
+                   d[2][2];
             km__bspan_eval(&sp, t, pos, der, NULL);
             km_curve_eval_side(&c, t, k == 10 ? -1 : 1, 1, d);
             double scale = 1 + off;
             for (int q = 0; q < 2; q++) {
               assert_true(fabs(pos[q] - d[0][q]) <= 1e-13 * scale);
-              assert_true(fabs(der[q] - d[1][q]) <= 1e-9 * (1 + fabs(d[1][q])) * scale);
+              assert_true(fabs(der[q] - d[1][q]) <=
+                          1e-9 * (1 + fabs(d[1][q])) * scale);
             }
           }
         }
@@ -127,7 +136,8 @@ static void sincos_agrees_with_libm(void **state) {
   double worst = 0.0;
   for (int k = 0; k < 400000; k++) {
     /* every scale up to the fast range, and the quadrant boundaries */
-    double x = k < 200000 ? tu_uniform(&rng, -1.0, 1.0) * pow(10.0, tu_uniform(&rng, -8, 5))
+    double x = k < 200000 ? tu_uniform(&rng, -1.0, 1.0) *
+                                pow(10.0, tu_uniform(&rng, -8, 5))
                           : (k - 300000) * (PI / 4) * (1 + 1e-16 * (k % 3 - 1));
     if (!(fabs(x) < 1e5)) continue;
     double s, c;
@@ -316,7 +326,8 @@ static void merge_never_crosses_a_jump(void **state) {
   /* the smooth runs each side merge into one piece each */
   assert_int_equal(q.m, 2);
   assert_true(q.x[1] == 0.3);
-  assert_close(km__pp_eval(&q, 0.3 - 1e-12), model(0.3 - 1e-12, 0, 0.4, 0.3), 1e-11);
+  assert_close(km__pp_eval(&q, 0.3 - 1e-12), model(0.3 - 1e-12, 0, 0.4, 0.3),
+               1e-11);
   assert_close(km__pp_eval(&q, 0.3), model(0.3, 0, 0.4, 0.3), 1e-12);
   assert_true(max_gap(&p, &q, 5000) <= 1e-6);
   km__pp_free(&p);

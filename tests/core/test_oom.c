@@ -35,8 +35,7 @@ typedef struct shapes {
 static void open_cubic(km_curve *c, const double cp[10]) {
   static const double knots[9] = {0, 0, 0, 0, 0.5, 1, 1, 1, 1};
   km_curve_init(c);
-  assert_status(km_curve_create(c, 3, 5, knots, cp, NULL, false, NULL),
-                KM_OK);
+  assert_status(km_curve_create(c, 3, 5, knots, cp, NULL, false, NULL), KM_OK);
 }
 
 static int shapes_setup(void **state) {
@@ -46,12 +45,10 @@ static int shapes_setup(void **state) {
   static const double wave[10] = {0, 0, 0.3, 0.5, 0.5, 0, 0.7, -0.5, 1, 0};
   tu_circle_nurbs(0, 0, 1, 1, kn, cp, w);
   km_curve_init(&s.circle);
-  assert_status(km_curve_create(&s.circle, 2, 9, kn, cp, w, true, NULL),
-                KM_OK);
+  assert_status(km_curve_create(&s.circle, 2, 9, kn, cp, w, true, NULL), KM_OK);
   tu_rounded_rect(-1, -0.75, 2, 1.5, 0.25, kn, cp, w);
   km_curve_init(&s.rect);
-  assert_status(km_curve_create(&s.rect, 2, 17, kn, cp, w, true, NULL),
-                KM_OK);
+  assert_status(km_curve_create(&s.rect, 2, 17, kn, cp, w, true, NULL), KM_OK);
   {
     /* U -> S: its best-aligned start's frames cross, so the morph plans
      * and previews further starts to pick one. */
@@ -61,8 +58,8 @@ static int shapes_setup(void **state) {
     for (int k = 0; k < 2; k++) {
       assert_int_equal(tf_load_shape("U_to_S", which[k], &b), 0);
       km_curve_init(dst[k]);
-      assert_status(km_curve_create(dst[k], b.degree, b.n, b.knots, b.cp,
-                                    b.w, b.closed, NULL),
+      assert_status(km_curve_create(dst[k], b.degree, b.n, b.knots, b.cp, b.w,
+                                    b.closed, NULL),
                     KM_OK);
       tf_bspline_free(&b);
     }
@@ -89,10 +86,8 @@ static int shapes_teardown(void **state) {
 
 /* What a core status means for the loop; why names any other. */
 static oom_outcome outcome_of(km_status st, const char *what, char *why) {
-  if (st == KM_OK)
-    return OOM_RAN_OK;
-  if (st == KM_ENOMEM)
-    return OOM_RAN_NOMEM;
+  if (st == KM_OK) return OOM_RAN_OK;
+  if (st == KM_ENOMEM) return OOM_RAN_NOMEM;
   snprintf(why, 160, "%s: %s", what, km_status_name(st));
   return OOM_RAN_OTHER;
 }
@@ -153,16 +148,12 @@ static oom_outcome run_path(void *ctx, char *why) {
   km_path_init(&p);
   km_curve_init(&out);
   st = km_path_move_to(&p, 0, 0, NULL);
-  if (st == KM_OK)
-    st = km_path_line_to(&p, 1, 0, NULL);
+  if (st == KM_OK) st = km_path_line_to(&p, 1, 0, NULL);
   if (st == KM_OK)
     st = km_path_arc_to(&p, 0.5, 0.5, 0, false, true, 1, 1, NULL);
-  if (st == KM_OK)
-    st = km_path_cubic_to(&p, 0.5, 1.5, 0, 1.5, 0, 1, NULL);
-  if (st == KM_OK)
-    st = km_path_close(&p, NULL);
-  if (st == KM_OK)
-    st = km_path_to_curve(&p, 0, &out, NULL);
+  if (st == KM_OK) st = km_path_cubic_to(&p, 0.5, 1.5, 0, 1.5, 0, 1, NULL);
+  if (st == KM_OK) st = km_path_close(&p, NULL);
+  if (st == KM_OK) st = km_path_to_curve(&p, 0, &out, NULL);
   km_curve_free(&out);
   km_path_free(&p);
   return outcome_of(st, "km_path", why);
@@ -197,15 +188,13 @@ static km_status morph_frames(const km_morph *m, const morph_case *c) {
                       c->metrics ? &sig : NULL, NULL);
   km_curve_free(&f);
   km_signature_free(&sig);
-  if (st == KM_OK)
-    st = km_morph_frame(m, 0.25, &f, NULL, NULL, NULL);
+  if (st == KM_OK) st = km_morph_frame(m, 0.25, &f, NULL, NULL, NULL);
   km_curve_free(&f);
   if (st == KM_OK)
     st = km_morph_frame_points(
         m, 0.75, c->metrics ? KM_FRAME_WITH_METRICS : KM_FRAME_CURVE, NULL,
         &points, NULL);
-  if (st == KM_OK)
-    (void)km_morph_matches_used(m, NULL, 0);
+  if (st == KM_OK) (void)km_morph_matches_used(m, NULL, 0);
   return st;
 }
 
@@ -226,8 +215,7 @@ static oom_outcome run_morph(void *ctx, char *why) {
     snprintf(why, 160, "a failed km_morph_create wrote its morph");
     return OOM_RAN_OTHER;
   }
-  if (st != KM_OK)
-    return outcome_of(st, "km_morph_create", why);
+  if (st != KM_OK) return outcome_of(st, "km_morph_create", why);
   st = morph_frames(m, c);
   km_morph_free(m);
   return outcome_of(st, "km_morph_frame", why);
@@ -235,8 +223,8 @@ static oom_outcome run_morph(void *ctx, char *why) {
 
 static void morph_curvature_closed_survives_oom(void **state) {
   shapes *s = *state;
-  morph_case c = {&s->circle, &s->rect, KM_METHOD_CURVATURE, NULL, 0, false,
-                  false};
+  morph_case c = {&s->circle, &s->rect, KM_METHOD_CURVATURE, NULL, 0,
+                  false,      false};
   oom_loop("morph curvature closed", run_morph, &c, false, OOM_MAX_RUNS);
 }
 
@@ -244,52 +232,50 @@ static void morph_curvature_closed_survives_oom(void **state) {
  * it made another start win and answered a different morph. */
 static void morph_start_preview_survives_oom(void **state) {
   shapes *s = *state;
-  morph_case c = {&s->letter_u, &s->letter_s, KM_METHOD_CURVATURE, NULL, 0, false,
-                  false};
+  morph_case c = {&s->letter_u, &s->letter_s, KM_METHOD_CURVATURE, NULL, 0,
+                  false,        false};
   oom_loop("morph start preview", run_morph, &c, false, OOM_MAX_RUNS);
 }
 
 static void morph_curvature_closed_metrics_survives_oom(void **state) {
   shapes *s = *state;
-  morph_case c = {&s->circle, &s->rect, KM_METHOD_CURVATURE, NULL, 0, false,
-                  true};
+  morph_case c = {&s->circle, &s->rect, KM_METHOD_CURVATURE, NULL, 0,
+                  false,      true};
   oom_loop("morph curvature closed metrics", run_morph, &c, false,
            OOM_MAX_RUNS);
 }
 
 static void morph_curvature_open_survives_oom(void **state) {
   shapes *s = *state;
-  morph_case c = {&s->arch, &s->wave, KM_METHOD_CURVATURE, NULL, 0, false,
-                  true};
+  morph_case c = {&s->arch, &s->wave, KM_METHOD_CURVATURE, NULL, 0,
+                  false,    true};
   oom_loop("morph curvature open", run_morph, &c, false, OOM_MAX_RUNS);
 }
 
 static void morph_linear_closed_survives_oom(void **state) {
   shapes *s = *state;
-  morph_case c = {&s->circle, &s->rect, KM_METHOD_LINEAR, NULL, 0, false,
-                  true};
+  morph_case c = {&s->circle, &s->rect, KM_METHOD_LINEAR, NULL, 0, false, true};
   oom_loop("morph linear closed", run_morph, &c, false, OOM_MAX_RUNS);
 }
 
 static void morph_linear_open_survives_oom(void **state) {
   shapes *s = *state;
-  morph_case c = {&s->arch, &s->wave, KM_METHOD_LINEAR, NULL, 0, false,
-                  false};
+  morph_case c = {&s->arch, &s->wave, KM_METHOD_LINEAR, NULL, 0, false, false};
   oom_loop("morph linear open", run_morph, &c, false, OOM_MAX_RUNS);
 }
 
 static void morph_with_matches_survives_oom(void **state) {
   shapes *s = *state;
   static const double pairs[4] = {0.3, 0.4, 0.6, 0.7};
-  morph_case c = {&s->arch, &s->wave, KM_METHOD_CURVATURE, pairs, 2, false,
-                  true};
+  morph_case c = {&s->arch, &s->wave, KM_METHOD_CURVATURE, pairs, 2,
+                  false,    true};
   oom_loop("morph matches", run_morph, &c, false, OOM_MAX_RUNS);
 }
 
 static void morph_with_auto_matches_survives_oom(void **state) {
   shapes *s = *state;
-  morph_case c = {&s->circle, &s->rect, KM_METHOD_CURVATURE, NULL, 0, true,
-                  true};
+  morph_case c = {&s->circle, &s->rect, KM_METHOD_CURVATURE, NULL, 0,
+                  true,       true};
   oom_loop("morph auto matches", run_morph, &c, false, OOM_MAX_RUNS);
 }
 

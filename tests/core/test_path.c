@@ -323,7 +323,7 @@ static void point_pieces_are_dropped_but_degenerate_legs_kept(void **state) {
   assert_status(km_path_line_to(&p, 5, 1, NULL), KM_OK);
   build(&p, &c, 0);
   assert_int_equal(c.degree, 3);
-  assert_int_equal(c.n, 4); /* one piece */
+  assert_int_equal(c.n, 4);                  /* one piece */
   assert_true(c.cp[2] == 1 && c.cp[3] == 1); /* the zero leg is kept */
   km_curve_free(&c);
   km_path_free(&p);
@@ -339,8 +339,8 @@ static void point_pieces_are_dropped_but_degenerate_legs_kept(void **state) {
 
 /* With eps > 0 a piece within eps of the previous end is dropped and the
  * next one attached there: the shape moves by at most eps. */
-static void pieces_within_eps_are_dropped_and_the_path_stays_joined(
-    void **state) {
+static void
+pieces_within_eps_are_dropped_and_the_path_stays_joined(void **state) {
   (void)state;
   km_path p;
   km_curve c;
@@ -408,8 +408,7 @@ static void bad_coordinates_and_misuse_are_refused(void **state) {
                 KM_ENONFINITE);
   assert_int_equal(e.index, 2);
   assert_status(km_path_quad_to(&p, 0, 1, -1e16, 0, &e), KM_ERANGE);
-  assert_status(km_path_arc_to(&p, NAN, 1, 0, 0, 0, 1, 1, &e),
-                KM_ENONFINITE);
+  assert_status(km_path_arc_to(&p, NAN, 1, 0, 0, 0, 1, 1, &e), KM_ENONFINITE);
   /* an absurdly flat ellipse scaled to reach its end leaves the range */
   assert_status(km_path_arc_to(&p, 1e-300, 1, 0, 0, 0, 1, 0, &e), KM_ERANGE);
   /* nothing was added by the failures */

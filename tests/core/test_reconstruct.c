@@ -154,8 +154,7 @@ static void unit_circle_is_reconstructed_within_each_tolerance(void **state) {
       for (size_t k = 0; k < r.n + (size_t)deg + 1; k++) {
         double s = r.knots[k], d[1][2];
         km_curve_eval(&r, s, 0, d);
-        assert_close(hypot(d[0][0] - sin(s), d[0][1] - (1 - cos(s))), 0.0,
-                     tol);
+        assert_close(hypot(d[0][0] - sin(s), d[0][1] - (1 - cos(s))), 0.0, tol);
       }
       /* the fixture's samples */
       for (size_t i = 0; i < a.nsamples; i++) {
@@ -238,8 +237,8 @@ static double theta_piecewise(double s, const void *ctx) {
          tu_poly(IB, 4, 2.0, 0);
 }
 
-static void error_bound_covers_the_true_error_with_a_corner_and_a_jump(
-    void **state) {
+static void
+error_bound_covers_the_true_error_with_a_corner_and_a_jump(void **state) {
   (void)state;
   /* kappa as one cubic spline: knot 2 of multiplicity 4 makes the jump */
   const double kn[14] = {0, 0, 0, 0, 1, 2, 2, 2, 2, 3.5, 5, 5, 5, 5};
@@ -366,12 +365,19 @@ static void letter_outline_with_corners_survives_a_round_trip(void **state) {
   /* a "D": a quadratic (elevated exactly to a cubic), a cubic joining it
    * smoothly, and two lines, with corners at (0,10), (-1,5) and the seam
    * (0,0) */
-  const double cp[26] = {0,       0,        10.0 / 3, 0,  5.5,  1,
-                         6.5,     3,        7.25,     4.5, 6,   10,
-                         0,       10,       -1.0 / 3, 10 - 5.0 / 3,
-                         -2.0 / 3, 10 - 10.0 / 3, -1, 5,
-                         -2.0 / 3, 5 - 5.0 / 3,  -1.0 / 3, 5 - 10.0 / 3,
-                         0,       0};
+  const double cp[26] = {0,        0,
+                         10.0 / 3, 0,
+                         5.5,      1,
+                         6.5,      3,
+                         7.25,     4.5,
+                         6,        10,
+                         0,        10,
+                         -1.0 / 3, 10 - 5.0 / 3,
+                         -2.0 / 3, 10 - 10.0 / 3,
+                         -1,       5,
+                         -2.0 / 3, 5 - 5.0 / 3,
+                         -1.0 / 3, 5 - 10.0 / 3,
+                         0,        0};
   const double kn[17] = {0, 0, 0, 0, 1, 1, 1, 2, 2, 2, 3, 3, 3, 4, 4, 4, 4};
   km_curve c;
   make_curve(&c, 3, 13, kn, cp, NULL, true);
@@ -400,9 +406,12 @@ static void fixture_outlines_survive_a_round_trip(void **state) {
   static const struct {
     const char *pair;
     char which;
-  } shapes[] = {{"U_to_S", 'a'},       {"U_to_S", 'b'},
-                {"crescent_to_heart", 'a'}, {"crescent_to_heart", 'b'},
-                {"arrow_rot90", 'a'},  {"spiral_open", 'a'},
+  } shapes[] = {{"U_to_S", 'a'},
+                {"U_to_S", 'b'},
+                {"crescent_to_heart", 'a'},
+                {"crescent_to_heart", 'b'},
+                {"arrow_rot90", 'a'},
+                {"spiral_open", 'a'},
                 {"circle_to_star", 'a'}};
   for (size_t i = 0; i < sizeof shapes / sizeof shapes[0]; i++) {
     tf_bspline b;
@@ -451,8 +460,8 @@ static void reconstruct_rejects_other_degrees(void **state) {
   km_signature_free(&sig);
 }
 
-static void corner_one_ulp_before_a_curvature_break_keeps_its_turn(
-    void **state) {
+static void
+corner_one_ulp_before_a_curvature_break_keeps_its_turn(void **state) {
   (void)state;
   /* kappa = 2^40 on [a, b] = [1/2 - 2^-40, 1/2] and 0 elsewhere, length 1,
    * a corner of pi/2 at s_c one ulp before b. theta climbs to 1 rad over
@@ -472,8 +481,8 @@ static void corner_one_ulp_before_a_curvature_break_keeps_its_turn(
   const double start[2] = {0, 0};
   km_signature sig;
   km_signature_init(&sig);
-  assert_status(km_signature_create(&sig, 1.0, start, 0.0, &kappa, &corner,
-                                    1, false, &err),
+  assert_status(km_signature_create(&sig, 1.0, start, 0.0, &kappa, &corner, 1,
+                                    false, &err),
                 KM_OK);
   km_fn_free(&kappa);
   double ex = a + sin(phi) / K + 0.5 * cos(th1);
@@ -513,7 +522,8 @@ static km_status falling_kappa(km_signature *sig, double k0, km_error *err) {
   assert_status(km_fn_create(&kappa, 1, 2, kn, co, err), KM_OK);
   const double start[2] = {0, 0};
   km_signature_init(sig);
-  km_status st = km_signature_create(sig, 4.0, start, 0.0, &kappa, NULL, 0, false, err);
+  km_status st =
+      km_signature_create(sig, 4.0, start, 0.0, &kappa, NULL, 0, false, err);
   km_fn_free(&kappa);
   return st;
 }
@@ -546,8 +556,9 @@ static void reconstruction_that_turns_without_end_is_refused(void **state) {
   assert_status(km_fn_constant(&kappa, 0.0, 4.0, 1.0, &err), KM_OK);
   km_signature_init(&sig);
   const double start[2] = {0, 0};
-  assert_status(km_signature_create(&sig, 4.0, start, 0.0, &kappa, NULL, 0, false, &err),
-                KM_OK);
+  assert_status(
+      km_signature_create(&sig, 4.0, start, 0.0, &kappa, NULL, 0, false, &err),
+      KM_OK);
   double bound;
   assert_status(km_reconstruct(&sig, 5, 2.1e-3, &r, &bound, &err), KM_OK);
   assert_true(r.n < 100 && bound <= 2.1e-3);
@@ -568,14 +579,15 @@ static void reconstruction_holds_to_a_number_of_points(void **state) {
   km_fn_init(&kappa);
   assert_status(km_fn_constant(&kappa, 0.0, 2 * M_PI, 1.0, &err), KM_OK);
   const double start[2] = {1, 0};
-  assert_status(km_signature_create(&sig, 2 * M_PI, start, M_PI / 2, &kappa, NULL, 0, true,
-                                    &err),
+  assert_status(km_signature_create(&sig, 2 * M_PI, start, M_PI / 2, &kappa,
+                                    NULL, 0, true, &err),
                 KM_OK);
   km_curve r;
   km_curve_init(&r);
   const size_t limits[] = {2000, 1000, 700, 400, 100, 3};
   for (size_t k = 0; k < sizeof limits / sizeof *limits; k++) {
-    km_status st = km_reconstruct_within(&sig, 3, 1e-9, limits[k], &r, NULL, &err);
+    km_status st =
+        km_reconstruct_within(&sig, 3, 1e-9, limits[k], &r, NULL, &err);
     if (limits[k] >= 1000) assert_status(st, KM_OK);
     if (limits[k] <= 700) {
       assert_status(st, KM_ELIMIT);
@@ -604,22 +616,21 @@ static void polyline_is_held_to_a_limit_of_exactly_its_points(void **state) {
   assert_status(km_fn_constant(&kappa, 0.0, 3.0, 0.0, &err), KM_OK);
   const double start[2] = {0, 0};
   const km_corner corners[2] = {{1.0, 1.0}, {2.0, 1.0}};
-  assert_status(km_signature_create(&sig, 3.0, start, 0.0, &kappa, corners,
-                                    2, false, &err),
+  assert_status(km_signature_create(&sig, 3.0, start, 0.0, &kappa, corners, 2,
+                                    false, &err),
                 KM_OK);
   km_curve r;
   km_curve_init(&r);
-  assert_status(km_reconstruct_within(&sig, 3, 1e-6, 0, &r, NULL, &err),
-                KM_OK);
+  assert_status(km_reconstruct_within(&sig, 3, 1e-6, 0, &r, NULL, &err), KM_OK);
   size_t needed = r.n;
   km_curve_free(&r);
   assert_int_equal(needed, 10);
-  assert_status(
-      km_reconstruct_within(&sig, 3, 1e-6, needed, &r, NULL, &err), KM_OK);
+  assert_status(km_reconstruct_within(&sig, 3, 1e-6, needed, &r, NULL, &err),
+                KM_OK);
   assert_true(r.n <= needed);
   km_curve_free(&r);
-  km_status st = km_reconstruct_within(&sig, 3, 1e-6, needed - 1, &r, NULL,
-                                       &err);
+  km_status st =
+      km_reconstruct_within(&sig, 3, 1e-6, needed - 1, &r, NULL, &err);
   assert_status(st, KM_ELIMIT);
   assert_int_equal(err.field, KM_FIELD_TOLERANCE);
   km_curve_free(&r);

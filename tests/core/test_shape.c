@@ -136,20 +136,23 @@ static void nesting_tree_does_not_depend_on_contour_order(void **state) {
   circle(&base[4], 13, 13, 1, 1);
   const long want_parent[5] = {-1, 0, 1, 1, -1};
   const int want_depth[5] = {0, 1, 2, 2, 0};
-  const size_t orders[3][5] = {{0, 1, 2, 3, 4}, {4, 3, 2, 1, 0}, {2, 0, 4, 3, 1}};
+  const size_t orders[3][5] = {
+      {0, 1, 2, 3, 4}, {4, 3, 2, 1, 0}, {2, 0, 4, 3, 1}};
   for (int o = 0; o < 3; o++) {
     km_curve c[5];
     for (int i = 0; i < 5; i++) c[i] = base[orders[o][i]];
     km_shape s;
     km_shape_init(&s);
-    assert_status(km_shape_create(&s, c, 5, KM_FILL_EVENODD, NULL, NULL), KM_OK);
+    assert_status(km_shape_create(&s, c, 5, KM_FILL_EVENODD, NULL, NULL),
+                  KM_OK);
     for (int i = 0; i < 5; i++) {
       size_t b = orders[o][i];
       long p = s.parent[i];
       long want = want_parent[b];
       assert_int_equal(p < 0 ? -1 : (long)orders[o][p], want);
       assert_int_equal(s.depth[i], want_depth[b]);
-      assert_int_equal(s.role[i], want_depth[b] % 2 ? KM_ROLE_HOLE : KM_ROLE_OUTER);
+      assert_int_equal(s.role[i],
+                       want_depth[b] % 2 ? KM_ROLE_HOLE : KM_ROLE_OUTER);
       double sa = shoelace(&s.contours[i]);
       assert_true(want_depth[b] % 2 ? sa < 0 : sa > 0);
     }
@@ -175,16 +178,19 @@ static void shape_refuses_bad_contours_naming_them(void **state) {
   km_shape s;
   km_shape_init(&s);
   km_error err;
-  assert_status(km_shape_create(&s, c, 4, KM_FILL_NONZERO, NULL, &err), KM_ECLOSED);
+  assert_status(km_shape_create(&s, c, 4, KM_FILL_NONZERO, NULL, &err),
+                KM_ECLOSED);
   assert_int_equal(err.index, 3);
   assert_int_equal(err.field, KM_FIELD_CLOSED);
   /* more contours than the limit */
   km_shape_limits lim = {2, 0};
-  assert_status(km_shape_create(&s, c, 3, KM_FILL_NONZERO, &lim, &err), KM_ELIMIT);
+  assert_status(km_shape_create(&s, c, 3, KM_FILL_NONZERO, &lim, &err),
+                KM_ELIMIT);
   assert_int_equal(err.index, 2);
   /* control points of all contours above the bound: 9 + 9 > 12 */
   km_shape_limits pts = {0, 12};
-  assert_status(km_shape_create(&s, c, 3, KM_FILL_NONZERO, &pts, &err), KM_ELIMIT);
+  assert_status(km_shape_create(&s, c, 3, KM_FILL_NONZERO, &pts, &err),
+                KM_ELIMIT);
   assert_int_equal(err.index, 1);
   assert_int_equal(err.field, KM_FIELD_CONTROL_POINTS);
   /* zero length: a closed curve whose control points all coincide */
@@ -195,18 +201,23 @@ static void shape_refuses_bad_contours_naming_them(void **state) {
   assert_status(km_curve_create(&dot, 2, 5, pkn, pcp, NULL, true, NULL), KM_OK);
   km_curve_free(&c[1]);
   c[1] = dot;
-  assert_status(km_shape_create(&s, c, 3, KM_FILL_NONZERO, NULL, &err), KM_EDEGENERATE);
+  assert_status(km_shape_create(&s, c, 3, KM_FILL_NONZERO, NULL, &err),
+                KM_EDEGENERATE);
   assert_int_equal(err.index, 1);
   /* a flat closed contour (there and back) encloses no area */
   const double fkn[5] = {0, 0, 1, 2, 2};
   const double fcp[6] = {0, 0, 1, 0, 0, 0};
   km_curve flat;
   km_curve_init(&flat);
-  assert_status(km_curve_create(&flat, 1, 3, fkn, fcp, NULL, true, NULL), KM_OK);
-  assert_status(km_shape_create(&s, &flat, 1, KM_FILL_NONZERO, NULL, &err), KM_EDEGENERATE);
+  assert_status(km_curve_create(&flat, 1, 3, fkn, fcp, NULL, true, NULL),
+                KM_OK);
+  assert_status(km_shape_create(&s, &flat, 1, KM_FILL_NONZERO, NULL, &err),
+                KM_EDEGENERATE);
   assert_int_equal(err.index, 0);
-  assert_status(km_shape_create(&s, c, 0, KM_FILL_NONZERO, NULL, &err), KM_ECOUNT);
-  assert_status(km_shape_create(&s, c, 1, (km_fill_rule)7, NULL, &err), KM_EINVAL);
+  assert_status(km_shape_create(&s, c, 0, KM_FILL_NONZERO, NULL, &err),
+                KM_ECOUNT);
+  assert_status(km_shape_create(&s, c, 1, (km_fill_rule)7, NULL, &err),
+                KM_EINVAL);
   assert_null(s.contours);
   km_curve_free(&flat);
   free_curves(c, 4);
@@ -232,7 +243,6 @@ static void copy_is_deep(void **state) {
   free_curves(c, 2);
 }
 
-
 /* ---- pairing ------------------------------------------------------------ */
 
 static void make_shape(km_shape *s, km_curve *c, size_t n) {
@@ -240,8 +250,8 @@ static void make_shape(km_shape *s, km_curve *c, size_t n) {
   assert_status(km_shape_create(s, c, n, KM_FILL_EVENODD, NULL, NULL), KM_OK);
 }
 
-static void get_pairs(const km_shape *a, const km_shape *b,
-                      km_shape_pair **p, size_t *n) {
+static void get_pairs(const km_shape *a, const km_shape *b, km_shape_pair **p,
+                      size_t *n) {
   km_error err;
   assert_status(km_shape_pair_auto(a, b, NULL, NULL, p, n, &err), KM_OK);
 }
@@ -262,8 +272,10 @@ static void ring_pairs_outer_with_outer_and_hole_with_hole(void **state) {
   circle(&a[1], 0, 0, 1, 0);
   circle(&tmp, 5, 1, 1.5, 1);
   km_curve_init(&b[0]);
-  assert_status(km_curve_transform(&b[0], &tmp, 2.0, 5 - 5 * cos(2.0) + sin(2.0),
-                                   1 - 5 * sin(2.0) - cos(2.0), NULL), KM_OK);
+  assert_status(km_curve_transform(&b[0], &tmp, 2.0,
+                                   5 - 5 * cos(2.0) + sin(2.0),
+                                   1 - 5 * sin(2.0) - cos(2.0), NULL),
+                KM_OK);
   km_curve_free(&tmp);
   circle(&b[1], 5, 1, 3, 1);
   km_shape sa, sb;

@@ -121,9 +121,12 @@ static void c_outline(km_curve *c) {
   km_path_init(&p);
   double a = 40 * M_PI / 180;
   assert_status(km_path_move_to(&p, 2 * cos(a), 2 * sin(a), NULL), KM_OK);
-  assert_status(km_path_arc_to(&p, 2, 2, 0, true, true, 2 * cos(a), -2 * sin(a), NULL), KM_OK);
+  assert_status(
+      km_path_arc_to(&p, 2, 2, 0, true, true, 2 * cos(a), -2 * sin(a), NULL),
+      KM_OK);
   assert_status(km_path_line_to(&p, cos(a), -sin(a), NULL), KM_OK);
-  assert_status(km_path_arc_to(&p, 1, 1, 0, true, false, cos(a), sin(a), NULL), KM_OK);
+  assert_status(km_path_arc_to(&p, 1, 1, 0, true, false, cos(a), sin(a), NULL),
+                KM_OK);
   assert_status(km_path_close(&p, NULL), KM_OK);
   km_curve_init(c);
   assert_status(km_path_to_curve(&p, 0.0, c, NULL), KM_OK);
@@ -168,7 +171,8 @@ static void o_to_c_counter_shrinks_away(void **state) {
       assert_null(f.contours[1].cp);
     }
     if (k == 0) assert_le(curves_distance(&f.contours[0], &keep[0], 800), 1e-3);
-    if (k == 40) assert_le(curves_distance(&f.contours[0], &keep[1], 800), 1e-3);
+    if (k == 40)
+      assert_le(curves_distance(&f.contours[0], &keep[1], 800), 1e-3);
     if (k > 0)
       for (size_t s = 0; s < 2; s++)
         if (f.present[s] && prev.present[s]) {

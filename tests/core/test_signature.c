@@ -29,15 +29,16 @@ static void sign(const km_curve *c, double rel, km_signature *sig) {
 }
 
 /* The number of corners, listing the first few when it is wrong. */
-#define assert_ncorners(sig, want)                                            \
-  do {                                                                        \
-    if ((sig)->ncorners != (size_t)(want)) {                                  \
-      print_error("%zu corners, expected %d:\n", (sig)->ncorners, (int)(want)); \
-      for (size_t i_ = 0; i_ < (sig)->ncorners && i_ < 6; i_++)              \
-        print_error("  s = %.17g turn = %.17g\n", (sig)->corners[i_].s,      \
-                    (sig)->corners[i_].turn);                                 \
-      fail();                                                                 \
-    }                                                                         \
+#define assert_ncorners(sig, want)                                             \
+  do {                                                                         \
+    if ((sig)->ncorners != (size_t)(want)) {                                   \
+      print_error("%zu corners, expected %d:\n", (sig)->ncorners,              \
+                  (int)(want));                                                \
+      for (size_t i_ = 0; i_ < (sig)->ncorners && i_ < 6; i_++)                \
+        print_error("  s = %.17g turn = %.17g\n", (sig)->corners[i_].s,        \
+                    (sig)->corners[i_].turn);                                  \
+      fail();                                                                  \
+    }                                                                          \
   } while (0)
 
 static double kappa_at(const km_signature *sig, double s) {
@@ -67,11 +68,13 @@ static void circle_case(int ccw) {
   for (int i = 0; i <= 500; i++) {
     double s = L * i / 500.0;
     assert_close(kappa_at(&sig, s), sgn / R, 1e-9 / R);
-    assert_close(tu_wrap(km_signature_theta(&sig, s) - sgn * (M_PI / 2 + s / R)),
-                 0.0, 1e-9);
+    assert_close(
+        tu_wrap(km_signature_theta(&sig, s) - sgn * (M_PI / 2 + s / R)), 0.0,
+        1e-9);
   }
   assert_close(km_signature_max_abs_kappa(&sig), 1.0 / R, 1e-9 / R);
-  assert_close(km_signature_bending_energy(&sig), L / (R * R), 1e-9 * L / (R * R));
+  assert_close(km_signature_bending_energy(&sig), L / (R * R),
+               1e-9 * L / (R * R));
   km_signature_free(&sig);
   km_curve_free(&c);
 }
@@ -138,8 +141,8 @@ static void clockwise_square_has_four_negative_corners(void **state) {
   polygon_case(3.0, 3.0, 0);
 }
 
-static void cubic_square_and_star_from_fixtures_have_polygon_corners(
-    void **state) {
+static void
+cubic_square_and_star_from_fixtures_have_polygon_corners(void **state) {
   (void)state;
   static const struct {
     const char *pair;
@@ -221,8 +224,7 @@ static bool has_knot_near(const km_fn *f, double x, double tol) {
   return false;
 }
 
-static void kappa_breakpoints_include_arc_length_images_of_knots(
-    void **state) {
+static void kappa_breakpoints_include_arc_length_images_of_knots(void **state) {
   (void)state;
   /* rounded rectangle: kappa jumps between 0 and 1/r at known s */
   const double W = 7.0, H = 4.0, r = 1.25;
@@ -273,9 +275,8 @@ static void kappa_breakpoints_include_arc_length_images_of_knots(
 
 /* Max |theta_a - theta_b| and |kappa_a - kappa_b| over many s (the lengths
  * must agree first). */
-static void assert_same_signature(const km_signature *a,
-                                  const km_signature *b, double theta_tol,
-                                  double kappa_tol) {
+static void assert_same_signature(const km_signature *a, const km_signature *b,
+                                  double theta_tol, double kappa_tol) {
   assert_close(b->length, a->length, 1e-12 * a->length);
   assert_close(b->start[0], a->start[0], 1e-12 * a->length);
   assert_close(b->start[1], a->start[1], 1e-12 * a->length);
@@ -288,8 +289,7 @@ static void assert_same_signature(const km_signature *a,
   assert_close(b->turning, a->turning, theta_tol);
   for (int i = 0; i <= 1000; i++) {
     double s = a->length * (i + 0.5) / 1001.0;
-    assert_close(km_signature_theta(b, s), km_signature_theta(a, s),
-                 theta_tol);
+    assert_close(km_signature_theta(b, s), km_signature_theta(a, s), theta_tol);
     assert_close(kappa_at(b, s), kappa_at(a, s), kappa_tol);
   }
 }
@@ -347,8 +347,8 @@ static double bezier_speed(double u, const void *ctx) {
   return hypot(d[0], d[1]);
 }
 
-static void repeated_first_control_point_gives_the_traced_signature(
-    void **state) {
+static void
+repeated_first_control_point_gives_the_traced_signature(void **state) {
   (void)state;
   /* D(u) = cubic Bezier (0,0), (0,0), (2,1), (3,3): D'(u) = 3u (4 - 3u, 2),
    * zero at u = 0 but the direction (4 - 3u, 2) never vanishes: the trace
@@ -442,9 +442,9 @@ static void degenerate_leg_at_a_join_is_smooth_or_a_corner(void **state) {
       assert_close(km_signature_theta(&sig, sig.corners[0].s), 0.0, 1e-6);
     }
     /* tangent at the end: (6, 3) - P2 */
-    assert_close(tu_wrap(km_signature_theta(&sig, L) -
-                         atan2(3 - cp[11], 6 - cp[10])),
-                 0.0, 1e-8);
+    assert_close(
+        tu_wrap(km_signature_theta(&sig, L) - atan2(3 - cp[11], 6 - cp[10])),
+        0.0, 1e-8);
     km_signature_free(&sig);
     km_curve_free(&c);
   }
@@ -485,9 +485,9 @@ static void rigid_motion_keeps_curvature_and_corners(void **state) {
   for (int i = 0; i <= 1000; i++) {
     double s = a.length * (i + 0.5) / 1001.0;
     assert_close(kappa_at(&b, s), kappa_at(&a, s), kt);
-    assert_close(tu_wrap(km_signature_theta(&b, s) -
-                         km_signature_theta(&a, s) - rot),
-                 0.0, 1e-8);
+    assert_close(
+        tu_wrap(km_signature_theta(&b, s) - km_signature_theta(&a, s) - rot),
+        0.0, 1e-8);
   }
   km_signature_free(&a);
   km_signature_free(&b);
@@ -558,8 +558,9 @@ static void zero_length_curve_is_degenerate(void **state) {
   make_curve(&c, 3, 4, kn, cp, NULL, false);
   /* bounded: a failure to stop must fail this test, not stall the suite */
   int r = tu_run_bounded(signature_status, &c, 5);
-  if (r < 0) print_error("signature of a point: %s\n",
-                         r == -1 ? "did not finish in 5 s" : "crashed");
+  if (r < 0)
+    print_error("signature of a point: %s\n",
+                r == -1 ? "did not finish in 5 s" : "crashed");
   assert_int_equal(r, -KM_EDEGENERATE);
   km_curve_free(&c);
 
@@ -579,9 +580,8 @@ static void zero_length_curve_is_degenerate(void **state) {
 /* km_curve_create must fail with `want`, naming `field` (unless field is
  * negative) and `index` (unless index < -1), and leave out untouched. */
 static void expect_create_error(int p, size_t n, const double *kn,
-                                const double *cp, const double *w,
-                                bool closed, km_status want, int field,
-                                long index) {
+                                const double *cp, const double *w, bool closed,
+                                km_status want, int field, long index) {
   km_curve c;
   km_error err;
   km_curve_init(&c);
@@ -607,15 +607,14 @@ static void curve_create_rejects_bad_input_naming_the_field(void **state) {
 
   /* decreasing knots: the element smaller than its predecessor */
   const double dec[9] = {0, 0, 0, 0, -0.5, 1, 1, 1, 1};
-  expect_create_error(3, 5, dec, cp, NULL, false, KM_EKNOTS, KM_FIELD_KNOTS,
-                      4);
+  expect_create_error(3, 5, dec, cp, NULL, false, KM_EKNOTS, KM_FIELD_KNOTS, 4);
   const double dec6[10] = {0, 0, 0, 0, 0.5, 0.4, 1, 1, 1, 1};
   expect_create_error(3, 6, dec6, cp, NULL, false, KM_EKNOTS, KM_FIELD_KNOTS,
                       5);
   expect_create_error(0, 5, kn, cp, NULL, false, KM_EDEGREE, KM_FIELD_DEGREE,
                       -2);
-  expect_create_error(20, 5, kn, cp, NULL, false, KM_EDEGREE,
-                      KM_FIELD_DEGREE, -2);
+  expect_create_error(20, 5, kn, cp, NULL, false, KM_EDEGREE, KM_FIELD_DEGREE,
+                      -2);
   /* the knot count is n + degree + 1, so a wrong count shows as too few
    * control points for the degree (the contract layer checks array
    * lengths, which the core never sees) */
@@ -635,18 +634,16 @@ static void curve_create_rejects_bad_input_naming_the_field(void **state) {
   double nk[9];
   memcpy(nk, kn, sizeof nk);
   nk[4] = NAN;
-  expect_create_error(3, 5, nk, cp, NULL, false, KM_ENONFINITE,
-                      KM_FIELD_KNOTS, 4);
+  expect_create_error(3, 5, nk, cp, NULL, false, KM_ENONFINITE, KM_FIELD_KNOTS,
+                      4);
   double ww[5] = {1, 1, 0, 1, 1};
-  expect_create_error(3, 5, kn, cp, ww, false, KM_EWEIGHT, KM_FIELD_WEIGHTS,
-                      2);
+  expect_create_error(3, 5, kn, cp, ww, false, KM_EWEIGHT, KM_FIELD_WEIGHTS, 2);
   ww[2] = 1;
   ww[3] = -1;
-  expect_create_error(3, 5, kn, cp, ww, false, KM_EWEIGHT, KM_FIELD_WEIGHTS,
-                      3);
+  expect_create_error(3, 5, kn, cp, ww, false, KM_EWEIGHT, KM_FIELD_WEIGHTS, 3);
   ww[3] = NAN;
-  expect_create_error(3, 5, kn, cp, ww, false, KM_ENONFINITE,
-                      KM_FIELD_WEIGHTS, 3);
+  expect_create_error(3, 5, kn, cp, ww, false, KM_ENONFINITE, KM_FIELD_WEIGHTS,
+                      3);
   /* closed, but the last point is not the first */
   expect_create_error(3, 5, kn, cp, NULL, true, KM_ECLOSED, -1, -2);
   /* not clamped; interior multiplicity above the degree; empty domain */
@@ -711,8 +708,8 @@ static void sharp_turn_close_to_the_end_has_its_exact_length(void **state) {
   }
 }
 
-static void high_order_degenerate_ends_take_the_first_distinct_point(
-    void **state) {
+static void
+high_order_degenerate_ends_take_the_first_distinct_point(void **state) {
   (void)state;
   /* A degree-9 Bezier R R R R S S T T T T: C - R ~ (S - R) u^4 at the
    * start and C - T ~ (S - T) (1-u)^4 at the end, and C' is a positive
@@ -758,7 +755,8 @@ static void high_order_degenerate_ends_take_the_first_distinct_point(
   make_curve(&c, 9, 10, kn, cp, NULL, false);
   double u1 = 41, u0 = 16;
   L = (0.4 * pow(u1, 2.5) - 32.0 / 3 * pow(u1, 1.5) -
-       (0.4 * pow(u0, 2.5) - 32.0 / 3 * pow(u0, 1.5))) / 1250;
+       (0.4 * pow(u0, 2.5) - 32.0 / 3 * pow(u0, 1.5))) /
+      1250;
   sign_abs(&c, 1e-11 * L, &sig);
   assert_close(sig.length, L, 1e-14 * L);
   assert_close(sig.angle, 0.0, 1e-15);
@@ -777,14 +775,14 @@ static void closed_rational_curve_with_a_tiny_span_closes(void **state) {
    * 2.68 rad there within a length below 1e-15 of the curve's, so the turn
    * is a corner that must sit exactly on the span's end. A closed curve
    * ends where it starts and, being simple, turns by 2 pi. */
-  const double kn[10] = {0, 0, 0, 0, 1e-9, 1e-9,
-                         1.000000001, 1.000000001, 1.000000001, 1.000000001};
-  const double cp[12] = {-0.0097656214236667427, -0.00030289158464942399,
-                         0.00016800183108262701, -0.0027754634927901123,
-                         0.0046691081101701368, 0.0002986190585183479,
-                         -0.0077230487525749604, -0.0014888227664606702,
-                         -0.0083865110246433214, 0.0026475928892957957,
-                         -0.0097656214236667427, -0.00030289158464942399};
+  const double kn[10] = {0,           0,          0,           0,
+                         1e-9,        1e-9,       1.000000001, 1.000000001,
+                         1.000000001, 1.000000001};
+  const double cp[12] = {
+      -0.0097656214236667427, -0.00030289158464942399, 0.00016800183108262701,
+      -0.0027754634927901123, 0.0046691081101701368,   0.0002986190585183479,
+      -0.0077230487525749604, -0.0014888227664606702,  -0.0083865110246433214,
+      0.0026475928892957957,  -0.0097656214236667427,  -0.00030289158464942399};
   const double w[6] = {0.01, 0.01, 0.01, 0.01, 10, 10};
   km_curve c;
   make_curve(&c, 3, 6, kn, cp, w, true);
@@ -882,8 +880,7 @@ static void spans_below_their_rounding_are_traced_or_refused(void **state) {
   if (st == KM_OK) {
     double end[2];
     signature_end(&sig, end);
-    assert_true(hypot(end[0] - cp[2 * (N - 1)], end[1] - cp[2 * N - 1]) <=
-                tol);
+    assert_true(hypot(end[0] - cp[2 * (N - 1)], end[1] - cp[2 * N - 1]) <= tol);
     km_signature_free(&sig);
   } else {
     assert_status(st, KM_ERANGE);
@@ -892,15 +889,22 @@ static void spans_below_their_rounding_are_traced_or_refused(void **state) {
   km_curve_free(&c);
 }
 
-static void closed_curve_ending_below_resolution_turns_whole_turns(void **state) {
+static void
+closed_curve_ending_below_resolution_turns_whole_turns(void **state) {
   (void)state;
   /* A closed rational cubic 0.01 across at (1e9, 1e9), weights over three
    * decades: its last piece ends in a stretch below the resolution of its
    * directions, whose turn was handed on to a next piece that never came,
    * and the signature turned by -0.486 rad. A closed curve's tangent
    * comes back to itself: the turning is a whole number of turns. */
-  const double cp[12] = {999999999.9900002, 1000000000.0098441, 999999999.9911841, 1000000000.0039104, 1000000000.0087808, 1000000000.0029039, 1000000000.0071814, 1000000000.00604, 999999999.9923563, 999999999.9920048, 999999999.9900002, 1000000000.0098441};
-  const double w[6] = {1, 3.1622776601683795, 0.31622776601683794, 0.03162277660168379, 0.01, 10};
+  const double cp[12] = {
+      999999999.9900002,  1000000000.0098441, 999999999.9911841,
+      1000000000.0039104, 1000000000.0087808, 1000000000.0029039,
+      1000000000.0071814, 1000000000.00604,   999999999.9923563,
+      999999999.9920048,  999999999.9900002,  1000000000.0098441};
+  const double w[6] = {
+      1, 3.1622776601683795, 0.31622776601683794, 0.03162277660168379, 0.01,
+      10};
   const double kn[10] = {0.0, 0.0, 0.0, 0.0, 1.0, 3.0, 4.0, 4.0, 4.0, 4.0};
   km_curve c;
   make_curve(&c, 3, 6, kn, cp, w, true);
@@ -924,8 +928,8 @@ static void closed_curve_ending_below_resolution_turns_whole_turns(void **state)
  * corners. A pentagon at arbitrary angles, a rotated square and an L. */
 static void polygon_edges_have_exactly_zero_curvature(void **state) {
   (void)state;
-  const double pent[12] = {0.3, -1.1, 1.7, -0.4, 1.2, 1.3, -0.6, 0.9, -0.8, -0.7,
-                           0.3, -1.1};
+  const double pent[12] = {0.3,  -1.1, 1.7,  -0.4, 1.2, 1.3,
+                           -0.6, 0.9,  -0.8, -0.7, 0.3, -1.1};
   const double kp[8] = {0, 0, 1, 2, 3, 4, 5, 5};
   double sq[10], ksq[7] = {0, 0, 1, 2, 3, 4, 4};
   for (int i = 0; i < 5; i++) {
@@ -961,8 +965,8 @@ static void polygon_edges_have_exactly_zero_curvature(void **state) {
  * degree-9 curve ended 1.5e-12 of its length off). At the default
  * tolerance it is absorbed by an edge and no corner is reported. The end
  * is (1 + cos delta, sin delta) exactly. */
-static void turn_below_rounding_at_a_knot_counts_at_tight_tolerance(
-    void **state) {
+static void
+turn_below_rounding_at_a_knot_counts_at_tight_tolerance(void **state) {
   (void)state;
   const double delta = 4e-12;
   const double kn[5] = {0, 0, 1, 2, 2};
@@ -988,8 +992,8 @@ static void turn_below_rounding_at_a_knot_counts_at_tight_tolerance(
   }
 }
 
-static void rational_span_leaving_a_degenerate_leg_has_its_exact_length(
-    void **state) {
+static void
+rational_span_leaving_a_degenerate_leg_has_its_exact_length(void **state) {
   (void)state;
   /* the segment of curvecases.h, its boundary layer narrower as w1 grows,
    * at a loose tolerance and at one below the rounding floor at 1e6 (16 p
@@ -1063,8 +1067,7 @@ static void hairpin_signature_counts_its_tip(void **state) {
    * long as the curve, turns as its end tangents do, and ends at its end.
    * Measured with its tip lost, the length came out U^2 = 1e-6 short (an
    * open cubic near 1e12 ended 8.8 times its tolerance off the same way) */
-  const double L = tc_hairpin_length(0, 1), U = TC_HAIRPIN_U,
-               E = TC_HAIRPIN_E;
+  const double L = tc_hairpin_length(0, 1), U = TC_HAIRPIN_U, E = TC_HAIRPIN_E;
   const double turn = atan2(E, 1 - U) - atan2(E, -U);
   for (int v = 0; v < 8; v++) {
     km_curve c;
@@ -1095,9 +1098,9 @@ static void rational_end_in_a_boundary_layer_keeps_its_turn(void **state) {
    * (theta free there within its range), 8e-6 rad behind the curve: the
    * end was 3.4e9 off at a tolerance of 1e9. */
   const double kn[8] = {0, 0, 0, 0, 1, 1, 1, 1};
-  const double cp[8] = {0, -89407186999313.359, 500000000000000,
-                        -89407186999313.359, 10000, -89407086999313.344,
-                        750000000000000, -92669565880827.047};
+  const double cp[8] = {
+      0,     -89407186999313.359, 500000000000000, -89407186999313.359,
+      10000, -89407086999313.344, 750000000000000, -92669565880827.047};
   const double w[4] = {100, 0.01, 100, 0.01};
   km_curve c;
   make_curve(&c, 3, 4, kn, cp, w, false);
@@ -1118,21 +1121,18 @@ static const struct CMUnitTest tests[] = {
     cmocka_unit_test(polygon_edges_have_exactly_zero_curvature),
     cmocka_unit_test(turn_below_rounding_at_a_knot_counts_at_tight_tolerance),
     cmocka_unit_test(clockwise_square_has_four_negative_corners),
-    cmocka_unit_test(
-        cubic_square_and_star_from_fixtures_have_polygon_corners),
+    cmocka_unit_test(cubic_square_and_star_from_fixtures_have_polygon_corners),
     cmocka_unit_test(straight_line_has_zero_curvature_and_turning),
     cmocka_unit_test(kappa_breakpoints_include_arc_length_images_of_knots),
     cmocka_unit_test(knot_insertion_and_elevation_keep_the_signature),
-    cmocka_unit_test(
-        repeated_first_control_point_gives_the_traced_signature),
+    cmocka_unit_test(repeated_first_control_point_gives_the_traced_signature),
     cmocka_unit_test(degenerate_leg_at_a_join_is_smooth_or_a_corner),
     cmocka_unit_test(rigid_motion_keeps_curvature_and_corners),
     cmocka_unit_test(cusp_is_refused_with_its_parameter),
     cmocka_unit_test(zero_length_curve_is_degenerate),
     cmocka_unit_test(curve_create_rejects_bad_input_naming_the_field),
     cmocka_unit_test(sharp_turn_close_to_the_end_has_its_exact_length),
-    cmocka_unit_test(
-        high_order_degenerate_ends_take_the_first_distinct_point),
+    cmocka_unit_test(high_order_degenerate_ends_take_the_first_distinct_point),
     cmocka_unit_test(closed_rational_curve_with_a_tiny_span_closes),
     cmocka_unit_test(curve_far_from_the_origin_keeps_to_its_rounding),
     cmocka_unit_test(spans_below_their_rounding_are_traced_or_refused),

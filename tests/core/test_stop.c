@@ -28,13 +28,15 @@ static void wavy(km_curve *c, size_t n, int waves, double amp) {
   for (size_t i = 0; i < n + 4; i++)
     knots[i] = i < 4 ? 0.0 : i >= n ? (double)(n - 3) : (double)(i - 3);
   for (size_t i = 0; i < n; i++) {
-    double a = 2 * 3.14159265358979323846 * (double)(i % (n - 1)) / (double)(n - 1);
+    double a =
+        2 * 3.14159265358979323846 * (double)(i % (n - 1)) / (double)(n - 1);
     double r = 1 + amp * sin(waves * a);
     cp[2 * i] = r * cos(a);
     cp[2 * i + 1] = r * sin(a);
   }
   km_curve_init(c);
-  assert_int_equal(km_curve_create(c, 3, n, knots, cp, NULL, true, NULL), KM_OK);
+  assert_int_equal(km_curve_create(c, 3, n, knots, cp, NULL, true, NULL),
+                   KM_OK);
   free(knots);
   free(cp);
 }
@@ -77,7 +79,8 @@ static km_status run_signature(fixture *f, const km_stop *stop) {
 static km_status run_reconstruct(fixture *f, const km_stop *stop) {
   km_curve c;
   km_curve_init(&c);
-  km_status st = km_reconstruct_until(&f->sa, 3, 1e-10, 0, stop, &c, NULL, NULL);
+  km_status st =
+      km_reconstruct_until(&f->sa, 3, 1e-10, 0, stop, &c, NULL, NULL);
   km_curve_free(&c);
   return st;
 }
@@ -118,8 +121,8 @@ static km_status run_frame(fixture *f, const km_stop *stop, bool metrics,
   km_curve c;
   km_frame_metrics mt;
   km_curve_init(&c);
-  km_status st = km_morph_frame_until(m, 0.4, stop, &c, metrics ? &mt : NULL,
-                                      NULL, NULL);
+  km_status st =
+      km_morph_frame_until(m, 0.4, stop, &c, metrics ? &mt : NULL, NULL, NULL);
   km_curve_free(&c);
   km_morph_free(m);
   return st;
@@ -143,11 +146,15 @@ static const struct {
   const char *name;
   entry run;
 } entries[] = {
-    {"signature", run_signature},       {"reconstruct", run_reconstruct},
-    {"morph_create", run_create},       {"morph_create_auto", run_create_auto},
+    {"signature", run_signature},
+    {"reconstruct", run_reconstruct},
+    {"morph_create", run_create},
+    {"morph_create_auto", run_create_auto},
     {"morph_create_linear", run_create_linear},
-    {"frame_planned", run_frame_planned}, {"frame_metrics", run_frame_metrics},
-    {"frame_linear", run_frame_linear}, {"self_intersections", run_crossings},
+    {"frame_planned", run_frame_planned},
+    {"frame_metrics", run_frame_metrics},
+    {"frame_linear", run_frame_linear},
+    {"self_intersections", run_crossings},
 };
 #define NENTRIES (sizeof entries / sizeof entries[0])
 

@@ -44,8 +44,7 @@ static void fuzz_fail(const char *why, const api_response *r) {
 
 /* The promises every answer keeps, whatever the request was. */
 static void fuzz_check_response(const api_response *r) {
-  if (r->status >= 500)
-    fuzz_fail("server error for a client's request", r);
+  if (r->status >= 500) fuzz_fail("server error for a client's request", r);
   if (r->status < 200 || (r->status >= 300 && r->status < 400))
     fuzz_fail("status outside 2xx/4xx", r);
   if (r->content_type == NULL || r->body == NULL)
@@ -57,8 +56,7 @@ static void fuzz_check_response(const api_response *r) {
     fuzz_fail("an error that is not problem+json", r);
   if (strstr(r->content_type, "json") != NULL) {
     cJSON *doc = cJSON_ParseWithLength(r->body, r->length);
-    if (doc == NULL)
-      fuzz_fail("JSON answer does not parse", r);
+    if (doc == NULL) fuzz_fail("JSON answer does not parse", r);
     if (r->status >= 400) {
       const cJSON *st = cJSON_GetObjectItemCaseSensitive(doc, "status");
       const cJSON *ty = cJSON_GetObjectItemCaseSensitive(doc, "type");
@@ -82,8 +80,7 @@ typedef struct fuzz_countdown {
 
 static bool fuzz_stop_at(void *ctx) {
   fuzz_countdown *c = ctx;
-  if (c->left == 0)
-    return true;
+  if (c->left == 0) return true;
   c->left--;
   return false;
 }
@@ -95,8 +92,7 @@ static bool fuzz_stop_at(void *ctx) {
 static void fuzz_stopped_request(const api_config *cfg, const uint8_t *data,
                                  size_t size, int unstopped) {
   unsigned long h = 5381;
-  for (size_t i = 0; i < size; i++)
-    h = h * 33 + data[i];
+  for (size_t i = 0; i < size; i++) h = h * 33 + data[i];
   fuzz_countdown c = {h % 64};
   api_request req = {.route = FUZZ_ROUTE,
                      .body = (const char *)data,
@@ -143,8 +139,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     int pst = api_morph_prepare(&cfg, &req, cfg.max_frames_job, &plan, &perr);
     if (pst != 0) {
       fuzz_check_response(&perr);
-      if (plan != NULL)
-        fuzz_fail("failed prepare left a plan", &perr);
+      if (plan != NULL) fuzz_fail("failed prepare left a plan", &perr);
       if (pst != out.status)
         fuzz_fail("job prepare and synchronous morph disagree", &perr);
     } else {

@@ -15,9 +15,8 @@
 
 /* km_curve_create or fail the test: c is initialised first, so the caller
  * frees it with km_curve_free whatever happened. */
-static inline void make_curve(km_curve *c, int p, size_t n,
-                              const double *knots, const double *cp,
-                              const double *w, bool closed) {
+static inline void make_curve(km_curve *c, int p, size_t n, const double *knots,
+                              const double *cp, const double *w, bool closed) {
   km_error err;
   km_curve_init(c);
   assert_status(km_curve_create(c, p, n, knots, cp, w, closed, &err), KM_OK);
@@ -35,8 +34,8 @@ static inline void signature_of_analytic(const tf_analytic *a,
   assert_status(km_fn_create(&kappa, a->kappa_degree, a->kappa_n,
                              a->kappa_knots, a->kappa_coef, &err),
                 KM_OK);
-  assert_status(km_signature_create(sig, a->length, a->start, a->angle,
-                                    &kappa, NULL, 0, a->closed, &err),
+  assert_status(km_signature_create(sig, a->length, a->start, a->angle, &kappa,
+                                    NULL, 0, a->closed, &err),
                 KM_OK);
   km_fn_free(&kappa);
 }
@@ -92,8 +91,8 @@ static inline double tc_hairpin_length(double u0, double u1) {
   return tc_hairpin_primitive(u1 - TC_HAIRPIN_U) -
          tc_hairpin_primitive(u0 - TC_HAIRPIN_U);
 }
-static inline void tc_hairpin(km_curve *c, int degree, double weight,
-                              double ox, double oy) {
+static inline void tc_hairpin(km_curve *c, int degree, double weight, double ox,
+                              double oy) {
   const double U = TC_HAIRPIN_U, E = TC_HAIRPIN_E;
   /* quadratic Bezier: P1 = P0 + C'(0) / 2 */
   const double q[3][2] = {{0, 0}, {-0.5 * U, 0.5 * E}, {0.5 - U, E}};

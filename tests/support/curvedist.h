@@ -30,8 +30,7 @@ static inline size_t per_span(const km_curve *c, size_t total) {
 /* Dense samples of a curve: `per` points per knot span, uniform in the
  * parameter, span ends included (corners sit on knots), plus the end;
  * malloc'd (2 doubles a point, *np points), the caller frees. */
-static inline double *curve_points(const km_curve *c, size_t per,
-                                   size_t *np) {
+static inline double *curve_points(const km_curve *c, size_t per, size_t *np) {
   double *p = malloc(2 * (spans_of(c) * per + 1) * sizeof *p);
   assert_non_null(p);
   size_t k = 0;
@@ -72,15 +71,19 @@ static inline double chord_error(const km_curve *c, size_t per) {
       km_curve_eval(c, 0.5 * (u0 + u1), 0, pm);
       double dx = p1[0][0] - p0[0][0], dy = p1[0][1] - p0[0][1];
       double len = hypot(dx, dy);
-      double dist = len > 0 ? fabs((pm[0][0] - p0[0][0]) * dy - (pm[0][1] - p0[0][1]) * dx) / len
-                            : hypot(pm[0][0] - p0[0][0], pm[0][1] - p0[0][1]);
+      double dist =
+          len > 0
+              ? fabs((pm[0][0] - p0[0][0]) * dy - (pm[0][1] - p0[0][1]) * dx) /
+                    len
+              : hypot(pm[0][0] - p0[0][0], pm[0][1] - p0[0][1]);
       if (dist > worst) worst = dist;
     }
   }
   return worst;
 }
 
-static inline double seg_dist(const double *p, const double *a, const double *b) {
+static inline double seg_dist(const double *p, const double *a,
+                              const double *b) {
   double dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy;
   double u = l2 > 0 ? ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2 : 0.0;
   if (u < 0) u = 0;
@@ -89,8 +92,8 @@ static inline double seg_dist(const double *p, const double *a, const double *b)
 }
 
 /* max over points of P of the distance to the polyline Q */
-static inline double directed_dist(const double *P, size_t np,
-                                   const double *Q, size_t nq) {
+static inline double directed_dist(const double *P, size_t np, const double *Q,
+                                   size_t nq) {
   double worst = 0.0;
   for (size_t i = 0; i < np; i++) {
     double best = INFINITY;

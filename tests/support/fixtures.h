@@ -28,8 +28,8 @@ typedef struct tf_analytic {
   double *kappa_coef;  /* kappa_n */
   bool closed;
   size_t nsamples;
-  double *samples;     /* 4 per sample: s, x, y, theta */
-  double agreement;    /* stated accuracy of the samples */
+  double *samples;  /* 4 per sample: s, x, y, theta */
+  double agreement; /* stated accuracy of the samples */
 } tf_analytic;
 
 /* One curve (a or b) of a shapes.json pair. Arrays malloc'd; w may be

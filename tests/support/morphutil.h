@@ -10,7 +10,6 @@
 
 #include "km/morph.h"
 
-
 static km_morph *morph_new(const km_morph_input *a, const km_morph_input *b,
                            const km_morph_options *o) {
   km_morph *m = NULL;

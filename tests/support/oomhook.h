@@ -36,53 +36,49 @@ static void oom_arm(long fail_at, bool persist) {
   oom.persist = persist;
 }
 
-static void oom_disarm(void) { oom.fail_at = 0; }
+static void oom_disarm(void) {
+  oom.fail_at = 0;
+}
 
 /* Whether the allocation being asked for is to fail. */
 static bool oom_fails_now(void) {
   long k = ++oom.count;
-  bool fail = oom.fail_at > 0 &&
-              (k == oom.fail_at || (oom.persist && k > oom.fail_at));
-  if (fail)
-    oom.failed++;
+  bool fail =
+      oom.fail_at > 0 && (k == oom.fail_at || (oom.persist && k > oom.fail_at));
+  if (fail) oom.failed++;
   return fail;
 }
 
 void *km__malloc(size_t n) {
   void *p = oom_fails_now() ? NULL : malloc(n);
-  if (p != NULL)
-    oom.live++;
+  if (p != NULL) oom.live++;
   return p;
 }
 
 void *km__calloc(size_t count, size_t size) {
   void *p = oom_fails_now() ? NULL : calloc(count, size);
-  if (p != NULL)
-    oom.live++;
+  if (p != NULL) oom.live++;
   return p;
 }
 
 void *km__realloc(void *p, size_t n) {
   void *q;
-  if (oom_fails_now())
-    return NULL;
+  if (oom_fails_now()) return NULL;
   q = realloc(p, n);
-  if (q != NULL && p == NULL)
-    oom.live++;
+  if (q != NULL && p == NULL) oom.live++;
   return q;
 }
 
 void km__free(void *p) {
-  if (p != NULL)
-    oom.live--;
+  if (p != NULL) oom.live--;
   free(p);
 }
 
 /* What one run of a call under test ended with. */
 typedef enum oom_outcome {
-  OOM_RAN_OK,     /* the call succeeded */
-  OOM_RAN_NOMEM,  /* it reported out of memory, as it must */
-  OOM_RAN_OTHER   /* anything else: a bug when an allocation failed */
+  OOM_RAN_OK,    /* the call succeeded */
+  OOM_RAN_NOMEM, /* it reported out of memory, as it must */
+  OOM_RAN_OTHER  /* anything else: a bug when an allocation failed */
 } oom_outcome;
 
 /* One run of a call: make it, check what it gave, free all it returned.
@@ -118,8 +114,7 @@ static oom_report oom_loop(const char *name, oom_run run, void *ctx,
     }
     if (oom.failed == 0) {
       if (got != OOM_RAN_OK) {
-        print_error("%s: fails without a failed allocation: %s\n", name,
-                    why);
+        print_error("%s: fails without a failed allocation: %s\n", name, why);
         fail();
       }
       rep.allocations = oom.count;
@@ -128,9 +123,9 @@ static oom_report oom_loop(const char *name, oom_run run, void *ctx,
       return rep;
     }
     if (got != OOM_RAN_NOMEM) {
-      print_error("%s: allocation %ld of %ld failing gives %s: %s\n", name,
-                  n, oom.count,
-                  got == OOM_RAN_OK ? "success" : "another failure", why);
+      print_error("%s: allocation %ld of %ld failing gives %s: %s\n", name, n,
+                  oom.count, got == OOM_RAN_OK ? "success" : "another failure",
+                  why);
       fail();
     }
     rep.nomem_runs++;

@@ -53,18 +53,12 @@ int main(int argc, char **argv) {
 
   while ((opt = getopt(argc, argv, "t:lh")) != -1) {
     switch (opt) {
-    case 't':
-      name = optarg;
-      break;
+    case 't': name = optarg; break;
     case 'l':
       for (size_t i = 0; i < s->count; i++) printf("%s\n", s->tests[i].name);
       return 0;
-    case 'h':
-      usage(stdout, argv[0]);
-      return 0;
-    default:
-      usage(stderr, argv[0]);
-      return 2;
+    case 'h': usage(stdout, argv[0]); return 0;
+    default: usage(stderr, argv[0]); return 2;
     }
   }
   if (optind < argc) {

@@ -42,9 +42,9 @@ extern const tm_suite tm_this_suite;
 
 /* TM_SUITE(group, table, setup, teardown): hand the file-scope array
  * `table` of cmocka_unit_test entries to the shared main. */
-#define TM_SUITE(group_, table_, setup_, teardown_)                          \
-  const tm_suite tm_this_suite = {(group_), (table_),                        \
-                                  sizeof(table_) / sizeof((table_)[0]),      \
+#define TM_SUITE(group_, table_, setup_, teardown_)                            \
+  const tm_suite tm_this_suite = {(group_), (table_),                          \
+                                  sizeof(table_) / sizeof((table_)[0]),        \
                                   (setup_), (teardown_)}
 
 #endif

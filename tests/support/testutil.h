@@ -31,41 +31,41 @@
 #endif
 
 /* |got - want| <= tol, printing both values when it is not. NaN fails. */
-#define assert_close(got, want, tol)                                          \
-  do {                                                                        \
-    double tu_g_ = (got), tu_w_ = (want), tu_t_ = (tol);                      \
-    if (!(fabs(tu_g_ - tu_w_) <= tu_t_)) {                                    \
-      print_error("%s = %.17g, expected %s = %.17g within %.3g (off by "      \
-                  "%.3g)\n",                                                  \
-                  #got, tu_g_, #want, tu_w_, tu_t_, fabs(tu_g_ - tu_w_));     \
-      fail();                                                                 \
-    }                                                                         \
+#define assert_close(got, want, tol)                                           \
+  do {                                                                         \
+    double tu_g_ = (got), tu_w_ = (want), tu_t_ = (tol);                       \
+    if (!(fabs(tu_g_ - tu_w_) <= tu_t_)) {                                     \
+      print_error("%s = %.17g, expected %s = %.17g within %.3g (off by "       \
+                  "%.3g)\n",                                                   \
+                  #got, tu_g_, #want, tu_w_, tu_t_, fabs(tu_g_ - tu_w_));      \
+      fail();                                                                  \
+    }                                                                          \
   } while (0)
 
 /* |got - want| <= rel * |want|. */
-#define assert_rel(got, want, rel)                                            \
-  assert_close((got), (want), (rel) * fabs((double)(want)))
+#define assert_rel(got, want, rel)                                             \
+  assert_close((got), (want), (rel)*fabs((double)(want)))
 
 /* a <= b, printing both values when it is not. */
-#define assert_le(a, b)                                                       \
-  do {                                                                        \
-    double tu_a_ = (a), tu_b_ = (b);                                          \
-    if (!(tu_a_ <= tu_b_)) {                                                  \
-      print_error("expected %s = %.17g <= %s = %.17g\n", #a, tu_a_, #b,       \
-                  tu_b_);                                                     \
-      fail();                                                                 \
-    }                                                                         \
+#define assert_le(a, b)                                                        \
+  do {                                                                         \
+    double tu_a_ = (a), tu_b_ = (b);                                           \
+    if (!(tu_a_ <= tu_b_)) {                                                   \
+      print_error("expected %s = %.17g <= %s = %.17g\n", #a, tu_a_, #b,        \
+                  tu_b_);                                                      \
+      fail();                                                                  \
+    }                                                                          \
   } while (0)
 
 /* A status comparison that names both codes. */
-#define assert_status(got, want)                                              \
-  do {                                                                        \
-    int tu_s_ = (int)(got), tu_e_ = (int)(want);                              \
-    if (tu_s_ != tu_e_) {                                                     \
-      print_error("%s returned status %d, expected %s (%d)\n", #got, tu_s_,   \
-                  #want, tu_e_);                                              \
-      fail();                                                                 \
-    }                                                                         \
+#define assert_status(got, want)                                               \
+  do {                                                                         \
+    int tu_s_ = (int)(got), tu_e_ = (int)(want);                               \
+    if (tu_s_ != tu_e_) {                                                      \
+      print_error("%s returned status %d, expected %s (%d)\n", #got, tu_s_,    \
+                  #want, tu_e_);                                               \
+      fail();                                                                  \
+    }                                                                          \
   } while (0)
 
 /* Angle difference wrapped to (-pi, pi]. */
@@ -126,7 +126,8 @@ static inline double tu_blossom(const double *a, int deg, int p,
 static inline void tu_poly_to_bspline(const double *a, int deg, int p,
                                       const double *t, size_t n, double *out,
                                       size_t stride) {
-  for (size_t i = 0; i < n; i++) out[i * stride] = tu_blossom(a, deg, p, t + i + 1);
+  for (size_t i = 0; i < n; i++)
+    out[i * stride] = tu_blossom(a, deg, p, t + i + 1);
 }
 
 /* Gauss-Legendre nodes and weights on [-1, 1] (Newton on P_n). n <= 64. */
@@ -154,8 +155,7 @@ static inline void tu_gauss_legendre(int n, double *x, double *w) {
  * panels: exact for polynomials of degree <= 39 per panel, and to rounding
  * for the smooth analytic integrands the tests use. */
 static inline double tu_integrate(double (*f)(double, const void *),
-                                  const void *ctx, double a, double b,
-                                  int m) {
+                                  const void *ctx, double a, double b, int m) {
   double x[20], w[20];
   tu_gauss_legendre(20, x, w);
   double h = (b - a) / m, sum = 0.0;
@@ -175,8 +175,8 @@ static inline void tu_circle_nurbs(double cx, double cy, double r, int ccw,
                                    double *knots, double *cp, double *w) {
   static const double ux[9] = {1, 1, 0, -1, -1, -1, 0, 1, 1};
   static const double uy[9] = {0, 1, 1, 1, 0, -1, -1, -1, 0};
-  static const double kn[12] = {0, 0, 0, 0.25, 0.25, 0.5,
-                                0.5, 0.75, 0.75, 1, 1, 1};
+  static const double kn[12] = {0,   0,    0,    0.25, 0.25, 0.5,
+                                0.5, 0.75, 0.75, 1,    1,    1};
   for (int i = 0; i < 12; i++) knots[i] = kn[i];
   for (int i = 0; i < 9; i++) {
     cp[2 * i] = cx + r * ux[i];
@@ -198,12 +198,11 @@ static inline void tu_rounded_rect(double x0, double y0, double w, double h,
   /* the nine join points and the eight middle control points */
   const double jx[9] = {x0 + r, x0 + w - r, x0 + w, x0 + w, x0 + w - r,
                         x0 + r, x0,         x0,     x0 + r};
-  const double jy[9] = {y0,         y0,     y0 + r, y0 + h - r, y0 + h,
+  const double jy[9] = {y0,     y0,         y0 + r, y0 + h - r, y0 + h,
                         y0 + h, y0 + h - r, y0 + r, y0};
-  const double mx[8] = {0.5 * (jx[0] + jx[1]), x0 + w, x0 + w,
-                        x0 + w,                0.5 * (jx[4] + jx[5]),
-                        x0,                    x0,     x0};
-  const double my[8] = {y0, y0, 0.5 * (jy[2] + jy[3]), y0 + h,
+  const double mx[8] = {0.5 * (jx[0] + jx[1]), x0 + w, x0 + w, x0 + w,
+                        0.5 * (jx[4] + jx[5]), x0,     x0,     x0};
+  const double my[8] = {y0,     y0,     0.5 * (jy[2] + jy[3]), y0 + h,
                         y0 + h, y0 + h, 0.5 * (jy[6] + jy[7]), y0};
   for (int i = 0; i < 8; i++) {
     cp[4 * i] = jx[i];

@@ -24,19 +24,19 @@ typedef int api_status;
 
 /* Limits enforced before any work starts; see api_config_default(). */
 typedef struct api_config {
-  size_t max_body_bytes;          /* 8 MiB: bigger bodies are 413 */
-  size_t max_control_points;      /* 100,000 per curve */
-  size_t max_frames_sync;         /* 1,000 per POST /v1/morph */
-  size_t max_frames_job;          /* 10,000 per POST /v1/jobs */
-  size_t max_samples;             /* 100,000 kappa samples per request */
-  size_t max_json_depth;          /* 64: deeper JSON is 400 */
-  size_t max_output_bytes;        /* 64 MiB: an answer predicted larger
+  size_t max_body_bytes;     /* 8 MiB: bigger bodies are 413 */
+  size_t max_control_points; /* 100,000 per curve */
+  size_t max_frames_sync;    /* 1,000 per POST /v1/morph */
+  size_t max_frames_job;     /* 10,000 per POST /v1/jobs */
+  size_t max_samples;        /* 100,000 kappa samples per request */
+  size_t max_json_depth;     /* 64: deeper JSON is 400 */
+  size_t max_output_bytes;   /* 64 MiB: an answer predicted larger
                                      (an upper bound, from the control
                                      points or coefficients it will hold,
                                      before it is rendered) is 422
                                      limit-exceeded naming /frames,
                                      /times, /samples or /tolerance */
-  size_t max_contours;            /* 64 contours (subpaths) per shape; 0
+  size_t max_contours;       /* 64 contours (subpaths) per shape; 0
                                      asks for the default; more is 422
                                      limit-exceeded naming the contour */
 } api_config;

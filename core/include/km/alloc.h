@@ -50,12 +50,18 @@ void km__free(void *p);
 
 #include <stdlib.h>
 
-static inline void *km__malloc(size_t n) { return malloc(n); }
+static inline void *km__malloc(size_t n) {
+  return malloc(n);
+}
 static inline void *km__calloc(size_t count, size_t size) {
   return calloc(count, size);
 }
-static inline void *km__realloc(void *p, size_t n) { return realloc(p, n); }
-static inline void km__free(void *p) { free(p); }
+static inline void *km__realloc(void *p, size_t n) {
+  return realloc(p, n);
+}
+static inline void km__free(void *p) {
+  free(p);
+}
 
 #endif
 

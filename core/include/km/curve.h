@@ -129,8 +129,7 @@ km_status km_curve_reverse(km_curve *out, const km_curve *c, km_error *err);
  * span i has control points degree*i .. degree*(i+1). Same trace, domain
  * and closed flag; out owned by the caller. Returns KM_OK, KM_EINVAL (c
  * not a curve), KM_ENOMEM. */
-km_status km_curve_to_bezier(km_curve *out, const km_curve *c,
-                             km_error *err);
+km_status km_curve_to_bezier(km_curve *out, const km_curve *c, km_error *err);
 
 /* Degree raised by times >= 0 (exact); each distinct knot's multiplicity
  * grows by times; closed flag kept; out owned by the caller. Returns KM_OK,
@@ -233,7 +232,6 @@ long km_curve_self_intersections(const km_curve *c, double tol);
  * Returns KM_OK, KM_ECANCELLED, KM_EINVAL (c not a curve), KM_ENOMEM.
  * Order: takes no km_error (kept for callers); nothing names the field. */
 km_status km_curve_self_intersections_until(const km_curve *c, double tol,
-                                            const km_stop *stop,
-                                            long *count);
+                                            const km_stop *stop, long *count);
 
 #endif

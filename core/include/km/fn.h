@@ -20,10 +20,10 @@
 #include "km/status.h"
 
 typedef struct km_fn {
-  int degree;     /* 0..KM_MAX_FN_DEGREE */
-  size_t n;       /* number of coefficients */
-  double *knots;  /* n + degree + 1 */
-  double *coef;   /* n */
+  int degree;    /* 0..KM_MAX_FN_DEGREE */
+  size_t n;      /* number of coefficients */
+  double *knots; /* n + degree + 1 */
+  double *coef;  /* n */
 } km_fn;
 
 /* Make *f empty (all zero); f may be NULL. Allocates nothing. */

@@ -19,7 +19,10 @@
 
 /* Curvature interpolation (the paper), or the baseline: control points of
  * the two inputs made compatible, blended linearly. */
-typedef enum km_morph_method { KM_METHOD_CURVATURE, KM_METHOD_LINEAR } km_morph_method;
+typedef enum km_morph_method {
+  KM_METHOD_CURVATURE,
+  KM_METHOD_LINEAR
+} km_morph_method;
 
 /* TURNING blends the turning functions at equal arc-length fraction r:
  * theta_t(r) = (1-t) theta_a(r) + t theta_b(r), corners included, so total
@@ -47,7 +50,11 @@ typedef enum km_closure {
  * linearly; START, the paper's interpolated start point and angle;
  * CENTROID, the frame's arc-length centroid put on the inputs'
  * interpolated centroids (angle as START). */
-typedef enum km_anchor { KM_ANCHOR_FIT, KM_ANCHOR_START, KM_ANCHOR_CENTROID } km_anchor;
+typedef enum km_anchor {
+  KM_ANCHOR_FIT,
+  KM_ANCHOR_START,
+  KM_ANCHOR_CENTROID
+} km_anchor;
 
 /* Closed inputs: AUTO reverses `to` when its turning number is the
  * opposite of `from`'s; KEEP never does (different turning numbers are
@@ -66,11 +73,11 @@ typedef struct km_morph_options {
                              fractions, strictly increasing inside (0, 1)
                              on both sides; borrowed for km_morph_create */
   size_t nmatches;
-  bool auto_matches;      /* without matches: align features (curvature
+  bool auto_matches;   /* without matches: align features (curvature
                              extrema, corners) automatically */
-  size_t max_points;      /* control points a frame may have; 0: the core's
+  size_t max_points;   /* control points a frame may have; 0: the core's
                              own bound (KM_MAX_OUTPUT_PIECES) */
-  const km_stop *stop;    /* km_morph_create ends early with KM_ECANCELLED
+  const km_stop *stop; /* km_morph_create ends early with KM_ECANCELLED
                              when this asks it to (km/stop.h); NULL, the
                              default: never. Borrowed for the call only:
                              the morph keeps no reference to it */
@@ -95,13 +102,13 @@ typedef struct km_morph_input {
  * itself, max |kappa| and the energy from quadrature samples. */
 typedef struct km_frame_metrics {
   double length;
-  double max_abs_kappa;     /* 1 / length unit */
-  double bending_energy;    /* integral of kappa^2 ds */
-  long self_intersections;  /* proper self-crossings of the returned curve
+  double max_abs_kappa;    /* 1 / length unit */
+  double bending_energy;   /* integral of kappa^2 ds */
+  long self_intersections; /* proper self-crossings of the returned curve
                                (km_curve_self_intersections at the morph's
                                tolerance); out of memory fails the frame
                                with KM_ENOMEM */
-  double closure_gap;       /* |C(L) - C(0)| before closure; 0 if open */
+  double closure_gap;      /* |C(L) - C(0)| before closure; 0 if open */
 } km_frame_metrics;
 
 typedef struct km_morph km_morph;
@@ -137,8 +144,8 @@ typedef struct km_morph km_morph;
  *                   frames all poll it; nothing is leaked);
  *   KM_ENOMEM. */
 km_status km_morph_create(km_morph **out, const km_morph_input *from,
-                          const km_morph_input *to,
-                          const km_morph_options *opt, km_error *err);
+                          const km_morph_input *to, const km_morph_options *opt,
+                          km_error *err);
 
 /* Free the morph and everything it holds; m may be NULL. */
 void km_morph_free(km_morph *m);
@@ -172,15 +179,17 @@ km_status km_morph_frame(const km_morph *m, double t, km_curve *out,
  * sig_out. The blend, closure, reconstruction, plan passes and the
  * crossing count of the metrics poll it. Distinct calls may pass distinct
  * stops on one shared morph. Other statuses as km_morph_frame. */
-km_status km_morph_frame_until(const km_morph *m, double t,
-                               const km_stop *stop, km_curve *out,
-                               km_frame_metrics *metrics,
+km_status km_morph_frame_until(const km_morph *m, double t, const km_stop *stop,
+                               km_curve *out, km_frame_metrics *metrics,
                                km_signature *sig_out, km_error *err);
 
 /* What a frame is asked for: its curve alone, or its metrics or signature
  * too (such frames are blended and reconstructed exactly, not taken from
  * the morph's plan, and may have other control points). */
-typedef enum km_frame_parts { KM_FRAME_CURVE, KM_FRAME_WITH_METRICS } km_frame_parts;
+typedef enum km_frame_parts {
+  KM_FRAME_CURVE,
+  KM_FRAME_WITH_METRICS
+} km_frame_parts;
 
 /* Control points the curve of the frame at t will have (km_morph_frame
  * with metrics or a signature asked for when parts is

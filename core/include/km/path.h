@@ -36,10 +36,10 @@ typedef struct km_path_piece {
 } km_path_piece;
 
 typedef struct km_path {
-  bool started;     /* a start point was set */
-  bool closed;      /* km_path_close was called */
-  double start[2];  /* start point of the path */
-  double cur[2];    /* current point */
+  bool started;    /* a start point was set */
+  bool closed;     /* km_path_close was called */
+  double start[2]; /* start point of the path */
+  double cur[2];   /* current point */
   size_t npieces, cap;
   km_path_piece *pieces;
 } km_path;
@@ -63,8 +63,8 @@ km_status km_path_move_to(km_path *p, double x, double y, km_error *err);
  * argument at fault, 0-based: x1 is 0, y1 is 1, ...); KM_ELIMIT beyond
  * KM_MAX_PIECES pieces; KM_ENOMEM. */
 km_status km_path_line_to(km_path *p, double x, double y, km_error *err);
-km_status km_path_quad_to(km_path *p, double x1, double y1, double x,
-                          double y, km_error *err);
+km_status km_path_quad_to(km_path *p, double x1, double y1, double x, double y,
+                          km_error *err);
 km_status km_path_cubic_to(km_path *p, double x1, double y1, double x2,
                            double y2, double x, double y, km_error *err);
 

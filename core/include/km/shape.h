@@ -68,12 +68,12 @@ typedef struct km_shape {
   long *parent;       /* innermost containing contour, -1 for none */
   int *depth;         /* 0 for top-level contours */
   km_contour_role *role;
-  bool *reversed;     /* the input contour was turned round */
-  double *area;       /* |signed area| of each contour */
-  double *centroid;   /* 2 per contour: the centroid of its area */
-  double box[4];      /* xmin, ymin, xmax, ymax of all flattenings */
-  double *flat;       /* the flattenings, 2 doubles a point, closed */
-  size_t *flat_off;   /* ncontours + 1 point offsets into flat */
+  bool *reversed;   /* the input contour was turned round */
+  double *area;     /* |signed area| of each contour */
+  double *centroid; /* 2 per contour: the centroid of its area */
+  double box[4];    /* xmin, ymin, xmax, ymax of all flattenings */
+  double *flat;     /* the flattenings, 2 doubles a point, closed */
+  size_t *flat_off; /* ncontours + 1 point offsets into flat */
   km_fill_rule fill;
 } km_shape;
 
@@ -181,7 +181,7 @@ km_status km_shape_pair_check(const km_shape *a, const km_shape *b,
 /* ---- the compound morph ------------------------------------------------- */
 
 typedef struct km_shape_morph_options {
-  km_morph_options morph;    /* for every pair (its stop is not used) */
+  km_morph_options morph;     /* for every pair (its stop is not used) */
   const km_shape_pair *pairs; /* the caller's pairing, npairs pairs,
                                  borrowed for the call; NULL: automatic */
   size_t npairs;
@@ -205,14 +205,14 @@ typedef struct km_shape_frame {
   km_frame_metrics *metrics; /* per contour (km_morph_frame's metrics of
                                 its pair's frame, length scaled) */
   bool *present;
-  long *parent;          /* the slot of the contour it must lie in (its
+  long *parent;              /* the slot of the contour it must lie in (its
                             parent at the nearer end: from for t < 0.5),
                             -1 for none */
   long mutual_intersections; /* proper crossings between different
                                 contours, on their flattenings */
-  bool nesting_ok;       /* every present contour with a parent lies
+  bool nesting_ok;           /* every present contour with a parent lies
                             inside it (all its flattening points) */
-  size_t adjusted;       /* contours moved to keep them in their parent */
+  size_t adjusted;           /* contours moved to keep them in their parent */
 } km_shape_frame;
 
 void km_shape_frame_init(km_shape_frame *f);
@@ -263,7 +263,7 @@ size_t km_shape_morph_pairs(const km_shape_morph *m, km_shape_pair *pairs,
  *   KM_ECANCELLED, KM_ENOMEM.
  * Thread-safe on a shared morph. */
 km_status km_shape_morph_frame_until(const km_shape_morph *m, double t,
-                                     const km_stop *stop,
-                                     km_shape_frame *out, km_error *err);
+                                     const km_stop *stop, km_shape_frame *out,
+                                     km_error *err);
 
 #endif

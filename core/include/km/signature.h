@@ -29,11 +29,11 @@ typedef struct km_corner {
 typedef struct km_signature {
   double length;
   double start[2];
-  double angle;     /* tangent angle at s = 0 */
-  km_fn kappa;      /* smooth curvature on [0, length] */
+  double angle; /* tangent angle at s = 0 */
+  km_fn kappa;  /* smooth curvature on [0, length] */
   size_t ncorners;
   km_corner *corners; /* sorted by s; owned */
-  double turning;   /* integral of kappa + sum of turns */
+  double turning;     /* integral of kappa + sum of turns */
   bool closed;
 } km_signature;
 
@@ -107,8 +107,8 @@ km_status km_signature_create(km_signature *out, double length,
  *   KM_ENOMEM.
  * Order: out follows the curve, against the rule of km/kmorph.h for
  * functions making their own type (kept for callers). */
-km_status km_signature_compute(const km_curve *c, double tol,
-                               km_signature *out, km_error *err);
+km_status km_signature_compute(const km_curve *c, double tol, km_signature *out,
+                               km_error *err);
 
 /* km_signature_compute that ends early when stop (km/stop.h; NULL: never)
  * asks it to: then KM_ECANCELLED, *out untouched, nothing leaked. It is
@@ -133,8 +133,8 @@ double km_signature_theta(const km_signature *sig, double s);
  * are included. Used by tests, metrics and closure. Returns KM_OK or
  * KM_ENOMEM (nothing written).
  * Order: takes no km_error (kept for callers). */
-km_status km_signature_point(const km_signature *sig, double s,
-                             double pos[2], double *theta);
+km_status km_signature_point(const km_signature *sig, double s, double pos[2],
+                             double *theta);
 
 /* Largest |kappa| over [0, length] (km_fn_max_abs: to 1e-13 relative). */
 double km_signature_max_abs_kappa(const km_signature *sig);

@@ -15,24 +15,24 @@
 #include <stddef.h>
 
 /* X(name, value, default message) */
-#define KM_STATUS_MAP(X)                                                      \
-  X(OK, 0, "success")                                                         \
-  X(EINVAL, -1, "invalid argument")                                           \
-  X(ENOMEM, -2, "out of memory")                                              \
-  X(EDEGREE, -3, "degree out of range")                                       \
-  X(EKNOTS, -4, "invalid knot vector")                                        \
-  X(ECOUNT, -5, "wrong number of elements")                                   \
-  X(ENONFINITE, -6, "value is not finite")                                    \
-  X(ERANGE, -7, "value out of range")                                         \
-  X(EWEIGHT, -8, "weights must be positive")                                  \
-  X(ECLOSED, -9, "closed curve does not close")                               \
-  X(EDEGENERATE, -10, "curve has zero length")                                \
-  X(ECUSP, -11, "curve is not regular: the tangent reverses (cusp)")          \
-  X(ENOCONVERGE, -12, "numerical method did not converge")                    \
-  X(ETURNING, -13, "closed curves have different turning numbers")           \
-  X(EMIXED, -14, "cannot morph an open curve into a closed one")              \
-  X(ELIMIT, -15, "result would exceed a limit")                               \
-  X(ECANCELLED, -16, "cancelled")                                             \
+#define KM_STATUS_MAP(X)                                                       \
+  X(OK, 0, "success")                                                          \
+  X(EINVAL, -1, "invalid argument")                                            \
+  X(ENOMEM, -2, "out of memory")                                               \
+  X(EDEGREE, -3, "degree out of range")                                        \
+  X(EKNOTS, -4, "invalid knot vector")                                         \
+  X(ECOUNT, -5, "wrong number of elements")                                    \
+  X(ENONFINITE, -6, "value is not finite")                                     \
+  X(ERANGE, -7, "value out of range")                                          \
+  X(EWEIGHT, -8, "weights must be positive")                                   \
+  X(ECLOSED, -9, "closed curve does not close")                                \
+  X(EDEGENERATE, -10, "curve has zero length")                                 \
+  X(ECUSP, -11, "curve is not regular: the tangent reverses (cusp)")           \
+  X(ENOCONVERGE, -12, "numerical method did not converge")                     \
+  X(ETURNING, -13, "closed curves have different turning numbers")             \
+  X(EMIXED, -14, "cannot morph an open curve into a closed one")               \
+  X(ELIMIT, -15, "result would exceed a limit")                                \
+  X(ECANCELLED, -16, "cancelled")                                              \
   X(EMATCH, -17, "invalid correspondence")
 
 typedef enum km_status {
@@ -67,9 +67,9 @@ typedef enum km_field {
 
 typedef struct km_error {
   km_status code;
-  km_field field;  /* input field at fault, KM_FIELD_NONE if none */
-  long index;      /* element index within that field, -1 if none */
-  double param;    /* curve parameter (or arc length) where it happened, NAN
+  km_field field; /* input field at fault, KM_FIELD_NONE if none */
+  long index;     /* element index within that field, -1 if none */
+  double param;   /* curve parameter (or arc length) where it happened, NAN
                       if none */
   char message[KM_ERROR_MESSAGE_MAX];
 } km_error;

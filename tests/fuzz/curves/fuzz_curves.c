@@ -70,13 +70,17 @@ typedef struct reader {
   size_t n, i;
 } reader;
 
-static unsigned u8(reader *r) { return r->i < r->n ? r->p[r->i++] : 0u; }
+static unsigned u8(reader *r) {
+  return r->i < r->n ? r->p[r->i++] : 0u;
+}
 static unsigned u16(reader *r) {
   unsigned lo = u8(r);
   return lo | (u8(r) << 8);
 }
 /* A number in [-1, 1] from two bytes. */
-static double sym(reader *r) { return u16(r) / 32767.5 - 1.0; }
+static double sym(reader *r) {
+  return u16(r) / 32767.5 - 1.0;
+}
 
 static void fail(const char *why, double a, double b) {
   fprintf(stderr, "fuzz_curves: %s (%.17g vs %.17g)\n", why, a, b);
@@ -97,8 +101,7 @@ static size_t make_points(reader *r, unsigned family, int degree,
     break;
   case 1: { /* regular polygon with a small jitter: smooth, convex */
     n = (size_t)degree + 1 + count % 200;
-    if (n < 4)
-      n = 4;
+    if (n < 4) n = 4;
     double jit = pow(10.0, -(double)(u8(r) % 16));
     for (size_t i = 0; i < n; i++) {
       double a = 2 * PI * (double)i / (double)(n - 1);
@@ -110,8 +113,7 @@ static size_t make_points(reader *r, unsigned family, int degree,
   }
   case 2: { /* a hairpin: the polygon nearly reverses, by 10^-k */
     n = (size_t)degree + 1 + count % 16;
-    if (n < 4)
-      n = 4;
+    if (n < 4) n = 4;
     double eps = pow(10.0, -(double)(u8(r) % 16));
     double del = pow(10.0, -(double)(u8(r) % 16));
     size_t k = 1 + u8(r) % (n - 2);
@@ -179,32 +181,27 @@ static void make_knots(reader *r, int degree, size_t n, bool uniform,
   size_t m = n + (size_t)degree + 1;
   double t = 0;
   int mult = 0;
-  for (int i = 0; i <= degree; i++)
-    knots[i] = 0;
+  for (int i = 0; i <= degree; i++) knots[i] = 0;
   for (size_t i = (size_t)degree + 1; i < n; i++) {
     double inc = 1;
     if (!uniform) {
       unsigned b = u8(r) % 8;
       inc = b == 0 ? 0 : b == 1 ? 2 : b == 2 ? 1e-9 : 1;
     }
-    if (inc == 0 && mult + 1 >= degree)
-      inc = 1;
+    if (inc == 0 && mult + 1 >= degree) inc = 1;
     mult = inc == 0 ? mult + 1 : 0;
     t += inc;
     knots[i] = t;
   }
   t += 1;
-  for (size_t i = n; i < m; i++)
-    knots[i] = t;
+  for (size_t i = n; i < m; i++) knots[i] = t;
 }
 
 static double max_abs(const double *v, size_t n) {
   double m = 0;
   for (size_t i = 0; i < n; i++) {
-    if (!isfinite(v[i]))
-      fail("non-finite value in a result", v[i], (double)i);
-    if (fabs(v[i]) > m)
-      m = fabs(v[i]);
+    if (!isfinite(v[i])) fail("non-finite value in a result", v[i], (double)i);
+    if (fabs(v[i]) > m) m = fabs(v[i]);
   }
   return m;
 }
@@ -220,8 +217,7 @@ static void check_signature(const km_curve *c, const km_signature *sig) {
    * per span beyond the 1e-6 asked of them. */
   double M = 0, r = 1;
   size_t spans = 0;
-  for (size_t i = 0; i < 2 * c->n; i++)
-    M = fmax(M, fabs(c->cp[i]));
+  for (size_t i = 0; i < 2 * c->n; i++) M = fmax(M, fabs(c->cp[i]));
   if (c->w != NULL) {
     double lo = c->w[0], hi = c->w[0];
     for (size_t i = 1; i < c->n; i++) {
@@ -266,8 +262,7 @@ static void check_reconstruction(const km_curve *c, const km_signature *sig,
   double slack = 64 * DBL_EPSILON * scale;
   km_curve_domain(rc, &r0, &r1);
   km_curve_eval(rc, r0, 0, pr);
-  if (hypot(pr[0][0] - sig->start[0], pr[0][1] - sig->start[1]) >
-      bound + slack)
+  if (hypot(pr[0][0] - sig->start[0], pr[0][1] - sig->start[1]) > bound + slack)
     fail("reconstruction does not start at the start point", pr[0][0],
          sig->start[0]);
   km_curve_domain(c, &t0, &t1);
@@ -275,8 +270,8 @@ static void check_reconstruction(const km_curve *c, const km_signature *sig,
   km_curve_eval(rc, r1, 0, pr);
   double gap = hypot(pc[0][0] - pr[0][0], pc[0][1] - pr[0][1]);
   if (gap > 2 * sig_tol + bound + slack)
-    fail("reconstructed end misses the curve's end beyond the tolerances",
-         gap, 2 * sig_tol + bound);
+    fail("reconstructed end misses the curve's end beyond the tolerances", gap,
+         2 * sig_tol + bound);
 }
 
 static void run_morph(reader *r, const km_curve *c, const km_signature *sig,
@@ -286,13 +281,11 @@ static void run_morph(reader *r, const km_curve *c, const km_signature *sig,
   km_curve_init(&to);
   km_morph *m = NULL;
   double rot = PI * sym(r), dx = sym(r), dy = sym(r);
-  if (km_curve_transform(&moved, c, rot, dx, dy, NULL) != KM_OK)
-    goto done;
+  if (km_curve_transform(&moved, c, rot, dx, dy, NULL) != KM_OK) goto done;
   /* The reversed copy has the opposite turning of a closed curve: the
    * morph must refuse it or re-orient it, never break. */
   if (flags & 0x80) {
-    if (km_curve_reverse(&to, &moved, NULL) != KM_OK)
-      goto done;
+    if (km_curve_reverse(&to, &moved, NULL) != KM_OK) goto done;
   } else {
     to = moved;
     km_curve_init(&moved);
@@ -310,8 +303,7 @@ static void run_morph(reader *r, const km_curve *c, const km_signature *sig,
   o.auto_matches = (u8(r) & 1) != 0;
   km_morph_input from = {c, sig}, dest = {&to, NULL};
   km_error err;
-  if (km_morph_create(&m, &from, &dest, &o, &err) != KM_OK)
-    goto done;
+  if (km_morph_create(&m, &from, &dest, &o, &err) != KM_OK) goto done;
   double t = u8(r) / 255.0;
   km_curve f;
   km_curve_init(&f);
@@ -353,14 +345,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   km_curve_init(&c);
   km_signature_init(&sig);
   km_curve_init(&rc);
-  if (pts == NULL || knots == NULL || w == NULL)
-    goto done;
+  if (pts == NULL || knots == NULL || w == NULL) goto done;
 
   size_t n = make_points(r, family, degree, count,
                          many_knots_points(degree, (flags & 2) != 0), pts);
   bool closed = (flags & 1) && n > (size_t)degree + 1;
-  for (size_t i = 0; i < 2 * n; i++)
-    pts[i] = pts[i] * scale + offset;
+  for (size_t i = 0; i < 2 * n; i++) pts[i] = pts[i] * scale + offset;
   if (closed) {
     pts[2 * (n - 1)] = pts[0];
     pts[2 * (n - 1) + 1] = pts[1];
@@ -376,12 +366,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 
   bool verbose = getenv("FUZZ_CURVES_VERBOSE") != NULL;
   if (verbose) {
-    fprintf(stderr, "family %u degree %d n %zu closed %d rational %d "
-            "scale %g offset %g flags 0x%02x\n", family % 6, degree, n,
-            (int)closed, (int)rational, scale, offset, flags);
+    fprintf(stderr,
+            "family %u degree %d n %zu closed %d rational %d "
+            "scale %g offset %g flags 0x%02x\n",
+            family % 6, degree, n, (int)closed, (int)rational, scale, offset,
+            flags);
     /* the same curve as a POST /v1/signature body, to reproduce it */
-    fprintf(stderr, "{\"curve\":{\"type\":\"bspline\",\"degree\":%d,"
-            "\"closed\":%s,\"knots\":[", degree, closed ? "true" : "false");
+    fprintf(stderr,
+            "{\"curve\":{\"type\":\"bspline\",\"degree\":%d,"
+            "\"closed\":%s,\"knots\":[",
+            degree, closed ? "true" : "false");
     for (size_t i = 0; i < n + (size_t)degree + 1; i++)
       fprintf(stderr, "%s%.17g", i ? "," : "", knots[i]);
     fprintf(stderr, "],\"control_points\":[");
@@ -404,12 +398,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   clock_t c0 = clock();
   km_status sst = km_signature_compute(&c, tol, &sig, &err);
   if (verbose)
-    fprintf(stderr, "tol %g signature %s in %.3f s, length %.17g, %zu "
-            "kappa knots\n", tol, km_status_name(sst),
-            (double)(clock() - c0) / CLOCKS_PER_SEC, sig.length,
-            sst == KM_OK ? sig.kappa.n : (size_t)0);
-  if (sst != KM_OK)
-    goto done;
+    fprintf(stderr,
+            "tol %g signature %s in %.3f s, length %.17g, %zu "
+            "kappa knots\n",
+            tol, km_status_name(sst), (double)(clock() - c0) / CLOCKS_PER_SEC,
+            sig.length, sst == KM_OK ? sig.kappa.n : (size_t)0);
+  if (sst != KM_OK) goto done;
   check_signature(&c, &sig);
 
   /* The tolerance the signature promises: the asked one raised to its

@@ -27,8 +27,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     return 0;
   }
   if (c.n < 2 || c.degree < 1 || c.degree > 3 || !c.cp || !c.knots) abort();
-  double scale = 0, lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY,
-                                                            -INFINITY};
+  double scale = 0, lo[2] = {INFINITY, INFINITY},
+         hi[2] = {-INFINITY, -INFINITY};
   for (size_t i = 0; i < 2 * c.n; i++) {
     if (!isfinite(c.cp[i])) abort();
     if (fabs(c.cp[i]) > scale) scale = fabs(c.cp[i]);
@@ -46,8 +46,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   if (scale < 1e12 && bound <= tol) {
     km_curve back;
     km_curve_init(&back);
-    km_status st2 = api_svg_parse_path(d, strlen(d), 1e-9, &back, &off, msg,
-                                       sizeof msg);
+    km_status st2 =
+        api_svg_parse_path(d, strlen(d), 1e-9, &back, &off, msg, sizeof msg);
     /* Only a curve so small that printing within tol collapses it to a
      * point may come back as nothing. */
     if (st2 != KM_OK && !(st2 == KM_EDEGENERATE && extent <= tol)) abort();
