@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# checks.sh - the tree's own checks beside the test suites: every C file
+# laid out as .clang-format says (clang-format 14, Debian 12's), and the
+# compound-shape fixtures consistent with what they claim to be. Appends
+# "checks/<name> <passed> <failed>" to the results file summarise.sh
+# totals.
+set -u
+cd "$(dirname "$0")/.."
+results=${KM_RESULTS:-build/test-results.txt}
+mkdir -p "$(dirname "$results")"
+PY=/usr/bin/python3
+[ -x "$PY" ] || PY=python3
+status=0
+
+# 1. Layout: the generated contract (api/src/openapi.c) is not checked.
+files=$(git ls-files '*.c' '*.h' 2>/dev/null | grep -v '^api/src/openapi\.c$')
+if [ -z "$files" ]; then
+  files=$(find core api server cli tests bench -name '*.[ch]' | grep -v '^api/src/openapi\.c$')
+fi
+if out=$(clang-format --dry-run --Werror $files 2>&1); then
+  echo "ok   format: $(echo "$files" | wc -w) C files as .clang-format lays them out"
+  echo "checks/format 1 0" >>"$results"
+else
+  printf '%s\n' "$out" | head -n 20
+  echo "FAIL format: run 'make format' (clang-format -i) and commit"
+  echo "checks/format 0 1" >>"$results"
+  status=1
+fi
+
+# 2. The compound-shape fixtures (tests/fixtures/compound).
+out=$(cd tests/fixtures/compound && "$PY" -m unittest test_fixtures 2>&1)
+rc=$?
+ran=$(printf '%s\n' "$out" | sed -n 's/^Ran \([0-9]*\) test.*/\1/p' | tail -n 1)
+bad=$(printf '%s\n' "$out" | grep -cE '^(FAIL|ERROR): ')
+ran=${ran:-0}
+[ "$rc" -ne 0 ] && [ "$bad" -eq 0 ] && bad=1
+printf '%s\n' "$out" | grep -E '^(FAIL|ERROR):|^Ran|^OK|^FAILED'
+echo "checks/compound-fixtures $((ran - bad)) $bad" >>"$results"
+[ "$bad" -eq 0 ] || status=1
+exit $status
