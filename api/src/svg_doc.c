@@ -111,6 +111,21 @@ void api__svg_px(api_svg_doc *c, double v) {
   api__svg_buf_num(&c->b, v, API_SVG_PX_BUDGET, NULL);
 }
 
+void api__svg_path_open(api_svg_doc *c, double ox, double oy, double s,
+                        const api_svg_bbox *bb) {
+  api__svg_buf_put(&c->b, "<path transform=\"translate(");
+  api__svg_px(c, ox);
+  api__svg_buf_put(&c->b, " ");
+  api__svg_px(c, oy);
+  api__svg_buf_put(&c->b, ") scale(");
+  api__svg_buf_num(&c->b, s, 1e-9 * s, NULL);
+  api__svg_buf_put(&c->b, ") translate(");
+  api__svg_buf_num(&c->b, -bb->x0, 1e-4 / s, NULL);
+  api__svg_buf_put(&c->b, " ");
+  api__svg_buf_num(&c->b, -bb->y0, 1e-4 / s, NULL);
+  api__svg_buf_put(&c->b, ")\"");
+}
+
 void api__svg_frame_colour(const api_svg_doc *c, size_t i, char out[8]) {
   double f = c->n > 1 ? (double)i / (double)(c->n - 1) : 0.0;
   ramp(&c->from, &c->to, f, out);
@@ -148,17 +163,8 @@ void api__svg_draw_curve(api_svg_doc *c, const km_curve *cv, double ox,
     c->b.failed = true;
     return;
   }
-  api__svg_buf_put(&c->b, "<path transform=\"translate(");
-  api__svg_px(c, ox);
-  api__svg_buf_put(&c->b, " ");
-  api__svg_px(c, oy);
-  api__svg_buf_put(&c->b, ") scale(");
-  api__svg_buf_num(&c->b, s, 1e-9 * s, NULL);
-  api__svg_buf_put(&c->b, ") translate(");
-  api__svg_buf_num(&c->b, -bb->x0, 1e-4 / s, NULL);
-  api__svg_buf_put(&c->b, " ");
-  api__svg_buf_num(&c->b, -bb->y0, 1e-4 / s, NULL);
-  api__svg_buf_put(&c->b, ")\" fill=\"none\" stroke=\"");
+  api__svg_path_open(c, ox, oy, s, bb);
+  api__svg_buf_put(&c->b, " fill=\"none\" stroke=\"");
   api__svg_buf_escaped(&c->b, colour);
   api__svg_buf_put(&c->b, "\" stroke-width=\"");
   api__svg_buf_num(&c->b, c->sw / s, 1e-3 * c->sw / s, NULL);

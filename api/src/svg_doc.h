@@ -42,6 +42,11 @@ typedef struct api_svg_doc {
 
 /* A document coordinate, printed within API_SVG_PX_BUDGET. */
 void api__svg_px(api_svg_doc *c, double v);
+/* Open a <path> element whose transform maps the frames' box bb, scaled by
+ * s, to the offset (ox, oy) in pixels; the caller writes its attributes
+ * (from a space) and closes it. */
+void api__svg_path_open(api_svg_doc *c, double ox, double oy, double s,
+                        const api_svg_bbox *bb);
 /* Frame i's colour on the ramp from the first frame's to the last's. */
 void api__svg_frame_colour(const api_svg_doc *c, size_t i, char out[8]);
 /* "t = 0.5", escaped. */

@@ -152,17 +152,8 @@ static char **animate_paths(api_svg_doc *c, size_t np, size_t *drawn) {
  * transform until its <animate> starts, which this opens for its dur. */
 static void animate_open(api_svg_doc *c, const api_svg_bbox *bb, double ox,
                          double oy, double s, const char *first, double dur) {
-  api__svg_buf_put(&c->b, "<path transform=\"translate(");
-  api__svg_px(c, ox);
-  api__svg_buf_put(&c->b, " ");
-  api__svg_px(c, oy);
-  api__svg_buf_put(&c->b, ") scale(");
-  api__svg_buf_num(&c->b, s, 1e-9 * s, NULL);
-  api__svg_buf_put(&c->b, ") translate(");
-  api__svg_buf_num(&c->b, -bb->x0, 1e-4 / s, NULL);
-  api__svg_buf_put(&c->b, " ");
-  api__svg_buf_num(&c->b, -bb->y0, 1e-4 / s, NULL);
-  api__svg_buf_put(&c->b, ")\" fill=\"none\" stroke=\"");
+  api__svg_path_open(c, ox, oy, s, bb);
+  api__svg_buf_put(&c->b, " fill=\"none\" stroke=\"");
   api__svg_buf_escaped(&c->b, c->stroke);
   api__svg_buf_put(&c->b, "\" stroke-width=\"");
   api__svg_buf_num(&c->b, c->sw / s, 1e-3 * c->sw / s, NULL);

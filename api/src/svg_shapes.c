@@ -49,17 +49,8 @@ static api_svg_bbox shapes_bbox(const api_svg_shape_frame *f, size_t n) {
 static void draw_shape(api_svg_doc *c, const km_shape_frame *sf, double ox,
                        double oy, double s, const api_svg_bbox *bb,
                        const char *rule) {
-  api__svg_buf_put(&c->b, "<path transform=\"translate(");
-  api__svg_px(c, ox);
-  api__svg_buf_put(&c->b, " ");
-  api__svg_px(c, oy);
-  api__svg_buf_put(&c->b, ") scale(");
-  api__svg_buf_num(&c->b, s, 1e-9 * s, NULL);
-  api__svg_buf_put(&c->b, ") translate(");
-  api__svg_buf_num(&c->b, -bb->x0, 1e-4 / s, NULL);
-  api__svg_buf_put(&c->b, " ");
-  api__svg_buf_num(&c->b, -bb->y0, 1e-4 / s, NULL);
-  api__svg_buf_put(&c->b, ")\" fill=\"");
+  api__svg_path_open(c, ox, oy, s, bb);
+  api__svg_buf_put(&c->b, " fill=\"");
   api__svg_buf_escaped(&c->b, c->stroke);
   api__svg_buf_put(&c->b, "\" fill-opacity=\"0.35\" fill-rule=\"");
   api__svg_buf_put(&c->b, rule);
