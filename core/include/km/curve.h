@@ -114,9 +114,7 @@ km_status km_curve_insert_knot(km_curve *out, const km_curve *c, double t,
  * bit-identical point; each is owned by the caller. Returns KM_OK,
  * KM_EINVAL (c not a curve), KM_ERANGE / KM_ENONFINITE (t not inside the
  * domain; err->param = t), KM_ENOMEM; on failure neither output is
- * written.
- * Order: the two results follow the inputs, against the rule of
- * km/kmorph.h for functions making their own type (kept for callers). */
+ * written. */
 km_status km_curve_split(const km_curve *c, double t, km_curve *left,
                          km_curve *right, km_error *err);
 
@@ -145,9 +143,7 @@ km_status km_curve_elevate(km_curve *out, const km_curve *c, int times,
  * The traces and closed flags are unchanged; *out_a and *out_b are owned
  * by the caller, and on failure neither is written. Returns KM_OK,
  * KM_EINVAL (a or b not a curve), KM_EKNOTS (the merged knot vectors do
- * not agree: rounding, not met in practice), KM_ENOMEM.
- * Order: the two results follow the inputs, against the rule of
- * km/kmorph.h for functions making their own type (kept for callers). */
+ * not agree: rounding, not met in practice), KM_ENOMEM. */
 km_status km_curve_make_compatible(const km_curve *a, const km_curve *b,
                                    km_curve *out_a, km_curve *out_b,
                                    km_error *err);
@@ -230,7 +226,8 @@ long km_curve_self_intersections(const km_curve *c, double tol);
 /* km_curve_self_intersections that ends early when stop (km/stop.h; NULL:
  * never) asks it to. *count (out) receives the count on KM_OK only.
  * Returns KM_OK, KM_ECANCELLED, KM_EINVAL (c not a curve), KM_ENOMEM.
- * Order: takes no km_error (kept for callers); nothing names the field. */
+ * It takes no km_error: nothing but memory can fail and no field is at
+ * fault. */
 km_status km_curve_self_intersections_until(const km_curve *c, double tol,
                                             const km_stop *stop, long *count);
 

@@ -8,19 +8,17 @@
  * function's own comment says otherwise.
  *
  * PARAMETER ORDER. Inputs first, the object a function is named after
- * leading (km_morph_frame(m, t, ...)), then the out-parameters, then the
- * optional `km_error *err` last. One exception by design: a function that
- * makes a new object of its own type takes that object first, as memcpy
- * takes its destination: km_curve_create(out, ...), km_curve_copy(out, c,
- * err), km_fn_blend(out, ...), km_signature_create(out, ...),
- * km_morph_create(&out, ...). km_path_to_curve and km_reconstruct make a
- * curve from something else, so the curve follows their inputs.
- * Functions that break the rule say so in a line starting "Order:" and
- * keep their signatures (changing them would break every caller):
- * km_curve_split, km_curve_make_compatible (own-type results after the
- * inputs), km_signature_compute and km_signature_compute_until (the new
- * signature after the curve), km_signature_point and
- * km_curve_self_intersections_until (no km_error).
+ * leading (km_morph_frame(m, t, ...), km_curve_split(c, t, &left,
+ * &right, ...), km_signature_compute(c, tol, &sig, ...)), then the
+ * out-parameters, then the optional `km_error *err` last. One exception
+ * by design: a constructor - a function that builds an object of its
+ * own type from its parts or from another of its kind - takes that object
+ * first, as memcpy takes its destination: km_curve_create(out, ...),
+ * km_curve_copy(out, c, err), km_fn_blend(out, ...),
+ * km_signature_create(out, ...), km_morph_create(&out, ...). Two
+ * functions take no km_error, since nothing but memory can fail in them
+ * and no field is at fault: km_signature_point and
+ * km_curve_self_intersections_until (their comments say so).
  *
  * STATUS AND ERRORS (km/status.h). A fallible function returns KM_OK (0)
  * or a negative km_status. `err` may be NULL; when it is not and the call

@@ -104,9 +104,7 @@ km_status km_signature_create(km_signature *out, double length,
  *                   KM_FIELD_CONTROL_POINTS);
  *   KM_ELIMIT       the work budget spent (KM_FIELD_TOLERANCE: a looser
  *                   tolerance helps), or more than KM_MAX_PIECES pieces;
- *   KM_ENOMEM.
- * Order: out follows the curve, against the rule of km/kmorph.h for
- * functions making their own type (kept for callers). */
+ *   KM_ENOMEM. */
 km_status km_signature_compute(const km_curve *c, double tol, km_signature *out,
                                km_error *err);
 
@@ -132,7 +130,7 @@ double km_signature_theta(const km_signature *sig, double s);
  * there (the left-hand limit, unlike km_signature_theta); corners at s = 0
  * are included. Used by tests, metrics and closure. Returns KM_OK or
  * KM_ENOMEM (nothing written).
- * Order: takes no km_error (kept for callers). */
+ * It takes no km_error: only memory can fail. */
 km_status km_signature_point(const km_signature *sig, double s, double pos[2],
                              double *theta);
 
