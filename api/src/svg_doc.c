@@ -126,6 +126,20 @@ void api__svg_path_open(api_svg_doc *c, double ox, double oy, double s,
   api__svg_buf_put(&c->b, ")\"");
 }
 
+void api__svg_cell_frame(api_svg_doc *c, double x, double y, double cw,
+                         double ch) {
+  api__svg_buf_put(&c->b, "<rect x=\"");
+  api__svg_px(c, x + 0.5);
+  api__svg_buf_put(&c->b, "\" y=\"");
+  api__svg_px(c, y + 0.5);
+  api__svg_buf_put(&c->b, "\" width=\"");
+  api__svg_px(c, fmax(cw - 1, 0));
+  api__svg_buf_put(&c->b, "\" height=\"");
+  api__svg_px(c, fmax(ch - 1, 0));
+  api__svg_buf_put(&c->b, "\" fill=\"none\" stroke=\"#d0d0d0\" "
+                          "stroke-width=\"1\"/>\n");
+}
+
 void api__svg_frame_colour(const api_svg_doc *c, size_t i, char out[8]) {
   double f = c->n > 1 ? (double)i / (double)(c->n - 1) : 0.0;
   ramp(&c->from, &c->to, f, out);

@@ -45,6 +45,9 @@ void api__svg_px(api_svg_doc *c, double v);
 /* Open a <path> element whose transform maps the frames' box bb, scaled by
  * s, to the offset (ox, oy) in pixels; the caller writes its attributes
  * (from a space) and closes it. */
+/* The light frame of a filmstrip cell of cw x ch pixels at (x, y). */
+void api__svg_cell_frame(api_svg_doc *c, double x, double y, double cw,
+                         double ch);
 void api__svg_path_open(api_svg_doc *c, double ox, double oy, double s,
                         const api_svg_bbox *bb);
 /* Frame i's colour on the ramp from the first frame's to the last's. */

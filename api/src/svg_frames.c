@@ -36,16 +36,7 @@ void api__svg_filmstrip(api_svg_doc *c, const api_svg_options *o) {
   for (size_t i = 0; i < c->n; i++) {
     size_t r = i / cols, k = i % cols;
     double x = cw * (double)k, y = ch * (double)r;
-    api__svg_buf_put(&c->b, "<rect x=\"");
-    api__svg_px(c, x + 0.5);
-    api__svg_buf_put(&c->b, "\" y=\"");
-    api__svg_px(c, y + 0.5);
-    api__svg_buf_put(&c->b, "\" width=\"");
-    api__svg_px(c, fmax(cw - 1, 0));
-    api__svg_buf_put(&c->b, "\" height=\"");
-    api__svg_px(c, fmax(ch - 1, 0));
-    api__svg_buf_put(&c->b, "\" fill=\"none\" stroke=\"#d0d0d0\" "
-                            "stroke-width=\"1\"/>\n");
+    api__svg_cell_frame(c, x, y, cw, ch);
     double ox = x + 4, oy = y + 4;
     double dw = fmax(cw - 8, 1), dh = fmax(ch - label - 8, 1);
     double s = api__svg_fit(&bb, dw, dh, &ox, &oy);

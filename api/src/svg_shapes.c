@@ -79,16 +79,7 @@ static void cell(api_svg_doc *c, const api_svg_shape_frame *f, size_t i,
   const char *rule = f[i].fill == KM_FILL_EVENODD ? "evenodd" : "nonzero";
   const double label = 20.0;
   double x = cw * (double)(i % cols), y = ch * (double)(i / cols);
-  api__svg_buf_put(&c->b, "<rect x=\"");
-  api__svg_px(c, x + 0.5);
-  api__svg_buf_put(&c->b, "\" y=\"");
-  api__svg_px(c, y + 0.5);
-  api__svg_buf_put(&c->b, "\" width=\"");
-  api__svg_px(c, fmax(cw - 1, 0));
-  api__svg_buf_put(&c->b, "\" height=\"");
-  api__svg_px(c, fmax(ch - 1, 0));
-  api__svg_buf_put(&c->b, "\" fill=\"none\" stroke=\"#d0d0d0\" "
-                          "stroke-width=\"1\"/>\n");
+  api__svg_cell_frame(c, x, y, cw, ch);
   double ox = x + 4, oy = y + 4;
   double s =
       api__svg_fit(bb, fmax(cw - 8, 1), fmax(ch - label - 8, 1), &ox, &oy);
