@@ -373,18 +373,14 @@ done:
 
 /* ------------------------------------------------------------- printing */
 
-/* The paths of the frame's present contours joined into one "d": each
- * slot's own (pieces NULL) or with pieces[k] pieces and its Z. */
-static cJSON *joined_d(api_ctx *ctx, const km_shape_frame *sf, double tol,
-                       const size_t *pieces) {
+/* The paths of the frame's present contours joined into one "d". */
+static cJSON *joined_d(api_ctx *ctx, const km_shape_frame *sf, double tol) {
   api_svg_buf b;
   cJSON *s = NULL;
   api__svg_buf_init(&b);
   for (size_t k = 0; k < sf->ncontours; k++) {
     if (!sf->present[k]) continue;
-    char *d = pieces != NULL
-                  ? api_svg_path_d_fixed_z(&sf->contours[k], pieces[k], true)
-                  : api_svg_path_d(&sf->contours[k], tol, NULL);
+    char *d = api_svg_path_d(&sf->contours[k], tol, NULL);
     if (d == NULL) {
       b.failed = true;
       break;
@@ -456,7 +452,7 @@ cJSON *api__shape_frame_json(api_ctx *ctx, const api_morph_plan *pl,
       goto fail;
     }
   }
-  if (pl->inc.svg_d && ((c = joined_d(ctx, sf, pl->tol, NULL)) == NULL ||
+  if (pl->inc.svg_d && ((c = joined_d(ctx, sf, pl->tol)) == NULL ||
                         !api__add_item(ctx, fo, "svg_d", c)))
     goto fail;
   if (pl->metrics && ((c = shape_metrics_json(ctx, sf)) == NULL ||
@@ -504,14 +500,26 @@ oom:
   return NULL;
 }
 
+/* Where each slot's contour is a point while collapsed, 2 doubles a slot
+ * (NaN for a paired slot); NULL when out of memory. */
+static double *collapse_points(const km_shape_morph *m, size_t n) {
+  double *p = km__malloc((n ? 2 * n : 1) * sizeof *p);
+  for (size_t k = 0; p != NULL && k < n; k++)
+    if (!km_shape_morph_collapse_point(m, k, p + 2 * k))
+      p[2 * k] = p[2 * k + 1] = NAN;
+  return p;
+}
+
 cJSON *api__shape_animate_json(api_ctx *ctx, const api_morph_plan *pl) {
   size_t n = km_shape_morph_pairs(pl->smorph, NULL, 0);
   size_t *pieces = km__malloc((n ? n : 1) * sizeof *pieces);
+  double *collapse = collapse_points(pl->smorph, n);
   cJSON *a = NULL, *s;
-  if (pieces == NULL) goto oom;
+  if (pieces == NULL || collapse == NULL) goto oom;
   for (size_t k = 0; k < n; k++) pieces[k] = 1;
-  /* one piece count per slot, the most any frame needs: then every frame
-   * writes a slot with the same commands */
+  /* one piece count per slot, the most any frame needs, and a collapsed
+   * contour drawn as a point with its slot's pieces: then every frame
+   * writes every slot with the same commands */
   for (size_t i = 0; i < pl->nframes; i++) {
     const km_shape_frame *sf = &pl->frames[i].shape;
     for (size_t k = 0; k < n && k < sf->ncontours; k++) {
@@ -525,19 +533,21 @@ cJSON *api__shape_animate_json(api_ctx *ctx, const api_morph_plan *pl) {
   }
   if ((a = cJSON_CreateArray()) == NULL) goto oom;
   for (size_t i = 0; i < pl->nframes; i++) {
-    if ((s = joined_d(ctx, &pl->frames[i].shape, pl->tol, pieces)) == NULL)
-      goto fail;
-    if (!cJSON_AddItemToArray(a, s)) {
+    char *d = api_svg_shape_frame_d(&pl->frames[i].shape, pieces, collapse);
+    s = d != NULL ? cJSON_CreateString(d) : NULL;
+    km__free(d);
+    if (s == NULL || !cJSON_AddItemToArray(a, s)) {
       cJSON_Delete(s);
       goto oom;
     }
   }
   km__free(pieces);
+  km__free(collapse);
   return a;
 oom:
   api__oom(ctx);
-fail:
   km__free(pieces);
+  km__free(collapse);
   cJSON_Delete(a);
   return NULL;
 }

@@ -115,6 +115,21 @@ char *api_svg_shape_document(const api_svg_shape_frame *frames, size_t n,
  * whatever c->closed says: frames of one animation must agree on it. */
 char *api_svg_path_d_fixed_z(const km_curve *c, size_t n_pieces, bool with_z);
 
+/* A closed path of n_pieces (>= 1) cubic pieces all at the point p, with
+ * the commands api_svg_path_d_fixed_z writes for a closed curve: what an
+ * animation draws for a contour collapsed to p, so that interpolating it
+ * with the contour's live frames grows or shrinks it from p. */
+char *api_svg_point_d(const double p[2], size_t n_pieces);
+
+/* One frame of a compound animation: every slot of sf with pieces[k]
+ * pieces and its Z, a slot collapsed to a point written by
+ * api_svg_point_d at (collapse[2k], collapse[2k + 1]) (a slot without a
+ * collapse point, NaN, is left out), the subpaths joined by spaces. Frames
+ * of one morph so written share one command structure. NULL on
+ * out-of-memory. */
+char *api_svg_shape_frame_d(const km_shape_frame *sf, const size_t *pieces,
+                            const double *collapse);
+
 /* ---- internal helpers shared by the SVG writers ---- */
 
 /* A growing NUL-terminated string; after an allocation failure every

@@ -126,3 +126,45 @@ char *api_svg_shape_document(const api_svg_shape_frame *frames, size_t n,
   api__svg_buf_put(&c.b, "</svg>\n");
   return api__svg_buf_take(&c.b);
 }
+
+char *api_svg_point_d(const double p[2], size_t n_pieces) {
+  api_svg_buf b;
+  double ext = fmax(fabs(p[0]), fabs(p[1]));
+  /* the budget api_svg_path_d_fixed_z gives a curve of this extent */
+  double budget = 1e-6 * (ext > 0 ? ext : 1.0);
+  api__svg_buf_init(&b);
+  if (n_pieces < 1) n_pieces = 1;
+  api__svg_buf_put(&b, "M");
+  for (size_t i = 0; i <= 3 * n_pieces; i++) {
+    if (i > 0) api__svg_buf_put(&b, i == 1 ? "C" : " ");
+    api__svg_buf_num(&b, p[0], budget, NULL);
+    api__svg_buf_put(&b, ",");
+    api__svg_buf_num(&b, p[1], budget, NULL);
+  }
+  api__svg_buf_put(&b, " Z");
+  return api__svg_buf_take(&b);
+}
+
+char *api_svg_shape_frame_d(const km_shape_frame *sf, const size_t *pieces,
+                            const double *collapse) {
+  api_svg_buf b;
+  api__svg_buf_init(&b);
+  for (size_t k = 0; k < sf->ncontours && !b.failed; k++) {
+    const double *p = collapse + 2 * k;
+    char *d = NULL;
+    if (sf->present[k])
+      d = api_svg_path_d_fixed_z(&sf->contours[k], pieces[k], true);
+    else if (isfinite(p[0]) && isfinite(p[1]))
+      d = api_svg_point_d(p, pieces[k]);
+    else
+      continue;
+    if (d == NULL) {
+      b.failed = true;
+      break;
+    }
+    if (b.len > 0) api__svg_buf_put(&b, " ");
+    api__svg_buf_put(&b, d);
+    km__free(d);
+  }
+  return api__svg_buf_take(&b);
+}

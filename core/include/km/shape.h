@@ -249,6 +249,12 @@ void km_shape_morph_free(km_shape_morph *m);
 size_t km_shape_morph_pairs(const km_shape_morph *m, km_shape_pair *pairs,
                             size_t cap);
 
+/* The point an unpaired contour collapses into: where slot `slot` of m
+ * vanishes (at t = 1) or appears from (at t = 0), written to p. False,
+ * p untouched, for a paired slot or a slot out of range. */
+bool km_shape_morph_collapse_point(const km_shape_morph *m, size_t slot,
+                                   double p[2]);
+
 /* Frame at t in [0, 1] into *out (owned by the caller, km_shape_frame
  * _free; taken as empty). Each pair's curve is km_morph_frame_until's at t
  * (the engine's fit placement onto the pair's linear blend); a vanishing
