@@ -11,6 +11,12 @@
 //   const result = await km.morphJob(request, { onProgress: (s) => ..., signal });
 //   const at = interpolator(result);   // at(0.5) -> "M...".
 //
+// Compound shapes (glyphs with holes, icons of several parts) go in as an
+// SVG path with several subpaths or as shape(contours); their frames carry
+// one contour per slot of result.contour_matches_used (null where a
+// contour has shrunk to a point), and every helper here that reads frames
+// (framePath(s), frameContours, interpolator, bounds) takes both kinds.
+//
 // Every failure of the service is thrown as a KmorphError whose `problem`
 // is the RFC 9457 problem+json body the service sent (or one made up here
 // for network failures, failed and cancelled jobs). Aborts through an
@@ -51,6 +57,31 @@ export class KmorphError extends Error {
     for (const e of this.errors)
       if (e.pointer === pointer || (e.pointer || "").startsWith(pointer + "/")) return e.message;
     return null;
+  }
+
+  /** The errors that name one contour of a compound shape, as
+   * {side: "from" | "to" | "curve", contour, offset, pointer, message}:
+   * `contour` is the index in the shape's `contours` (or the subpath's
+   * index in an SVG `d`), `offset` the character offset in that `d` when
+   * the service gave one, else null. */
+  contourErrors() {
+    const out = [];
+    for (const e of this.errors) {
+      const pointer = e.pointer || "", message = e.message || "";
+      let m = /^\/(from|to|curve)\/contours\/(\d+)(?:\/|$)/.exec(pointer);
+      if (m) {
+        const at = /\boffset (\d+)/.exec(message);
+        out.push({ side: m[1], contour: Number(m[2]), offset: at ? Number(at[1]) : null, pointer, message });
+        continue;
+      }
+      m = /^\/(from|to|curve)\/d$/.exec(pointer);
+      const sub = /\bsubpath (\d+)/.exec(message);
+      if (m && sub) {
+        const at = /\boffset (\d+)/.exec(message);
+        out.push({ side: m[1], contour: Number(sub[1]), offset: at ? Number(at[1]) : null, pointer, message });
+      }
+    }
+    return out;
   }
 }
 
@@ -226,6 +257,39 @@ export class Client {
   async ready({ signal } = {}) { return (await this.request("GET", "/readyz", { signal })).body; }
 }
 
+// ------------------------------------------------------------ requests
+
+/** A Curve for a request: an SVG path `d` string becomes {type: "svg", d}
+ * (a compound shape when it has several subpaths), an array becomes a
+ * shape of those contours, an object is taken as it is. */
+export function curve(input) {
+  if (typeof input === "string") return { type: "svg", d: input };
+  if (Array.isArray(input)) return shape(input);
+  if (input && typeof input === "object") return input;
+  throw new TypeError("a curve is an SVG path string, an array of contours or a curve object");
+}
+
+/** A compound shape {type: "shape", contours, fill_rule?}: each contour a
+ * closed Curve or the `d` of one closed subpath; fillRule "nonzero" (the
+ * service's default) or "evenodd" decides which contours are holes. */
+export function shape(contours, { fillRule } = {}) {
+  if (!Array.isArray(contours) || contours.length === 0)
+    throw new TypeError("a shape needs an array of at least one contour");
+  const out = { type: "shape", contours: contours.map(curve) };
+  if (fillRule != null) out.fill_rule = fillRule;
+  return out;
+}
+
+/** A morph request from two curves (anything curve() takes) and options
+ * named as in the API (`contour_matches`) or in camelCase
+ * (`contourMatches`, `fillRule` is not one: give it to shape()). */
+export function morphRequest(from, to, options = {}) {
+  const req = { from: curve(from), to: curve(to) };
+  for (const [key, value] of Object.entries(options))
+    if (value !== undefined) req[key.replace(/[A-Z]/g, (c) => "_" + c.toLowerCase())] = value;
+  return req;
+}
+
 // ------------------------------------------------------------ geometry
 // Output curves are B-splines (or NURBS): {degree, knots, control_points,
 // weights?, closed}. These helpers evaluate them so that results can be
@@ -360,50 +424,132 @@ function pointsToPath(pts, closed) {
   return closed ? d + "Z" : d;
 }
 
-/** One `d` string per frame of a morph result: the service's own svg_d
- * when the request asked for it (`"include": ["svg_d"]`), else the frame's
- * B-spline converted here. */
-export function framePaths(result) {
-  return result.frames.map((f) => f.curve.svg_d || curveToPath(f.curve));
+/** Whether a morph result (or one of its frames) is of compound shapes:
+ * frames with `contours` in place of `curve`. */
+export function isCompound(resultOrFrame) {
+  const f = resultOrFrame && Array.isArray(resultOrFrame.frames) ? resultOrFrame.frames[0] : resultOrFrame;
+  return !!f && Array.isArray(f.contours);
+}
+
+/** The slots of a compound morph as [{slot, from, to}]: which contour of
+ * `from` went to which of `to` (from null: the contour appears; to null:
+ * it vanishes). A single-curve morph has one slot {slot: 0, from: 0, to: 0}. */
+export function contourPairs(result) {
+  const used = result.contour_matches_used;
+  if (!Array.isArray(used)) return [{ slot: 0, from: 0, to: 0 }];
+  return used.map(([from, to], slot) => ({ slot, from, to }));
+}
+
+/** A frame's curves, one per slot: CurveOut or null where the contour is
+ * a point at this t. A single-curve frame gives [curve]. */
+export function frameContours(frame) {
+  return Array.isArray(frame.contours) ? frame.contours : [frame.curve];
+}
+
+/** SVG path data per slot of a frame (null for a collapsed contour). */
+export function frameContourPaths(frame, options) {
+  return frameContours(frame).map((c) => (c ? c.svg_d || curveToPath(c, options) : null));
+}
+
+/** A frame's whole SVG path data: the service's svg_d when the request
+ * asked for it (`"include": ["svg_d"]`), else the frame's B-splines
+ * converted here; for shapes one closed subpath per present contour, in
+ * slot order, to be filled with the shape's fill rule. */
+export function framePath(frame, options) {
+  if (Array.isArray(frame.contours)) {
+    if (typeof frame.svg_d === "string") return frame.svg_d;
+    return frameContourPaths(frame, options).filter((d) => d !== null).join("");
+  }
+  return frame.curve.svg_d || curveToPath(frame.curve, options);
+}
+
+/** One `d` string per frame of a morph result (see framePath). */
+export function framePaths(result, options) {
+  return result.frames.map((f) => framePath(f, options));
+}
+
+function meanPoint(pts) {
+  let x = 0, y = 0;
+  for (const p of pts) { x += p[0]; y += p[1]; }
+  return [x / pts.length, y / pts.length];
+}
+
+/** Where each slot's contour is at every frame: its samples, or for a
+ * collapsed contour the point it shrinks into (or grows from), taken as
+ * the centre of its samples at the nearest frame where it is present. */
+function slotTracks(frames, samples) {
+  const perFrame = frames.map((f) => frameContours(f).map((c) => (c ? samplePoints(c, samples) : null)));
+  const slots = perFrame[0].length;
+  const tracks = [];
+  for (let k = 0; k < slots; k++) {
+    const pts = perFrame.map((row) => row[k]);
+    const closed = frames.map((f) => { const c = frameContours(f)[k]; return c ? !!c.closed : true; });
+    const points = pts.map((p, i) => {
+      if (p) return null;
+      for (let d = 1; d < pts.length; d++) {
+        if (i - d >= 0 && pts[i - d]) return meanPoint(pts[i - d]);
+        if (i + d < pts.length && pts[i + d]) return meanPoint(pts[i + d]);
+      }
+      return [0, 0];
+    });
+    tracks.push({ pts, points, closed });
+  }
+  return tracks;
 }
 
 /** A function t -> d for any t in [0, 1], like flubber's interpolate():
- * each frame is resampled at `samples` equal arc-length fractions and
- * points are blended linearly between the two frames around t (so frames
- * are hit exactly, up to the sampling, and motion in between is smooth).
- * Every string has the same structure, so the output also suits CSS/SMIL
- * path animation. Option `exact: true` returns the frame's own path when t
- * is a frame's t. */
-export function interpolator(result, { samples = 200, exact = false } = {}) {
+ * each frame's curve (each contour of a shape) is resampled at `samples`
+ * equal arc-length fractions and points are blended linearly between the
+ * two frames around t (so frames are hit exactly, up to the sampling, and
+ * motion in between is smooth). Every string has the same structure, so
+ * the output also suits CSS/SMIL path animation. A contour that vanishes
+ * or appears is blended with the point it shrinks into: with `collapsed`
+ * "point" (the default) it stays in the path as a degenerate subpath at
+ * that point, so the structure never changes; with "omit" it is left out
+ * where its length is zero. `perContour: true` returns, instead of one
+ * string, an array of one string per slot (null where omitted). Option
+ * `exact: true` returns the frame's own path when t is a frame's t. */
+export function interpolator(result, { samples = 200, exact = false, collapsed = "point", perContour = false } = {}) {
   const frames = result.frames;
   if (!frames.length) throw new RangeError("the morph result has no frames");
+  if (collapsed !== "point" && collapsed !== "omit") throw new RangeError('collapsed is "point" or "omit"');
   const ts = frames.map((f) => f.t);
-  const pts = frames.map((f) => samplePoints(f.curve, samples));
-  const closed = frames.map((f) => !!f.curve.closed);
-  const paths = exact ? framePaths(result) : null;
+  const tracks = slotTracks(frames, samples);
+  const paths = exact ? frames.map((f) => (perContour ? frameContourPaths(f) : framePath(f))) : null;
+  const degenerate = (c) => Array.from({ length: samples }, () => c);
+  const join = (list) => (perContour ? list : list.filter((d) => d !== null).join(""));
   return (t) => {
     t = Math.min(Math.max(+t, ts[0]), ts[ts.length - 1]);
     let i = 0;
     while (i < ts.length - 2 && t > ts[i + 1]) i++;
-    if (frames.length === 1) return exact ? paths[0] : pointsToPath(pts[0], closed[0]);
-    const span = ts[i + 1] - ts[i], f = span > 0 ? (t - ts[i]) / span : 0;
+    const j = frames.length === 1 ? i : i + 1;
+    const span = ts[j] - ts[i], f = span > 0 ? (t - ts[i]) / span : 0;
     if (exact) {
       if (Math.abs(t - ts[i]) < 1e-12) return paths[i];
-      if (Math.abs(t - ts[i + 1]) < 1e-12) return paths[i + 1];
+      if (Math.abs(t - ts[j]) < 1e-12) return paths[j];
     }
-    const a = pts[i], b = pts[i + 1];
-    const mixed = a.map((q, j) => [q[0] + f * (b[j][0] - q[0]), q[1] + f * (b[j][1] - q[1])]);
-    return pointsToPath(mixed, f < 0.5 ? closed[i] : closed[i + 1]);
+    return join(tracks.map(({ pts, points, closed }) => {
+      const a = pts[i], b = pts[j];
+      if ((!a && !b) || (!a && f === 0) || (!b && f === 1)) {
+        if (collapsed === "omit") return null;
+      }
+      const pa = a || degenerate(points[i]), pb = b || degenerate(points[j]);
+      const mixed = pa.map((q, n) => [q[0] + f * (pb[n][0] - q[0]), q[1] + f * (pb[n][1] - q[1])]);
+      return pointsToPath(mixed, f < 0.5 ? closed[i] : closed[j]);
+    }));
   };
 }
 
 /** Bounding box [minX, minY, maxX, maxY] of the frames' control polygons
- * (which contain the curves), for choosing an SVG viewBox. */
+ * (which contain the curves), every contour of a shape included, for
+ * choosing an SVG viewBox. */
 export function bounds(result) {
   let b = [Infinity, Infinity, -Infinity, -Infinity];
   for (const f of result.frames)
-    for (const [x, y] of f.curve.control_points)
-      b = [Math.min(b[0], x), Math.min(b[1], y), Math.max(b[2], x), Math.max(b[3], y)];
+    for (const c of frameContours(f))
+      if (c)
+        for (const [x, y] of c.control_points)
+          b = [Math.min(b[0], x), Math.min(b[1], y), Math.max(b[2], x), Math.max(b[3], y)];
   return b;
 }
 
