@@ -7,6 +7,20 @@
     paths = frame_paths(res)                     # one SVG d string per frame
     at = interpolator(res); at(0.5)              # d string at any t
 
+Compound shapes (glyphs with holes, icons of several parts) go in as an
+SVG path with several subpaths or as ``shape([...contours])``; their
+frames carry one contour per slot of ``result["contour_matches_used"]``
+(None where a contour has shrunk to a point), and the helpers that read
+frames (frame_path(s), frame_contours, interpolator, bounds) take both
+kinds of result:
+
+    ring = "M 90 50 A 40 40 0 1 1 10 50 A 40 40 0 1 1 90 50 Z " \
+           "M 70 50 A 20 20 0 1 0 30 50 A 20 20 0 1 0 70 50 Z"
+    disc = "M 90 50 A 40 40 0 1 1 10 50 A 40 40 0 1 1 90 50 Z"
+    res = km.morph(morph_request(ring, disc, frames=30))
+    res["contour_matches_used"]                 # [[0, 0], [1, None]]: the hole vanishes
+    frame_contour_paths(res["frames"][-1])      # ["M...Z", None]
+
 Every error answered by the service raises KmorphError carrying the
 problem+json body (``.problem``, ``.status``, ``.errors`` with JSON
 pointers). Network failures raise KmorphError with status 0. A job that
@@ -16,18 +30,22 @@ after the job was cancelled on the service too.
 Also a command line: ``python3 -m kmorph --help``.
 """
 import bisect
+import dataclasses
 import json
 import math
 import os
+import re
 import time
 import urllib.error
 import urllib.parse
 import urllib.request
 
 __all__ = [
-    "Client", "KmorphError", "JobCancelled", "DEFAULT_URL",
+    "Client", "KmorphError", "JobCancelled", "ContourError", "DEFAULT_URL",
+    "curve", "shape", "morph_request",
     "eval_curve", "curve_to_path", "sample_points", "frame_paths",
-    "interpolator", "bounds",
+    "is_compound", "contour_pairs", "frame_contours", "frame_contour_paths",
+    "frame_path", "interpolator", "bounds",
 ]
 
 DEFAULT_URL = "http://127.0.0.1:8080"
@@ -57,9 +75,40 @@ class KmorphError(Exception):
                 return e.get("message")
         return None
 
+    def contour_errors(self):
+        """The errors that name one contour of a compound shape, as
+        ContourError: from a pointer /from/contours/K/..., or from an SVG
+        `d` whose subpath K is at fault (with its character offset)."""
+        out = []
+        for e in self.errors:
+            ptr, msg = e.get("pointer", "") or "", e.get("message", "") or ""
+            at = re.search(r"\boffset (\d+)", msg)
+            offset = int(at.group(1)) if at else None
+            m = re.match(r"^/(from|to|curve)/contours/(\d+)(?:/|$)", ptr)
+            if m:
+                out.append(ContourError(m.group(1), int(m.group(2)), offset, ptr, msg))
+                continue
+            m = re.match(r"^/(from|to|curve)/d$", ptr)
+            sub = re.search(r"\bsubpath (\d+)", msg)
+            if m and sub:
+                out.append(ContourError(m.group(1), int(sub.group(1)), offset, ptr, msg))
+        return out
+
     def __str__(self):
         head = "%s %s" % (self.status, self.title) if self.status else self.title
         return "%s: %s" % (head, self.detail) if self.detail else head
+
+
+@dataclasses.dataclass(frozen=True)
+class ContourError:
+    """One error about one contour: side "from", "to" or "curve"; contour,
+    its index in the shape's contours (or the subpath's in an SVG d);
+    offset, the character offset in that d when the service gave one."""
+    side: str
+    contour: int
+    offset: object
+    pointer: str
+    message: str
 
 
 class JobCancelled(KmorphError):
@@ -248,6 +297,43 @@ def _parse(headers, raw):
     return text
 
 
+# ----------------------------------------------------------- requests
+
+def curve(value):
+    """A Curve for a request: an SVG path d string becomes {"type": "svg",
+    "d": ...} (a compound shape when it has several subpaths), a list or
+    tuple a shape of those contours, a dict is taken as it is."""
+    if isinstance(value, str):
+        return {"type": "svg", "d": value}
+    if isinstance(value, (list, tuple)):
+        return shape(value)
+    if isinstance(value, dict):
+        return value
+    raise TypeError("a curve is an SVG path string, a list of contours or a curve dict")
+
+
+def shape(contours, fill_rule=None):
+    """A compound shape {"type": "shape", "contours": [...]}: each contour
+    a closed curve dict or the d of one closed subpath; fill_rule
+    "nonzero" (the service's default) or "evenodd" decides the holes."""
+    contours = list(contours)
+    if not contours:
+        raise ValueError("a shape needs at least one contour")
+    out = {"type": "shape", "contours": [curve(c) for c in contours]}
+    if fill_rule is not None:
+        out["fill_rule"] = fill_rule
+    return out
+
+
+def morph_request(from_curve, to_curve, **options):
+    """A morph request from two curves (anything curve() takes) and the
+    request's other members by their API names (frames, tolerance,
+    contour_matches, include, ...); None values are left out."""
+    req = {"from": curve(from_curve), "to": curve(to_curve)}
+    req.update({k: v for k, v in options.items() if v is not None})
+    return req
+
+
 # ----------------------------------------------------------- geometry
 # Output curves: {degree, knots, control_points, weights?, closed}.
 
@@ -376,37 +462,130 @@ def _points_to_path(pts, closed):
     return d + ("Z" if closed else "")
 
 
-def frame_paths(result):
-    """One SVG d string per frame: svg_d when the request included it,
-    else the frame's B-spline converted here."""
-    return [f["curve"].get("svg_d") or curve_to_path(f["curve"]) for f in result["frames"]]
+def is_compound(result_or_frame):
+    """Whether a morph result (or frame) is of compound shapes: frames with
+    "contours" in place of "curve"."""
+    f = result_or_frame
+    if isinstance(f, dict) and isinstance(f.get("frames"), list):
+        f = f["frames"][0] if f["frames"] else None
+    return isinstance(f, dict) and isinstance(f.get("contours"), list)
 
 
-def interpolator(result, samples=200):
-    """A function t -> d for t in [0, 1]: frames resampled at equal
-    arc-length fractions, blended linearly between neighbouring frames."""
+def contour_pairs(result):
+    """The slots of a morph as [(slot, from, to)]: which contour of `from`
+    went to which of `to` (from None: it appears; to None: it vanishes).
+    A single-curve morph has the one slot (0, 0, 0)."""
+    used = result.get("contour_matches_used")
+    if not isinstance(used, list):
+        return [(0, 0, 0)]
+    return [(k, i, j) for k, (i, j) in enumerate(used)]
+
+
+def frame_contours(frame):
+    """A frame's curves, one per slot: the CurveOut dict, or None where
+    the contour is a point at this t. A single-curve frame gives [curve]."""
+    return frame["contours"] if isinstance(frame.get("contours"), list) else [frame["curve"]]
+
+
+def frame_contour_paths(frame, pieces=8):
+    """SVG path data per slot of a frame (None for a collapsed contour)."""
+    return [None if c is None else (c.get("svg_d") or curve_to_path(c, pieces))
+            for c in frame_contours(frame)]
+
+
+def frame_path(frame, pieces=8):
+    """A frame's whole SVG path data: the service's svg_d when the request
+    included it, else converted here; for shapes one closed subpath per
+    present contour, in slot order, to fill with the shape's fill rule."""
+    if isinstance(frame.get("contours"), list):
+        if isinstance(frame.get("svg_d"), str):
+            return frame["svg_d"]
+        return "".join(d for d in frame_contour_paths(frame, pieces) if d is not None)
+    return frame["curve"].get("svg_d") or curve_to_path(frame["curve"], pieces)
+
+
+def frame_paths(result, pieces=8):
+    """One SVG d string per frame (see frame_path)."""
+    return [frame_path(f, pieces) for f in result["frames"]]
+
+
+def _mean(pts):
+    return (sum(p[0] for p in pts) / len(pts), sum(p[1] for p in pts) / len(pts))
+
+
+def _slot_tracks(frames, samples):
+    """Per slot: samples per frame (None where collapsed), the point a
+    collapsed contour shrinks into (the centre of its samples at the
+    nearest frame where it is present), and closedness per frame."""
+    per_frame = [[None if c is None else sample_points(c, samples) for c in frame_contours(f)]
+                 for f in frames]
+    tracks = []
+    for k in range(len(per_frame[0])):
+        pts = [row[k] for row in per_frame]
+        closed = [True if frame_contours(f)[k] is None else bool(frame_contours(f)[k].get("closed"))
+                  for f in frames]
+        points = []
+        for i, p in enumerate(pts):
+            c = None
+            if p is None:
+                c = (0.0, 0.0)
+                for d in range(1, len(pts)):
+                    if i - d >= 0 and pts[i - d] is not None:
+                        c = _mean(pts[i - d])
+                        break
+                    if i + d < len(pts) and pts[i + d] is not None:
+                        c = _mean(pts[i + d])
+                        break
+            points.append(c)
+        tracks.append((pts, points, closed))
+    return tracks
+
+
+def interpolator(result, samples=200, collapsed="point", per_contour=False):
+    """A function t -> d for t in [0, 1]: each frame's curve (each contour
+    of a shape) resampled at equal arc-length fractions, blended linearly
+    between neighbouring frames; every string has one structure. A
+    contour that vanishes or appears is blended with the point it shrinks
+    into: collapsed="point" keeps it as a degenerate subpath there (the
+    structure never changes), "omit" leaves it out where its length is 0.
+    per_contour=True returns a list of one d per slot (None if omitted)."""
     frames = result["frames"]
     if not frames:
         raise ValueError("the morph result has no frames")
+    if collapsed not in ("point", "omit"):
+        raise ValueError('collapsed is "point" or "omit"')
     ts = [f["t"] for f in frames]
-    pts = [sample_points(f["curve"], samples) for f in frames]
-    closed = [bool(f["curve"].get("closed")) for f in frames]
+    tracks = _slot_tracks(frames, samples)
 
     def at(t):
         t = min(max(float(t), ts[0]), ts[-1])
         if len(frames) == 1:
-            return _points_to_path(pts[0], closed[0])
-        i = min(max(bisect.bisect_right(ts, t) - 1, 0), len(ts) - 2)
-        span = ts[i + 1] - ts[i]
+            i = j = 0
+        else:
+            i = min(max(bisect.bisect_right(ts, t) - 1, 0), len(ts) - 2)
+            j = i + 1
+        span = ts[j] - ts[i]
         f = (t - ts[i]) / span if span > 0 else 0.0
-        mixed = [(a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1]))
-                 for a, b in zip(pts[i], pts[i + 1])]
-        return _points_to_path(mixed, closed[i] if f < 0.5 else closed[i + 1])
+        out = []
+        for pts, points, closed in tracks:
+            a, b = pts[i], pts[j]
+            if collapsed == "omit" and ((a is None and b is None) or (a is None and f == 0)
+                                        or (b is None and f == 1)):
+                out.append(None)
+                continue
+            pa = a if a is not None else [points[i]] * samples
+            pb = b if b is not None else [points[j]] * samples
+            mixed = [(p[0] + f * (q[0] - p[0]), p[1] + f * (q[1] - p[1])) for p, q in zip(pa, pb)]
+            out.append(_points_to_path(mixed, closed[i] if f < 0.5 else closed[j]))
+        return out if per_contour else "".join(d for d in out if d is not None)
     return at
 
 
 def bounds(result):
-    """(min_x, min_y, max_x, max_y) of every frame's control polygon."""
-    xs = [p[0] for f in result["frames"] for p in f["curve"]["control_points"]]
-    ys = [p[1] for f in result["frames"] for p in f["curve"]["control_points"]]
+    """(min_x, min_y, max_x, max_y) of every frame's control polygon (every
+    contour of a shape), which holds the curves."""
+    pts = [p for f in result["frames"] for c in frame_contours(f) if c is not None
+           for p in c["control_points"]]
+    xs = [p[0] for p in pts]
+    ys = [p[1] for p in pts]
     return min(xs), min(ys), max(xs), max(ys)

@@ -1,16 +1,19 @@
 """python3 -m kmorph - the kmorph service from the command line.
 
 Subcommands: signature, reconstruct, morph, job, status, cancel, health.
-Curves are SVG path d strings ("M 0 0 L 10 0"), JSON curve objects, or
-@FILE / @- holding either (a file with a signature becomes a signature
-curve). Errors print the service's problem detail on stderr and exit 1;
-usage errors exit 2.
+Curves are SVG path d strings ("M 0 0 L 10 0"; several subpaths make a
+compound shape), JSON curve objects (a shape among them), or @FILE / @-
+holding either, or an SVG document whose <path> elements together are
+the shape (a file with a signature becomes a signature curve). Errors
+print the service's problem detail on stderr and exit 1; usage errors
+exit 2.
 """
 import argparse
 import json
 import sys
+import xml.etree.ElementTree as ET
 
-from . import Client, JobCancelled, KmorphError, DEFAULT_URL
+from . import Client, JobCancelled, KmorphError, DEFAULT_URL, contour_pairs, frame_path, is_compound
 
 
 def _read_arg(text):
@@ -50,7 +53,23 @@ def curve_arg(text):
         raise SystemExit(_usage_error("not a curve: expected type, signature, kappa or control_points"))
     if s[:1] in ("M", "m"):
         return {"type": "svg", "d": s}
-    raise SystemExit(_usage_error("not an SVG path (must start with M) nor JSON: %.60s" % s))
+    if s.startswith("<"):
+        return {"type": "svg", "d": _svg_document_path(s)}
+    raise SystemExit(_usage_error("not an SVG path (must start with M), SVG document nor JSON: %.60s" % s))
+
+
+def _svg_document_path(text):
+    """The d of every <path> of an SVG document, joined: one compound
+    shape (transforms and other elements are not applied)."""
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as e:
+        raise SystemExit(_usage_error("not a well-formed SVG document: %s" % e))
+    ds = [el.get("d").strip() for el in root.iter()
+          if el.tag.rsplit("}", 1)[-1] == "path" and (el.get("d") or "").strip()]
+    if not ds:
+        raise SystemExit(_usage_error("the SVG document has no <path> with a d attribute"))
+    return " ".join(ds)
 
 
 def _morph_request(a):
@@ -76,7 +95,11 @@ def _morph_request(a):
         if getattr(a, key) is not None:
             req[key] = getattr(a, key)
     if a.matches is not None:
-        req["matches"] = "auto" if a.matches == "auto" else json.loads(a.matches)
+        req["matches"] = "auto" if a.matches == "auto" else _json_arg(a.matches, "-M")
+    if a.contour_matches is not None:
+        req["contour_matches"] = _json_arg(a.contour_matches, "-C")
+    if a.paths:
+        req["include"] = sorted(set(req.get("include", []) + ["svg_d"]))
     if a.metrics:
         req["metrics"] = True
     if a.svg_d:
@@ -86,6 +109,37 @@ def _morph_request(a):
         req["format"] = "svg"
         req.setdefault("svg", {})["layout"] = layout
     return req
+
+
+def _json_arg(text, option):
+    try:
+        return json.loads(text)
+    except ValueError as e:
+        raise SystemExit(_usage_error("%s needs JSON: %s" % (option, e)))
+
+
+def _pairing_line(result):
+    """'from 0 -> to 1, from 1 vanishes, appears as to 2' for a compound
+    morph's contour_matches_used."""
+    parts = []
+    for _, i, j in contour_pairs(result):
+        if i is None:
+            parts.append("to %d appears" % j)
+        elif j is None:
+            parts.append("from %d vanishes" % i)
+        else:
+            parts.append("from %d -> to %d" % (i, j))
+    return ", ".join(parts)
+
+
+def _emit_morph(answer, a):
+    """A morph answer as asked: with -p one line per frame (t, a tab, the
+    frame's whole path data) and, for shapes, the pairing on stderr."""
+    if not a.paths or isinstance(answer, str):
+        return _emit(answer, a.output)
+    if is_compound(answer):
+        print("kmorph: contours: " + _pairing_line(answer), file=sys.stderr)
+    _emit("".join("%r\t%s\n" % (f["t"], frame_path(f)) for f in answer["frames"]), a.output)
 
 
 def _emit(answer, output):
@@ -105,6 +159,8 @@ def _morph_options(p):
     p.add_argument("-m", "--method", choices=["curvature", "linear"])
     p.add_argument("-b", "--blend", choices=["turning", "paper"])
     p.add_argument("-M", "--matches", help='"auto" or pairs as JSON: [[0.2,0.3]]')
+    p.add_argument("-C", "--contour-matches",
+                   help="shapes: pairs of contour indices as JSON, null for none: [[0,0],[1,null]]")
     p.add_argument("-c", "--closure", choices=["auto", "lsq", "c0", "c1", "g2", "none"])
     p.add_argument("-a", "--anchor", choices=["fit", "start", "centroid"])
     p.add_argument("-O", "--orient", choices=["auto", "keep"])
@@ -112,6 +168,8 @@ def _morph_options(p):
     p.add_argument("-g", "--degree", type=int, choices=[3, 5])
     p.add_argument("-k", "--metrics", action="store_true", help="per-frame metrics")
     p.add_argument("-d", "--svg-d", action="store_true", help="include svg_d in each frame")
+    p.add_argument("-p", "--paths", action="store_true",
+                   help="print one line per frame: t, a tab, its path data (shapes: the pairing on stderr)")
     p.add_argument("-l", "--layout", choices=["filmstrip", "overlay", "animate", "curvature_plot"],
                    help="answer in SVG with this layout")
     p.add_argument("-o", "--output", help="write to this file (FILE.svg asks for SVG)")
@@ -158,7 +216,7 @@ def main(argv=None):
             r = km.reconstruct(sig, a.tolerance, a.degree, ["svg_d"] if a.path else None)
             _emit(r["curve"]["svg_d"] if a.path else r, a.output)
         elif a.cmd == "morph":
-            _emit(km.morph(_morph_request(a)), a.output)
+            _emit_morph(km.morph(_morph_request(a)), a)
         elif a.cmd == "job":
             last = [None]
 
@@ -168,7 +226,7 @@ def main(argv=None):
                 if not a.quiet and line != last[0]:
                     print("kmorph: " + line, file=sys.stderr, flush=True)
                     last[0] = line
-            _emit(km.morph_job(_morph_request(a), on_progress=progress), a.output)
+            _emit_morph(km.morph_job(_morph_request(a), on_progress=progress), a)
         elif a.cmd == "status":
             _emit(km.job(a.id), None)
         elif a.cmd == "cancel":

@@ -1,0 +1,424 @@
+"""test_shapes.py - the Python client (clients/python/kmorph) and its
+command line with compound shapes against a live kmorphd: real glyph and
+icon pairs from tests/fixtures/compound morph with frames 0 and 1 equal
+to the inputs' contours (each input path parsed and sampled here,
+independently of the client and the service), a valid contour pairing, a
+caller's pairing honoured, a vanishing contour None at t = 1 and
+shrinking to a point in the interpolator, jobs, and errors naming the
+contour."""
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
+sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
+sys.path.insert(0, os.path.join(ROOT, "tests", "pylib"))
+
+import kmdaemon  # noqa: E402
+import kmorph  # noqa: E402
+from kmorph import (Client, KmorphError, ContourError, curve, shape, morph_request,  # noqa: E402
+                    is_compound, contour_pairs, frame_contours, frame_contour_paths,
+                    frame_path, frame_paths, interpolator, bounds)
+
+FIXTURES = os.path.join(ROOT, "tests", "fixtures", "compound")
+DAEMON = None
+
+
+def _load(name, key):
+    with open(os.path.join(FIXTURES, name), encoding="utf-8") as f:
+        return {x["id"]: x for x in json.load(f)[key]}
+
+
+SHAPES = {**_load("glyphs.json", "glyphs"), **_load("icons.json", "icons")}
+with open(os.path.join(FIXTURES, "pairs.json"), encoding="utf-8") as _f:
+    PAIRS = json.load(_f)["pairs"]
+
+
+def setUpModule():
+    global DAEMON
+    DAEMON = kmdaemon.Daemon()
+
+
+def tearDownModule():
+    if DAEMON:
+        DAEMON.stop()
+
+
+def url():
+    return "http://%s:%d" % (kmdaemon.HOST, DAEMON.port)
+
+
+# ------------------------------------------------ an SVG path, sampled here
+
+def subpaths(d, per=48):
+    """The subpaths of SVG path data as dense polylines (SVG 1.1 section
+    8.3: M L H V C S Q T A Z, absolute and relative; arcs by the endpoint
+    to centre conversion of implementation note F.6.5)."""
+    import re
+    tokens = re.findall(r"[MmLlHhVvCcSsQqTtAaZz]|[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?", d)
+    out, cur = [], None
+    i, cmd = 0, None
+    x = y = sx = sy = 0.0
+    last_c = last_q = None
+
+    def num():
+        nonlocal i
+        i += 1
+        return float(tokens[i - 1])
+
+    def bez(ctrl):
+        for k in range(1, per + 1):
+            t = k / per
+            pts = [tuple(p) for p in ctrl]
+            while len(pts) > 1:
+                pts = [(a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])) for a, b in zip(pts, pts[1:])]
+            cur.append(pts[0])
+
+    def arc(rx, ry, phi_deg, large, sweep, x2, y2):
+        if rx == 0 or ry == 0:
+            cur.append((x2, y2))
+            return
+        rx, ry = abs(rx), abs(ry)
+        phi = math.radians(phi_deg)
+        c, s = math.cos(phi), math.sin(phi)
+        dx, dy = (x - x2) / 2, (y - y2) / 2
+        x1p, y1p = c * dx + s * dy, -s * dx + c * dy
+        lam = x1p ** 2 / rx ** 2 + y1p ** 2 / ry ** 2
+        if lam > 1:
+            rx, ry = rx * math.sqrt(lam), ry * math.sqrt(lam)
+        num2 = rx * rx * ry * ry - rx * rx * y1p * y1p - ry * ry * x1p * x1p
+        f = math.sqrt(max(0.0, num2 / (rx * rx * y1p * y1p + ry * ry * x1p * x1p)))
+        if large == sweep:
+            f = -f
+        cxp, cyp = f * rx * y1p / ry, -f * ry * x1p / rx
+        cx, cy = c * cxp - s * cyp + (x + x2) / 2, s * cxp + c * cyp + (y + y2) / 2
+
+        def ang(ux, uy, vx, vy):
+            return math.atan2(ux * vy - uy * vx, ux * vx + uy * vy)
+        t1 = ang(1, 0, (x1p - cxp) / rx, (y1p - cyp) / ry)
+        dt = ang((x1p - cxp) / rx, (y1p - cyp) / ry, (-x1p - cxp) / rx, (-y1p - cyp) / ry)
+        if not sweep and dt > 0:
+            dt -= 2 * math.pi
+        if sweep and dt < 0:
+            dt += 2 * math.pi
+        n = max(4, math.ceil(abs(dt) / (2 * math.pi) * 4 * per))
+        for k in range(1, n + 1):
+            a = t1 + dt * k / n
+            cur.append((cx + rx * math.cos(a) * c - ry * math.sin(a) * s,
+                        cy + rx * math.cos(a) * s + ry * math.sin(a) * c))
+
+    while i < len(tokens):
+        if tokens[i].isalpha():
+            cmd = tokens[i]
+            i += 1
+        rel = cmd.islower()
+        ox, oy = (x, y) if rel else (0.0, 0.0)
+        u = cmd.upper()
+        if u == "M":
+            x, y = ox + num(), oy + num()
+            sx, sy = x, y
+            cur = [(x, y)]
+            out.append(cur)
+            cmd = "l" if rel else "L"
+            last_c = last_q = None
+        elif u == "Z":
+            x, y = sx, sy
+            cur.append((x, y))
+            cur = [(x, y)]
+            out.append(cur)
+            last_c = last_q = None
+        elif u in "LHV":
+            nx = ox + num() if u != "V" else x
+            ny = oy + num() if u == "L" else ((y if rel else 0.0) + num() if u == "V" else y)
+            bez([(x, y), (nx, ny)])
+            x, y = nx, ny
+            last_c = last_q = None
+        elif u in "CS":
+            if u == "C":
+                c1 = (ox + num(), oy + num())
+            else:
+                c1 = (2 * x - last_c[0], 2 * y - last_c[1]) if last_c else (x, y)
+            c2 = (ox + num(), oy + num())
+            e = (ox + num(), oy + num())
+            bez([(x, y), c1, c2, e])
+            last_c, last_q = c2, None
+            x, y = e
+        elif u in "QT":
+            if u == "Q":
+                c1 = (ox + num(), oy + num())
+            else:
+                c1 = (2 * x - last_q[0], 2 * y - last_q[1]) if last_q else (x, y)
+            e = (ox + num(), oy + num())
+            bez([(x, y), c1, e])
+            last_q, last_c = c1, None
+            x, y = e
+        elif u == "A":
+            rx, ry, phi, large, sweep = num(), num(), num(), num() != 0, num() != 0
+            nx, ny = ox + num(), oy + num()
+            arc(rx, ry, phi, large, sweep, nx, ny)
+            x, y = nx, ny
+            last_c = last_q = None
+        else:
+            raise ValueError("path command %s" % cmd)
+    return [p for p in out if len(p) > 1]
+
+
+class Polyline:
+    """A dense polyline with its segments in a grid of cells, so that the
+    distance from a point is found among the segments near it."""
+
+    def __init__(self, pts, cell):
+        self.pts, self.cell, self.grid = pts, cell, {}
+        for k in range(1, len(pts)):
+            (ax, ay), (bx, by) = pts[k - 1], pts[k]
+            for gx in range(int(math.floor(min(ax, bx) / cell)), int(math.floor(max(ax, bx) / cell)) + 1):
+                for gy in range(int(math.floor(min(ay, by) / cell)), int(math.floor(max(ay, by) / cell)) + 1):
+                    self.grid.setdefault((gx, gy), []).append(k)
+
+    def distance(self, q, reach):
+        """Distance from q, or infinity if no segment is within reach."""
+        best = math.inf
+        c = self.cell
+        seen = set()
+        for gx in range(int(math.floor((q[0] - reach) / c)), int(math.floor((q[0] + reach) / c)) + 1):
+            for gy in range(int(math.floor((q[1] - reach) / c)), int(math.floor((q[1] + reach) / c)) + 1):
+                for k in self.grid.get((gx, gy), ()):
+                    if k in seen:
+                        continue
+                    seen.add(k)
+                    (ax, ay), (bx, by) = self.pts[k - 1], self.pts[k]
+                    vx, vy = bx - ax, by - ay
+                    l2 = vx * vx + vy * vy
+                    u = min(1.0, max(0.0, ((q[0] - ax) * vx + (q[1] - ay) * vy) / l2)) if l2 > 0 else 0.0
+                    best = min(best, math.hypot(ax + u * vx - q[0], ay + u * vy - q[1]))
+        return best if best <= reach else math.inf
+
+
+def hausdorff(p, q, reach):
+    """Symmetric Hausdorff distance of two dense polylines, infinity when
+    it exceeds reach (every third point queried against every segment)."""
+    cell = max(reach, 1e-9)
+    a, b = Polyline(p, cell), Polyline(q, cell)
+    h = 0.0
+    for pt in p[::3]:
+        h = max(h, b.distance(pt, reach))
+    for pt in q[::3]:
+        h = max(h, a.distance(pt, reach))
+    return h
+
+
+def poly_length(p):
+    return sum(math.dist(a, b) for a, b in zip(p, p[1:]))
+
+
+# Tolerance of every request (font units of a 100-unit em, icon units of a
+# 24-unit box) and the margin beyond it for the sampling of both sides (48
+# points per input segment, 16 per frame Bezier: chords within 1e-4 of
+# the curves at these sizes) and the 1e-6 rounding of path numbers: 2e-5
+# of the shape's size.
+TOL = {"glyph": 0.01, "icon": 0.003}
+MARGIN = {"glyph": 0.002, "icon": 0.0005}
+
+
+def pair(frm, to):
+    for p in PAIRS:
+        if p["from"] == frm and p["to"] == to:
+            return p
+    raise AssertionError("pair %s -> %s not in pairs.json" % (frm, to))
+
+
+class ShapeTest(unittest.TestCase):
+    def setUp(self):
+        self.km = Client(url())
+
+    def assert_ends_are_inputs(self, res, from_d, to_d, bound):
+        """Slot k of frame 0 is contour i of `from` for the pair [i, j]
+        (None when i is None), of frame 1 contour j of `to`; compared as
+        point sets. Returns the largest distance."""
+        worst = 0.0
+        used = res["contour_matches_used"]
+        for frame, inputs, side in ((res["frames"][0], subpaths(from_d), 0),
+                                    (res["frames"][-1], subpaths(to_d), 1)):
+            paths = frame_contour_paths(frame)
+            self.assertEqual(len(paths), len(used))
+            for k, pr in enumerate(used):
+                want = pr[side]
+                if want is None:
+                    self.assertIsNone(paths[k], "slot %d at t = %d is collapsed" % (k, side))
+                    continue
+                self.assertIsNotNone(paths[k], "slot %d at t = %d is present" % (k, side))
+                mine = subpaths(paths[k], 16)
+                self.assertEqual(len(mine), 1)
+                h = hausdorff(mine[0], inputs[want], 4 * bound)
+                self.assertLessEqual(h, bound, "t = %d, slot %d (contour %d)" % (side, k, want))
+                worst = max(worst, h)
+        return worst
+
+    def assert_assignment(self, used, n_from, n_to):
+        """Every contour of either side appears exactly once across pairs."""
+        seen_from, seen_to = [0] * n_from, [0] * n_to
+        for i, j in used:
+            self.assertFalse(i is None and j is None)
+            if i is not None:
+                seen_from[i] += 1
+            if j is not None:
+                seen_to[j] += 1
+        self.assertEqual(seen_from, [1] * n_from)
+        self.assertEqual(seen_to, [1] * n_to)
+
+    def test_real_pairs_reproduce_their_inputs_at_both_ends_with_a_valid_pairing(self):
+        cases = [("dejavu-serif/0", "dejavu-serif/O"), ("dejavu-sans/O", "dejavu-sans/C"),
+                 ("dejavu-sans/i", "dejavu-sans/l"), ("mdi/circle-double", "mdi/target"),
+                 ("mdi/dice-3", "mdi/dice-5")]
+        for frm, to in cases:
+            with self.subTest(pair="%s -> %s" % (frm, to)):
+                p = pair(frm, to)
+                tol = TOL[p["kind"]]
+                res = self.km.morph(morph_request(SHAPES[frm]["d"], SHAPES[to]["d"], frames=5, tolerance=tol))
+                self.assertTrue(is_compound(res))
+                self.assert_assignment(res["contour_matches_used"], *p["counts"])
+                self.assertEqual(contour_pairs(res), [(k, i, j) for k, (i, j) in
+                                                      enumerate(res["contour_matches_used"])])
+                worst = self.assert_ends_are_inputs(res, SHAPES[frm]["d"], SHAPES[to]["d"],
+                                                    tol + MARGIN[p["kind"]])
+                print("%s -> %s: ends within %.3g of the inputs (tolerance %g)" % (frm, to, worst, tol),
+                      file=sys.stderr)
+                for f in res["frames"]:
+                    present = sum(c is not None for c in frame_contours(f))
+                    d = frame_path(f)
+                    self.assertEqual((d.count("M"), d.count("Z")), (present, present))
+                # A B-spline lies in its control polygon's hull.
+                x0, y0, x1, y1 = bounds(res)
+                for f in res["frames"]:
+                    for d in frame_contour_paths(f):
+                        for x, y in (subpaths(d, 4)[0] if d else []):
+                            self.assertTrue(x0 - 1e-6 <= x <= x1 + 1e-6 and y0 - 1e-6 <= y <= y1 + 1e-6)
+
+    def test_o_to_c_counter_is_none_at_t_1_and_svg_d_is_the_combined_path(self):
+        res = self.km.morph(morph_request(SHAPES["dejavu-sans/O"]["d"], SHAPES["dejavu-sans/C"]["d"],
+                                          frames=3, tolerance=TOL["glyph"], include=["svg_d"]))
+        slot = [j for _, j in res["contour_matches_used"]].index(None)
+        self.assertIsNone(frame_contours(res["frames"][2])[slot])
+        self.assertIsNotNone(frame_contours(res["frames"][1])[slot])
+        self.assertEqual(frame_paths(res)[2], res["frames"][2]["svg_d"])
+        self.assertEqual(res["frames"][2]["svg_d"].count("M"), 1)
+        # Without svg_d the client writes the same shape itself, within the
+        # tolerance the service writes its numbers to.
+        bare = {"t": 1, "contours": [c and {k: v for k, v in c.items() if k != "svg_d"}
+                                     for c in res["frames"][2]["contours"]]}
+        mine, theirs = subpaths(frame_path(bare), 16), subpaths(res["frames"][2]["svg_d"], 16)
+        self.assertEqual(len(mine), 1)
+        self.assertLessEqual(hausdorff(mine[0], theirs[0], 0.04), TOL["glyph"])
+
+    def test_o_to_c_interpolator_shrinks_the_counter_to_length_0_with_one_structure(self):
+        res = self.km.morph(morph_request(SHAPES["dejavu-sans/O"]["d"], SHAPES["dejavu-sans/C"]["d"],
+                                          frames=5, tolerance=TOL["glyph"]))
+        slot = [j for _, j in res["contour_matches_used"]].index(None)
+        per = interpolator(res, samples=120, per_contour=True)
+        whole = interpolator(res, samples=120)
+        import re
+        structure = re.sub(r"-?[\d.e]+", "#", whole(0))
+        prev = math.inf
+        for k in range(41):
+            t = k / 40
+            d = per(t)[slot]
+            self.assertIsNotNone(d)
+            length = poly_length(subpaths(d, 1)[0])
+            self.assertLessEqual(length, prev + 1e-9, "t = %g" % t)
+            prev = length
+            self.assertEqual(re.sub(r"-?[\d.e]+", "#", whole(t)), structure, "t = %g" % t)
+        self.assertLess(prev, 1e-9)
+        omit = interpolator(res, samples=120, collapsed="omit")
+        self.assertEqual(omit(1).count("M"), 1)
+        self.assertEqual(omit(0.99).count("M"), 2)
+        mid = subpaths(per(0.5)[slot], 1)[0]
+        frame = subpaths(frame_contour_paths(res["frames"][2])[slot], 16)[0]
+        self.assertLess(hausdorff(mid, frame, 0.2), 0.05)
+
+    def test_a_callers_contour_matches_are_honoured(self):
+        frm, to = SHAPES["mdi/dice-3"]["d"], SHAPES["mdi/dice-5"]["d"]
+        auto = self.km.morph(morph_request(frm, to, frames=2, tolerance=TOL["icon"]))
+        mine = [[0, 0], [1, 1], [2, 2], [3, 3], [None, 4], [None, 5]]
+        self.assertNotEqual(auto["contour_matches_used"], mine)
+        res = self.km.morph(morph_request(frm, to, frames=2, tolerance=TOL["icon"], contour_matches=mine))
+        key = lambda p: (p[0] is None, p[0] or 0, p[1] is None, p[1] or 0)  # noqa: E731
+        self.assertEqual(sorted(res["contour_matches_used"], key=key), sorted(mine, key=key))
+        self.assert_ends_are_inputs(res, frm, to, TOL["icon"] + MARGIN["icon"])
+
+    def test_a_shape_of_contours_morphs_as_the_compound_svg_path(self):
+        d = SHAPES["liberation-sans/i"]["d"]
+        parts = ["M" + s.strip() for s in d.split("M") if s.strip()]
+        self.assertEqual(len(parts), 2)
+        target = SHAPES["liberation-sans/j"]["d"]
+        a = self.km.morph(morph_request(d, target, frames=3, tolerance=TOL["glyph"]))
+        b = self.km.morph(morph_request(shape(parts, fill_rule="nonzero"), target, frames=3,
+                                        tolerance=TOL["glyph"]))
+        self.assertEqual(a, b)
+        self.assertEqual(curve(parts), {"type": "shape", "contours": [{"type": "svg", "d": p} for p in parts]})
+
+    def test_a_job_of_shapes_answers_the_synchronous_frames(self):
+        req = morph_request(SHAPES["mdi/circle-double"]["d"], SHAPES["mdi/target"]["d"], frames=9,
+                            tolerance=TOL["icon"])
+        seen = []
+        res = self.km.morph_job(req, on_progress=lambda s: seen.append(s["progress"]))
+        self.assertEqual(seen[-1], 1)
+        sync = self.km.morph(req)
+        self.assertEqual(res["contour_matches_used"], sync["contour_matches_used"])
+        self.assertEqual(frame_paths(res), frame_paths(sync))
+
+    def test_errors_name_the_contour_and_the_subpath_offset(self):
+        good = "M 0 0 L 10 0 L 10 10 Z"
+        with self.assertRaises(KmorphError) as cm:
+            self.km.morph(morph_request(shape([good, "M 20 0 L 30 0 L 30 10"]), good))
+        e = cm.exception
+        self.assertEqual(e.status, 422)
+        self.assertIsNotNone(e.message_for("/from/contours/1"))
+        self.assertEqual([(c.side, c.contour) for c in e.contour_errors()], [("from", 1)])
+        self.assertIsInstance(e.contour_errors()[0], ContourError)
+        bad = "M 0 0 L 10 0 L 10 10 Z M 20 0 L 20 0 Z"
+        with self.assertRaises(KmorphError) as cm:
+            self.km.morph(morph_request(good, bad))
+        c = cm.exception.contour_errors()[0]
+        self.assertEqual((c.side, c.contour, c.offset), ("to", 1, bad.index("M 20")))
+
+
+class ShapeCommandLineTest(unittest.TestCase):
+    def run_cli(self, *args):
+        env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "clients", "python"), KMORPH_URL=url())
+        return subprocess.run([sys.executable, "-m", "kmorph", *args], capture_output=True,
+                              text=True, env=env, timeout=120)
+
+    def test_paths_print_one_line_per_frame_and_the_pairing_with_contour_matches(self):
+        frm, to = SHAPES["mdi/dice-3"], SHAPES["mdi/dice-5"]
+        with tempfile.TemporaryDirectory() as tmp:
+            # An SVG document as an icon ships: its <path> is the shape.
+            svg = os.path.join(tmp, "dice-3.svg")
+            with open(svg, "w", encoding="utf-8") as f:
+                f.write('<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 24 24"><path d="%s" /></svg>'
+                        % frm["d"])
+            r = self.run_cli("morph", "-n", "3", "-p", "-t", "0.003",
+                             "-C", "[[0,0],[1,1],[2,2],[3,3],[null,4],[null,5]]", "@" + svg, to["d"])
+        self.assertEqual(r.returncode, 0, r.stderr)
+        lines = r.stdout.splitlines()
+        self.assertEqual([ln.split("\t")[0] for ln in lines], ["0", "0.5", "1"])
+        self.assertIn("kmorph: contours: from 0 -> to 0, from 1 -> to 1, from 2 -> to 2, from 3 -> to 3, "
+                      "to 4 appears, to 5 appears", r.stderr)
+        # The pips that appear are points at t = 0 and present at t = 1.
+        self.assertEqual([ln.split("\t")[1].count("M") for ln in lines], [4, 6, 6])
+        first = subpaths(lines[0].split("\t")[1], 16)
+        for k, want in enumerate(subpaths(frm["d"])):
+            self.assertLessEqual(hausdorff(first[k], want, 0.02), TOL["icon"] + MARGIN["icon"])
+
+    def test_a_bad_contour_exits_1_naming_it(self):
+        r = self.run_cli("morph", json.dumps(shape(["M 0 0 L 10 0 L 10 10 Z", "M 20 0 L 30 0 L 30 10"])),
+                         "M 0 0 L 10 0 L 10 10 Z")
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("at /from/contours/1:", r.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()
