@@ -2,8 +2,10 @@
 // with the curvature method and the linear baseline (synchronously, or as
 // jobs with a progress bar for long morphs), then play, scrub and inspect
 // the frames. All service calls go through kmorph.js.
-import { Client, KmorphError, curveToPath, samplePoints, bounds } from "./kmorph.js";
+import { Client, KmorphError, curveToPath, samplePoints } from "./kmorph.js";
 import { CURVES, PAIRS } from "./examples.js";
+import { splitSubpaths, slotColour, isShapeResult, framePath, frameMetrics, frameIsBad, resultBounds,
+         slotPoints } from "./shapes.js";
 
 const km = new Client();
 const $ = (sel, root = document) => root.querySelector(sel);
@@ -18,7 +20,10 @@ const PLOT_MAX = 21;
 
 const state = {
   input: { from: null, to: null },      /* parsed curve objects */
-  display: { from: "", to: "" },       /* SVG d of each input, for the editor */
+  /* each input as the editor draws it: {contours: [d], closed, compound,
+   * fillRule}, or null */
+  display: { from: null, to: null },
+  contourMatches: null,                 /* contour_matches_used of the shown morph */
   drawing: null,                        /* "from" | "to" while clicking points */
   drawn: { from: [], to: [] },
   picking: false,
@@ -62,10 +67,39 @@ function setFieldError(which, message) {
   if (field) field.classList.toggle("has-error", !!message);
 }
 
-/** The SVG d to show for an input curve: its own d, the B-spline drawn
- * here, or (signatures and fitted points) the service's reconstruction. */
+/** An input as the editor draws it: one path per contour (a compound
+ * shape's subpaths or contours, else the curve itself), whether every
+ * contour is closed, and the fill rule. */
+async function displayShape(curve) {
+  if (curve.type === "shape") {
+    const contours = (curve.contours || []).map((c) => contourPath(c));
+    return { contours, closed: true, compound: true, fillRule: curve.fill_rule || "nonzero" };
+  }
+  if (curve.type === "svg") {
+    let subpaths = null;
+    try { subpaths = splitSubpaths(curve.d); } catch { subpaths = null; /* the service says what is wrong */ }
+    if (subpaths && subpaths.length > 1)
+      return { contours: subpaths.map((p) => p.d), closed: subpaths.every((p) => p.closed), compound: true,
+               fillRule: "nonzero" };
+    return single(curve.d, /z\s*$/i.test(curve.d));
+  }
+  const d = await displayPath(curve);
+  return single(d, curve.type === "bspline" ? !!curve.closed : /z\s*$/i.test(d));
+}
+
+function single(d, closed) { return { contours: [d], closed, compound: false, fillRule: "nonzero" }; }
+
+function contourPath(c) {
+  if (!c || typeof c !== "object") return "";
+  if (c.type === "svg") return typeof c.d === "string" ? c.d : "";
+  if (c.type === "bspline") { try { return curveToPath(c); } catch { return ""; } }
+  if (c.type === "points" && Array.isArray(c.points)) return pointsPath(c.points, true);
+  return "";
+}
+
+/** The SVG d to show for a single curve: the B-spline drawn here, or
+ * (signatures and fitted points) the service's reconstruction. */
 async function displayPath(curve) {
-  if (curve.type === "svg") return curve.d;
   if (curve.type === "bspline") return curveToPath(curve);
   let sig = curve.signature;
   if (curve.type === "points") {
@@ -95,20 +129,21 @@ async function updateCurve(which) {
     curve = parseCurve(text);
   } catch (e) {
     state.input[which] = null;
-    state.display[which] = "";
+    state.display[which] = null;
     setFieldError(which, e.message);
     renderEditor();
     return;
   }
   state.input[which] = curve;
+  state.contourMatches = null;
   try {
-    const d = await displayPath(curve);
+    const shown = await displayShape(curve);
     if (seq !== previewSeq[which]) return;
-    state.display[which] = d;
+    state.display[which] = shown;
     setFieldError(which, "");
   } catch (e) {
     if (seq !== previewSeq[which]) return;
-    state.display[which] = curve.type === "points" ? pointsPath(curve.points, curve.closed) : "";
+    state.display[which] = curve.type === "points" ? single(pointsPath(curve.points, curve.closed), !!curve.closed) : null;
     setFieldError(which, problemText(e));
   }
   renderEditor();
@@ -139,10 +174,25 @@ function svgEl(name, attrs = {}, parent) {
 function renderEditor() {
   const svg = $("#editor"), g = $("#editor-content");
   g.replaceChildren();
+  const compound = isCompound();
   for (const which of ["from", "to"]) {
-    const d = state.drawing === which ? pointsPath(state.drawn[which], $(`.draw-closed[data-which=${which}]`).checked)
-                                      : state.display[which];
-    if (d) svgEl("path", { d, class: which, "data-which": which }, g);
+    if (state.drawing === which) {
+      const d = pointsPath(state.drawn[which], $(`.draw-closed[data-which=${which}]`).checked);
+      if (d) svgEl("path", { d, class: which, "data-which": which }, g);
+      continue;
+    }
+    const shown = state.display[which];
+    if (!shown || !shown.contours.some(Boolean)) continue;
+    /* a closed single curve against a compound shape is a shape of one contour */
+    const outlined = shown.compound || (compound && shown.closed);
+    /* One path of every contour, filled under the fill rule (holes show as
+     * holes); a compound shape's contours are outlined one by one in the
+     * colour of their pair. */
+    svgEl("path", { d: shown.contours.join(" "), class: `${which}${shown.closed ? " fillable" : ""}${outlined ? " shape" : ""}`,
+                    "data-which": which, "fill-rule": shown.fillRule }, g);
+    if (outlined)
+      shown.contours.forEach((d, i) => svgEl("path", { d, class: "contour", "data-which": which, "data-contour": i,
+                                                       style: `stroke: ${contourColour(which, i)}` }, g));
   }
   if (!state.drawing) fitViewBox(svg, g);
   const r = viewScale(svg) * 4;
@@ -160,6 +210,18 @@ function renderEditor() {
     if (p) svgEl("circle", { cx: p.x, cy: p.y, r: r * 1.5, class: "match", fill: "var(--from)" }, g);
   }
   renderMatchList();
+}
+
+/** The colour of input contour i: its pair's after a morph, else its side's. */
+function contourColour(which, i) {
+  const side = which === "from" ? "var(--from)" : "var(--to)";
+  if (!state.contourMatches) return side;
+  const k = state.contourMatches.findIndex((pair) => pair[which === "from" ? 0 : 1] === i);
+  return k < 0 ? side : slotColour(k);
+}
+
+function isCompound() {
+  return ["from", "to"].some((w) => state.display[w] && state.display[w].compound);
 }
 
 function fitViewBox(svg, g) {
@@ -281,7 +343,7 @@ function optionsRequest() {
   }
   const mode = $("#matches-mode").value;
   if (mode === "auto") req.matches = "auto";
-  else if (mode === "pairs" && state.matches.length) req.matches = state.matches;
+  else if (mode === "pairs" && state.matches.length && !isCompound()) req.matches = state.matches;
   return req;
 }
 
@@ -395,13 +457,20 @@ function showResults(outcomes) {
   /* One viewBox for every panel, so shapes compare at the same scale. */
   let b = [Infinity, Infinity, -Infinity, -Infinity];
   for (const o of outcomes) {
-    const c = bounds(o.result);
+    const c = resultBounds(o.result);
     b = [Math.min(b[0], c[0]), Math.min(b[1], c[1]), Math.max(b[2], c[2]), Math.max(b[3], c[3])];
   }
   const pad = Math.max(b[2] - b[0], b[3] - b[1]) * 0.05 || 1;
   const viewBox = `${b[0] - pad} ${b[1] - pad} ${b[2] - b[0] + 2 * pad} ${b[3] - b[1] + 2 * pad}`;
   for (const o of outcomes) state.panels.push(buildPanel(o, viewBox));
   for (const p of state.panels) panels.appendChild(p.root);
+  const shape = isShapeResult(outcomes[0].result);
+  state.contourMatches = shape ? outcomes[0].result.contour_matches_used || null : null;
+  renderContourList();
+  renderEditor();
+  /* The service draws compound morphs as a filmstrip only. */
+  for (const opt of $("#svg-layout").options) opt.disabled = shape && opt.value !== "filmstrip";
+  if (shape) $("#svg-layout").value = "filmstrip";
   const n = outcomes[0].result.frames.length;
   /* Slider steps land exactly on frames: k steps per frame interval. */
   const k = Math.max(1, Math.ceil(1000 / Math.max(1, n - 1)));
@@ -411,60 +480,104 @@ function showResults(outcomes) {
   for (const p of state.panels) loadPlot(p);
 }
 
+/** Which contour went to which: one line per pair, in its colour. */
+function renderContourList() {
+  const ul = $("#contour-list");
+  ul.replaceChildren();
+  ul.hidden = !state.contourMatches;
+  if (!state.contourMatches) return;
+  state.contourMatches.forEach(([i, j], k) => {
+    const li = document.createElement("li");
+    li.dataset.slot = k;
+    const sw = document.createElement("span");
+    sw.className = "swatch slot";
+    sw.style.background = slotColour(k);
+    li.appendChild(sw);
+    li.append(i === null ? `to contour ${j} grows from a point`
+                         : j === null ? `from contour ${i} shrinks to a point`
+                                      : `from contour ${i} → to contour ${j}`);
+    ul.appendChild(li);
+  });
+}
+
 function fmt(v, digits = 4) {
   if (typeof v !== "number") return "";
   if (v !== 0 && (Math.abs(v) >= 1e5 || Math.abs(v) < 1e-3)) return v.toExponential(2);
   return Number(v.toPrecision(digits + 2)).toString();
 }
 
+/** The fill rule of a frame: the nearer input's (from's for t < 1/2), as
+ * the service's filmstrip does. */
+function fillRuleAt(t) {
+  const shown = state.display[t < 0.5 ? "from" : "to"];
+  return shown ? shown.fillRule : "nonzero";
+}
+
 function buildPanel(o, viewBox) {
   const root = $("#panel-template").content.firstElementChild.cloneNode(true);
   const { method, result } = o;
+  const shape = isShapeResult(result);
   root.id = "panel-" + method;
   root.dataset.method = method;
-  const paths = result.frames.map((f) => f.curve.svg_d || curveToPath(f.curve));
-  const maxSi = Math.max(0, ...result.frames.map((f) => (f.metrics ? f.metrics.self_intersections : 0)));
-  const badFrames = result.frames.filter((f) => f.metrics && f.metrics.self_intersections > 0).length;
+  root.classList.toggle("compound", shape);
+  const paths = result.frames.map(framePath);
+  const metrics = result.frames.map(frameMetrics);
+  const maxSi = Math.max(0, ...metrics.map((m) => m.self_intersections || 0));
+  const badFrames = metrics.filter((m) => m.self_intersections > 0).length;
+  const apart = shape ? metrics.filter((m) => m.mutual_intersections > 0 || m.nesting_ok === false).length : 0;
   $(".method-name", root).textContent = method === "curvature" ? "Curvature blend" : "Linear (control points)";
   $(".summary", root).textContent = `${result.frames.length} frames · ${badFrames} self-intersecting` +
-                                    (badFrames ? ` (up to ${maxSi})` : "");
+                                    (badFrames ? ` (up to ${maxSi})` : "") +
+                                    (shape ? ` · ${apart} with contours crossing or a hole outside` : "");
   const stage = $(".stage", root);
   stage.setAttribute("viewBox", viewBox);
   stage.dataset.testid = "stage-" + method;
   $(".ghost.from", stage).setAttribute("d", paths[0]);
   $(".ghost.to", stage).setAttribute("d", paths[paths.length - 1]);
+  const current = $(".current", stage);
+  current.classList.add("fillable");
+  /* A compound frame's contours outlined one by one in their pair's colour. */
+  const slotPaths = shape ? result.frames[0].contours.map((_, k) =>
+    svgEl("path", { class: "slot", "data-slot": k, style: `stroke: ${slotColour(k)}` }, stage)) : [];
   /* Filmstrip: every frame, or FILM_MAX evenly chosen. */
   const film = $(".filmstrip", root);
   const n = paths.length, count = Math.min(n, FILM_MAX);
   const picks = [...new Set(Array.from({ length: count }, (_, i) => Math.round(i * (n - 1) / Math.max(1, count - 1))))];
   const thumbs = new Map();
   for (const i of picks) {
-    const f = result.frames[i];
+    const f = result.frames[i], m = metrics[i];
     const svg = svgEl("svg", { viewBox, preserveAspectRatio: "xMidYMid meet", "data-frame": i,
-                               "data-si": f.metrics ? f.metrics.self_intersections : "" }, film);
+                               "data-si": f.metrics ? m.self_intersections : "" }, film);
     svgEl("title", {}, svg).textContent = `frame ${i}, t = ${fmt(f.t)}` +
-      (f.metrics ? `, ${f.metrics.self_intersections} self-intersections` : "");
-    svgEl("path", { d: paths[i] }, svg);
-    if (f.metrics && f.metrics.self_intersections > 0) svg.classList.add("bad");
+      (f.metrics ? `, ${m.self_intersections} self-intersections` : "") +
+      (shape && f.metrics ? `, ${m.mutual_intersections} crossings between contours` +
+                            (m.nesting_ok ? "" : ", a hole outside its contour") : "");
+    svgEl("path", { d: paths[i], class: "fillable", "fill-rule": fillRuleAt(f.t) }, svg);
+    if (shape)
+      f.contours.forEach((c, k) => c && svgEl("path", { d: curveToPath(c), class: "slot", "data-slot": k,
+                                                        style: `stroke: ${slotColour(k)}` }, svg));
+    if (frameIsBad(m)) svg.classList.add("bad");
     svg.addEventListener("click", () => { stop(); setT(f.t); });
     thumbs.set(i, svg);
   }
-  /* Metrics of every frame; self-intersecting rows stand out. */
+  /* Metrics of every frame; frames drawn wrong stand out. */
   const tbody = $("tbody", root), rows = [];
   const tableFrames = result.frames.length <= 2000 ? result.frames : null;
   if (tableFrames) {
     const frag = document.createDocumentFragment();
     tableFrames.forEach((f, i) => {
-      const m = f.metrics || {};
+      const m = metrics[i];
       const tr = document.createElement("tr");
       tr.dataset.frame = i;
-      for (const v of [i, fmt(f.t), fmt(m.length), fmt(m.max_abs_kappa), fmt(m.bending_energy),
-                       m.self_intersections ?? "", fmt(m.closure_gap)]) {
+      const cells = [i, fmt(f.t), fmt(m.length), fmt(m.max_abs_kappa), fmt(m.bending_energy),
+                     m.self_intersections ?? "", fmt(m.closure_gap)];
+      if (shape) cells.push(m.mutual_intersections ?? "", m.nesting_ok === undefined ? "" : m.nesting_ok ? "yes" : "no");
+      for (const v of cells) {
         const td = document.createElement("td");
         td.textContent = v;
         tr.appendChild(td);
       }
-      if (m.self_intersections > 0) tr.classList.add("bad");
+      if (frameIsBad(m)) tr.classList.add("bad");
       tr.addEventListener("click", () => { stop(); setT(f.t); });
       rows.push(tr);
       frag.appendChild(tr);
@@ -473,36 +586,62 @@ function buildPanel(o, viewBox) {
   } else {
     $(".metrics-details summary", root).textContent = `Per-frame metrics (${result.frames.length} frames: download JSON for all)`;
   }
-  return { root, method, result, paths, stage, thumbs, rows, cache: new Map(), current: -1, request: o.request };
+  return { root, method, result, shape, paths, metrics, stage, slotPaths, thumbs, rows, cache: new Map(),
+           current: -1, request: o.request };
 }
 
-function framePoints(panel, i) {
-  let pts = panel.cache.get(i);
+const SAMPLES = 240;
+
+/** Points of slot k of frame i (k = 0 for a single curve), at equal
+ * arc-length fractions; a slot absent in frame i takes its partner frame
+ * j's contour collapsed to a point. */
+function framePoints(panel, i, k, j) {
+  const key = `${i}/${k}`;
+  let pts = panel.cache.get(key);
   if (!pts) {
-    pts = samplePoints(panel.result.frames[i].curve, 240);
-    panel.cache.set(i, pts);
+    const f = panel.result.frames[i];
+    if (!panel.shape) pts = samplePoints(f.curve, SAMPLES);
+    else if (f.contours[k]) pts = slotPoints(f.contours[k], null, SAMPLES);
+    else if (panel.result.frames[j].contours[k]) pts = slotPoints(null, panel.result.frames[j].contours[k], SAMPLES);
+    else pts = null;
+    panel.cache.set(key, pts);
   }
   return pts;
 }
 
-/** The path of a panel at time t: the frame's own path at a frame time,
- * else a blend of the two frames around t at equal arc-length fractions. */
-function pathAt(panel, t) {
-  const frames = panel.result.frames, n = frames.length;
-  let i = 0;
-  while (i < n - 2 && t > frames[i + 1].t) i++;
-  for (const j of [i, Math.min(i + 1, n - 1)])
-    if (Math.abs(frames[j].t - t) < 1e-9) return { d: panel.paths[j], frame: j, exact: true };
-  const a = framePoints(panel, i), b = framePoints(panel, i + 1);
-  const f = (t - frames[i].t) / (frames[i + 1].t - frames[i].t || 1);
-  const closed = frames[i].curve.closed;
+function blendPath(a, b, f, closed) {
   const end = closed ? a.length - 1 : a.length;
   let d = "";
   for (let j = 0; j < end; j++) {
     const x = a[j][0] + f * (b[j][0] - a[j][0]), y = a[j][1] + f * (b[j][1] - a[j][1]);
     d += `${j ? "L" : "M"}${x.toFixed(5)},${y.toFixed(5)}`;
   }
-  return { d: closed ? d + "Z" : d, frame: f < 0.5 ? i : i + 1, exact: false };
+  return closed ? d + "Z" : d;
+}
+
+/** The path of a panel at time t: the frame's own path at a frame time,
+ * else a blend of the two frames around t at equal arc-length fractions
+ * (slot by slot for compound shapes). `slots` has each slot's path. */
+function pathAt(panel, t) {
+  const frames = panel.result.frames, n = frames.length;
+  let i = 0;
+  while (i < n - 2 && t > frames[i + 1].t) i++;
+  for (const j of [i, Math.min(i + 1, n - 1)])
+    if (Math.abs(frames[j].t - t) < 1e-9) {
+      const slots = panel.shape ? frames[j].contours.map((c) => (c ? curveToPath(c) : "")) : null;
+      return { d: panel.paths[j], slots, frame: j, exact: true };
+    }
+  const f = (t - frames[i].t) / (frames[i + 1].t - frames[i].t || 1);
+  const frame = f < 0.5 ? i : i + 1;
+  if (!panel.shape) {
+    const d = blendPath(framePoints(panel, i, 0), framePoints(panel, i + 1, 0), f, frames[i].curve.closed);
+    return { d, slots: null, frame, exact: false };
+  }
+  const slots = frames[i].contours.map((_, k) => {
+    const a = framePoints(panel, i, k, i + 1), b = framePoints(panel, i + 1, k, i);
+    return a && b ? blendPath(a, b, f, true) : "";
+  });
+  return { d: slots.join(""), slots, frame, exact: false };
 }
 
 function setT(t) {
@@ -514,8 +653,10 @@ function setT(t) {
     const at = pathAt(p, state.t);
     const cur = $(".current", p.stage);
     cur.setAttribute("d", at.d);
+    cur.setAttribute("fill-rule", fillRuleAt(state.t));
     cur.dataset.frame = at.exact ? String(at.frame) : "";
-    const f = p.result.frames[at.frame], m = f.metrics || {};
+    if (at.slots) p.slotPaths.forEach((el, k) => el.setAttribute("d", at.slots[k]));
+    const m = p.metrics[at.frame];
     const root = p.root;
     $(".m-length", root).textContent = fmt(m.length);
     $(".m-kappa", root).textContent = fmt(m.max_abs_kappa);
@@ -525,7 +666,14 @@ function setT(t) {
     si.classList.toggle("bad", m.self_intersections > 0);
     si.dataset.testid = "si-" + p.method;
     $(".m-gap", root).textContent = fmt(m.closure_gap);
-    p.stage.classList.toggle("bad", m.self_intersections > 0);
+    if (p.shape) {
+      const mi = $(".m-mutual", root), nest = $(".m-nesting", root);
+      mi.textContent = m.mutual_intersections ?? "";
+      mi.classList.toggle("bad", m.mutual_intersections > 0);
+      nest.textContent = m.nesting_ok === undefined ? "" : m.nesting_ok ? "yes" : "no";
+      nest.classList.toggle("bad", m.nesting_ok === false);
+    }
+    p.stage.classList.toggle("bad", frameIsBad(m));
     if (p.current !== at.frame) {
       if (p.rows[p.current]) p.rows[p.current].classList.remove("current");
       if (p.thumbs.get(p.current)) p.thumbs.get(p.current).classList.remove("current");
@@ -542,6 +690,10 @@ function setT(t) {
 /** Fetch the paper-style plot of kappa_t(s) for a subset of the frames. */
 async function loadPlot(panel) {
   const div = $(".plot", panel.root);
+  if (panel.shape) {
+    div.textContent = "The curvature plot is drawn for single curves; see each contour's metrics in the JSON download.";
+    return;
+  }
   const frames = panel.result.frames, n = frames.length, count = Math.min(n, PLOT_MAX);
   const times = [...new Set(Array.from({ length: count }, (_, i) => frames[Math.round(i * (n - 1) / Math.max(1, count - 1))].t))];
   const { include, metrics, frames: _f, ...rest } = panel.request;
@@ -669,12 +821,17 @@ function init() {
   $("#pick-matches").addEventListener("click", () => {
     if (state.picking) { stopPicking(); renderEditor(); return; }
     if (state.drawing) toggleDraw(state.drawing);
+    if (isCompound()) {
+      $("#editor-hint").textContent = "Picked pairs match points of single curves; the contours of compound shapes are paired by the service (see the colours after Morph).";
+      return;
+    }
     state.picking = true;
     $("#editor").classList.add("picking");
     $("#pick-matches").textContent = "Stop picking";
     $("#editor-hint").textContent = "Click a point on the from curve, then its partner on the to curve.";
   });
   $("#clear-matches").addEventListener("click", () => { state.matches = []; state.pending = null; renderEditor(); });
+  $("#outline-only").addEventListener("change", (e) => document.body.classList.toggle("outlines", e.target.checked));
   $("#morph").addEventListener("click", runMorph);
   $("#cancel").addEventListener("click", () => state.controller && state.controller.abort());
   $("#scrub").addEventListener("input", (e) => { stop(); setT(Number(e.target.value) / state.steps); });

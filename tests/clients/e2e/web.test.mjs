@@ -4,85 +4,15 @@
 // what the page shows (frame count, self-intersection counts, drawn
 // paths) is what the API answered; scrub to t = 1/2 and keep a screenshot
 // under build/. Any console error fails the test.
-import { test, before, after } from "node:test";
+import { test } from "node:test";
 import assert from "node:assert/strict";
 import fs from "node:fs";
-import os from "node:os";
 import path from "node:path";
-import { chromium } from "playwright-core";
-import { startDaemon, ROOT } from "../lib/daemon.mjs";
+import { useBrowser, openPage as open, waitForEditor, morphAndWait, answerFor, setScrub, screenPoint,
+         ARTIFACTS } from "./harness.mjs";
 
-const ARTIFACTS = path.join(ROOT, "build", "clients-e2e");
-const FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
-               "--disable-background-networking", "--disable-component-update", "--disable-sync"];
-
-let daemon, context, profile;
-before(async () => {
-  fs.mkdirSync(ARTIFACTS, { recursive: true });
-  daemon = await startDaemon();
-  profile = fs.mkdtempSync(path.join(os.tmpdir(), "kmorph-chromium-"));
-  /* A persistent context is how Playwright takes a fresh --user-data-dir. */
-  context = await chromium.launchPersistentContext(profile, {
-    executablePath: "/usr/bin/chromium", headless: true, args: FLAGS, timeout: 60000,
-    viewport: { width: 1280, height: 1000 },
-  });
-});
-after(async () => {
-  if (context) await context.close();
-  if (daemon) await daemon.stop();
-  if (profile) fs.rmSync(profile, { recursive: true, force: true });
-});
-
-/** A fresh page that records console errors, page errors and the JSON
- * answers of POST /v1/morph and /v1/jobs/{id}/result. */
-async function openPage() {
-  const page = await context.newPage();
-  const errors = [], morphs = [];
-  page.on("console", (m) => { if (m.type() === "error") errors.push(m.text()); });
-  page.on("pageerror", (e) => errors.push("page error: " + e.message));
-  /* the handlers below read bodies asynchronously: morphAndWait awaits
-   * them, or a test could look at `morphs` before the answer is in */
-  page.kmPending = [];
-  page.on("response", (r) => page.kmPending.push((async () => {
-    const u = new URL(r.url());
-    const isMorph = u.pathname === "/v1/morph" && r.request().method() === "POST";
-    const isResult = /^\/v1\/jobs\/[0-9a-f]+\/result$/.test(u.pathname);
-    if ((isMorph || isResult) && r.status() === 200 && /json/.test(r.headers()["content-type"] || "")) {
-      try { morphs.push({ request: isMorph ? JSON.parse(r.request().postData()) : null, result: await r.json() }); }
-      catch { /* page gone */ }
-    }
-  })()));
-  await page.goto(daemon.url + "/", { waitUntil: "load" });
-  await page.waitForSelector("body[data-ready='1']", { timeout: 10000 });
-  return { page, errors, morphs };
-}
-
-async function waitForEditor(page) {
-  await page.waitForFunction(() => document.querySelectorAll("#editor path.from, #editor path.to").length === 2,
-                             null, { timeout: 10000 });
-}
-
-async function morphAndWait(page, count) {
-  await page.click("#morph");
-  await page.waitForFunction((n) => document.querySelectorAll("#panels .panel").length === n &&
-                                    !document.querySelector("#morph").disabled, count, { timeout: 60000 });
-  await Promise.all(page.kmPending);
-}
-
-/** The JSON answer of the page's morph with this method and frame count. */
-function answerFor(morphs, method, frames) {
-  const hits = morphs.filter((m) => m.result.method === method && m.result.frames.length === frames &&
-                                    m.result.frames.every((f) => f.curve.svg_d));
-  assert.ok(hits.length >= 1, `no ${method} answer with ${frames} frames among ${morphs.length}`);
-  return hits[hits.length - 1];
-}
-
-async function setScrub(page, t) {
-  await page.$eval("#scrub", (el, t) => {
-    el.value = String(Math.round(t * Number(el.max)));
-    el.dispatchEvent(new Event("input", { bubbles: true }));
-  }, t);
-}
+const env = useBrowser();
+const openPage = (query) => open(env, query);
 
 test("the spiral example morphed both ways shows exactly what the API returned", async () => {
   const { page, errors, morphs } = await openPage();
@@ -217,15 +147,6 @@ test("drawing by clicking control points makes a points curve the service fits",
   assert.deepEqual(errors, []);
   await page.close();
 });
-
-/** Screen coordinates of the point at arc-length fraction f of an editor curve. */
-function screenPoint(page, which, f) {
-  return page.$eval(`#editor path.${which}`, (p, f) => {
-    const q = p.getPointAtLength(f * p.getTotalLength());
-    const m = p.ownerSVGElement.getScreenCTM();
-    return { x: q.x * m.a + q.y * m.c + m.e, y: q.x * m.b + q.y * m.d + m.f };
-  }, f);
-}
 
 test("picked match pairs and the options reach the service, and the result honours the matches", async () => {
   const { page, errors, morphs } = await openPage();
