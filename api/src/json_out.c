@@ -7,8 +7,8 @@
  *
  * Numbers are printed here, not by cJSON: cJSON 1.7.15 prints %1.15g when
  * that reads back within DBL_EPSILON *relative*, which loses the last bit
- * (0.1 + 0.2 comes out as 0.3). We print the shortest of %.15g, %.16g and
- * %.17g that reads back exactly and hand cJSON the text as a raw item.
+ * (0.1 + 0.2 comes out as 0.3). We print the shortest decimal that reads
+ * back exactly (num_print.c) and hand cJSON the text as a raw item.
  */
 #include <math.h>
 #include <stdio.h>
@@ -17,14 +17,12 @@
 
 #include "internal.h"
 #include "km/alloc.h"
+#include "num_print.h"
 #include "svg.h"
 
 cJSON *api__number(double v) {
-  char buf[40];
-  for (int digits = 15; digits <= 17; digits++) {
-    snprintf(buf, sizeof buf, "%.*g", digits, v);
-    if (digits == 17 || strtod(buf, NULL) == v) break;
-  }
+  char buf[API_NUM_PRINT_MAX];
+  api__num_print(buf, v);
   return cJSON_CreateRaw(buf);
 }
 

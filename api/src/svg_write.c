@@ -11,9 +11,9 @@
  * whose numerator is a polynomial of degree d + 3 in Bernstein form; the
  * largest of its coefficients over the smallest weight bounds the distance
  * at equal parameter, hence the distance between the traces. Numbers are
- * printed in the shortest form that reads back within a share of the
- * tolerance; the error committed by printing is measured, not assumed, and
- * added to the reported bound.
+ * printed with the fewest digits that read back within a share of the
+ * tolerance (num_print.c); the error committed by printing is measured,
+ * not assumed, and added to the reported bound.
  */
 #include <float.h>
 #include <math.h>
@@ -24,6 +24,7 @@
 
 #include "km/alloc.h"
 #include "km/limits.h"
+#include "num_print.h"
 #include "svg.h"
 
 /* ---- string buffer ---------------------------------------------------- */
@@ -103,89 +104,16 @@ void api__svg_buf_escaped(api_svg_buf *b, const char *text) {
   }
 }
 
-/* Drop trailing zeros of a fixed-point string ("1.500" -> "1.5", "2." ->
- * "2") and the sign of a zero. */
-static void trim_fixed(char *s) {
-  char *dot = strchr(s, '.');
-  if (dot) {
-    char *end = s + strlen(s);
-    while (end > dot + 1 && end[-1] == '0') *--end = '\0';
-    if (end == dot + 1) *dot = '\0';
-  }
-  if (strcmp(s, "-0") == 0) memmove(s, s + 1, 2);
-}
-
-/* "2.50e-05" -> "2.5e-5", "1e+20" -> "1e20": same number, fewer bytes. */
-static void trim_exp(char *s) {
-  char *e = strchr(s, 'e');
-  if (!e) return;
-  /* "2.500e+01" -> "2.5e+01" first */
-  char *dot = strchr(s, '.');
-  if (dot && dot < e) {
-    char *z = e;
-    while (z > dot + 1 && z[-1] == '0') z--;
-    if (z == dot + 1) z = dot;
-    memmove(z, e, strlen(e) + 1);
-    e = z;
-  }
-  char *src = e + 1, *dst = e + 1;
-  if (*src == '+')
-    src++;
-  else if (*src == '-')
-    *dst++ = *src++;
-  while (*src == '0' && src[1]) src++;
-  memmove(dst, src, strlen(src) + 1);
-}
-
 void api__svg_buf_num(api_svg_buf *b, double x, double budget, double *err) {
-  char fx[64], ex[40];
+  char text[API_NUM_PRINT_MAX];
+  double got;
   if (!isfinite(x)) x = 0.0;
   if (!(budget >= 0.0) || !isfinite(budget)) budget = 0.0;
-  if (fabs(x) <= budget) {
-    api__svg_buf_put(b, "0");
-    if (err && fabs(x) > *err) *err = fabs(x);
-    return;
-  }
-  /* Shortest scientific form within budget (17 digits always round-trip).
-   * The search starts one digit below the estimate from the magnitudes,
-   * so it takes a try or two rather than seventeen. */
-  int p0 = 1, d0 = 0;
-  if (budget > 0) {
-    double est = ceil(log10(fabs(x) / budget));
-    p0 = est > 17 ? 17 : est < 2 ? 1 : (int)est - 1;
-    double dd = ceil(log10(0.5 / budget));
-    d0 = dd > 24 ? 24 : dd < 1 ? 0 : (int)dd - 1;
-  } else {
-    p0 = 15;
-    double mag = floor(log10(fabs(x)));
-    d0 = mag >= 15 ? 0 : mag < -9 ? 24 : (int)(15 - mag) - 1;
-  }
-  double gote = x;
-  for (int prec = p0; prec <= 17; prec++) {
-    snprintf(ex, sizeof ex, "%.*e", prec - 1, x);
-    gote = strtod(ex, NULL);
-    if (fabs(gote - x) <= budget) break;
-  }
-  trim_exp(ex);
-  /* Shortest fixed-point form, when it is not absurdly long; it reads
-   * better ("120.5" rather than "1.205e2"). */
-  double gotf = x;
-  bool have_fixed = false;
-  if (fabs(x) < 1e16) {
-    for (int dec = d0; dec <= 24; dec++) {
-      snprintf(fx, sizeof fx, "%.*f", dec, x);
-      gotf = strtod(fx, NULL);
-      if (fabs(gotf - x) <= budget || gotf == x) {
-        have_fixed = true;
-        break;
-      }
-    }
-    trim_fixed(fx);
-  }
-  bool use_fixed = have_fixed && strlen(fx) <= strlen(ex) + 2;
-  double got = use_fixed ? gotf : gote;
+  size_t n = api__num_print_within(text, x, budget, &got);
   if (err && fabs(got - x) > *err) *err = fabs(got - x);
-  api__svg_buf_put(b, use_fixed ? fx : ex);
+  if (!reserve(b, n)) return;
+  memcpy(b->s + b->len, text, n + 1);
+  b->len += n;
 }
 
 char *api__svg_buf_take(api_svg_buf *b) {

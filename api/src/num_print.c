@@ -1,0 +1,413 @@
+/* num_print.c - shortest round-trip decimals of doubles (Schubfach) and
+ * their layout as JSON and SVG numbers.
+ *
+ * DESIGN. A double v = c * 2^q lies in the interval of reals that round
+ * to it, [v - ulp/2, v + ulp/2] (half as far below at a power of two, the
+ * ends included when c is even). Schubfach (R. Giulietti, "The Schubfach
+ * way to render doubles", 2020) picks the decimal exponent k from q alone
+ * so that the interval scaled by 10^-k holds at most one multiple of ten
+ * and at least one integer: the shortest decimal is then the multiple of
+ * ten when there is one, else the integer nearest to v * 10^-k. The ends
+ * and v itself, scaled by 4 and by 10^-k, are computed with one 64 x 128
+ * bit product each against a table of 128-bit upper bounds of powers of
+ * ten (num_pow10.h, generated exactly by tools/gen_pow10_table.py), and
+ * rounded to odd: the lowest bit says "inexact", which is all the
+ * comparisons need. The product uses unsigned __int128 where the
+ * compiler has it (gcc, clang) and four 32-bit products elsewhere.
+ *
+ * The SVG printer rounds the shortest digits to fewer significant
+ * digits until the result lies within the budget, reading each
+ * candidate back by one correctly rounded multiplication or division
+ * (both operands exact doubles: Clinger's fast path) and by strtod only
+ * where that path does not apply.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "num_pow10.h"
+#include "num_print.h"
+
+/* ---- 64 x 64 -> 128 bit products -------------------------------------- */
+
+typedef struct u128 {
+  uint64_t hi, lo;
+} u128;
+
+static inline u128 mul64(uint64_t a, uint64_t b) {
+#if defined(__SIZEOF_INT128__)
+  unsigned __int128 p = (unsigned __int128)a * b;
+  return (u128){(uint64_t)(p >> 64), (uint64_t)p};
+#else
+  uint64_t a0 = (uint32_t)a, a1 = a >> 32, b0 = (uint32_t)b, b1 = b >> 32;
+  uint64_t p00 = a0 * b0, p01 = a0 * b1, p10 = a1 * b0, p11 = a1 * b1;
+  uint64_t mid = (p00 >> 32) + (uint32_t)p01 + (uint32_t)p10;
+  return (u128){p11 + (p01 >> 32) + (p10 >> 32) + (mid >> 32),
+                (mid << 32) | (uint32_t)p00};
+#endif
+}
+
+/* floor(cp * g / 2^128) with its lowest bit set when the product is not
+ * an integer (g is an upper bound, hence "> 1" rather than "!= 0"). */
+static inline uint64_t round_to_odd(const uint64_t g[2], uint64_t cp) {
+  u128 low = mul64(cp, g[1]);
+  u128 high = mul64(cp, g[0]);
+  uint64_t mid = high.lo + low.hi;
+  uint64_t top = high.hi + (mid < high.lo);
+  return top | (mid > 1);
+}
+
+/* floor(x / 2^s) for negative x too, without relying on how >> treats
+ * negative numbers. */
+static inline int floor_shift(int64_t x, int s) {
+  return (int)(x >= 0 ? x >> s : -((-x + ((int64_t)1 << s) - 1) >> s));
+}
+
+/* floor(log10(2^q)), floor(log10(3/4 2^q)) and floor(log2(10^k)) for the
+ * exponents of doubles (checked exactly over the whole range when the
+ * constants were chosen). */
+static inline int floor_log10_pow2(int q) {
+  return floor_shift((int64_t)q * 1262611, 22);
+}
+static inline int floor_log10_three_quarters_pow2(int q) {
+  return floor_shift((int64_t)q * 1262611 - 524031, 22);
+}
+static inline int floor_log2_pow10(int k) {
+  return floor_shift((int64_t)k * 1741647, 19);
+}
+
+static const uint64_t pow10_u64[20] = {1u,
+                                       10u,
+                                       100u,
+                                       1000u,
+                                       10000u,
+                                       100000u,
+                                       1000000u,
+                                       10000000u,
+                                       100000000u,
+                                       1000000000u,
+                                       10000000000u,
+                                       100000000000u,
+                                       1000000000000u,
+                                       10000000000000u,
+                                       100000000000000u,
+                                       1000000000000000u,
+                                       10000000000000000u,
+                                       100000000000000000u,
+                                       1000000000000000000u,
+                                       10000000000000000000u};
+
+static int count_digits(uint64_t d) {
+  int n = 1;
+  while (n < 20 && d >= pow10_u64[n]) n++;
+  return n;
+}
+
+static api_decimal normalised(uint64_t digits, int exp10) {
+  while (digits % 10 == 0) {
+    digits /= 10;
+    exp10++;
+  }
+  return (api_decimal){digits, exp10, count_digits(digits)};
+}
+
+/* ---- the shortest decimal ---------------------------------------------- */
+
+api_decimal api__shortest_decimal(double v) {
+  uint64_t bits;
+  memcpy(&bits, &v, sizeof bits);
+  uint64_t fraction = bits & (((uint64_t)1 << 52) - 1);
+  int biased = (int)((bits >> 52) & 0x7ff);
+  uint64_t c;
+  int q;
+  if (biased != 0) {
+    c = fraction | ((uint64_t)1 << 52);
+    q = biased - 1075;
+    /* an integer below 2^53 is its own shortest decimal */
+    if (q <= 0 && q >= -52 && (c & (((uint64_t)1 << -q) - 1)) == 0)
+      return normalised(c >> -q, 0);
+  } else {
+    c = fraction;
+    q = -1074;
+  }
+  bool even = (c & 1) == 0;
+  bool lower_closer = fraction == 0 && biased > 1;
+  uint64_t cbl = 4 * c - 2 + (lower_closer ? 1 : 0);
+  uint64_t cb = 4 * c, cbr = 4 * c + 2;
+  int k =
+      lower_closer ? floor_log10_three_quarters_pow2(q) : floor_log10_pow2(q);
+  int h = q + floor_log2_pow10(-k) + 1;
+  const uint64_t *g = api_pow10_g[-k - API_POW10_K_MIN];
+  uint64_t vbl = round_to_odd(g, cbl << h);
+  uint64_t vb = round_to_odd(g, cb << h);
+  uint64_t vbr = round_to_odd(g, cbr << h);
+  uint64_t lower = vbl + (even ? 0 : 1), upper = vbr - (even ? 0 : 1);
+  uint64_t s = vb / 4;
+  if (s >= 10) {
+    /* a multiple of ten inside the interval is shorter; at most one of
+     * the two neighbours of v * 10^-k among them can be inside */
+    uint64_t sp = s / 10;
+    bool below_inside = lower <= 40 * sp, above_inside = 40 * sp + 40 <= upper;
+    if (below_inside != above_inside)
+      return normalised(sp + (above_inside ? 1 : 0), k + 1);
+  }
+  bool below_inside = lower <= 4 * s, above_inside = 4 * s + 4 <= upper;
+  if (below_inside != above_inside)
+    return normalised(s + (above_inside ? 1 : 0), k);
+  /* both neighbours are inside: the nearer one, the even one on a tie */
+  uint64_t mid = 4 * s + 2;
+  bool up = vb > mid || (vb == mid && (s & 1) != 0);
+  return normalised(s + (up ? 1 : 0), k);
+}
+
+/* ---- layout --------------------------------------------------------- */
+
+static const char two_digits[201] = "00010203040506070809"
+                                    "10111213141516171819"
+                                    "20212223242526272829"
+                                    "30313233343536373839"
+                                    "40414243444546474849"
+                                    "50515253545556575859"
+                                    "60616263646566676869"
+                                    "70717273747576777879"
+                                    "80818283848586878889"
+                                    "90919293949596979899";
+
+/* The n decimal digits of d into out[0 .. n). */
+static void put_digits(char *out, uint64_t d, int n) {
+  char *p = out + n;
+  while (d >= 100) {
+    unsigned r = (unsigned)(d % 100);
+    d /= 100;
+    p -= 2;
+    memcpy(p, &two_digits[2 * r], 2);
+  }
+  if (d >= 10) {
+    p -= 2;
+    memcpy(p, &two_digits[2 * d], 2);
+  } else {
+    *--p = (char)('0' + d);
+  }
+}
+
+static int exponent_length(int e) {
+  int a = e < 0 ? -e : e;
+  return (e < 0 ? 1 : 0) + (a >= 100 ? 3 : a >= 10 ? 2 : 1);
+}
+
+/* Characters of the fixed form of d (sign excluded). */
+static int fixed_length(api_decimal d) {
+  int lead = d.exp10 + d.ndigits - 1;
+  if (d.exp10 >= 0) return d.ndigits + d.exp10;
+  if (lead >= 0) return d.ndigits + 1;
+  return 1 - lead + d.ndigits;
+}
+
+static int scientific_length(api_decimal d) {
+  int lead = d.exp10 + d.ndigits - 1;
+  return d.ndigits + (d.ndigits > 1 ? 1 : 0) + 1 + exponent_length(lead);
+}
+
+static size_t put_fixed(char *out, api_decimal d) {
+  int lead = d.exp10 + d.ndigits - 1;
+  if (d.exp10 >= 0) {
+    put_digits(out, d.digits, d.ndigits);
+    memset(out + d.ndigits, '0', (size_t)d.exp10);
+    return (size_t)(d.ndigits + d.exp10);
+  }
+  if (lead >= 0) {
+    /* digits, then the point moved into place */
+    put_digits(out + 1, d.digits, d.ndigits);
+    memmove(out, out + 1, (size_t)lead + 1);
+    out[lead + 1] = '.';
+    return (size_t)d.ndigits + 1;
+  }
+  int zeros = -lead - 1;
+  out[0] = '0';
+  out[1] = '.';
+  memset(out + 2, '0', (size_t)zeros);
+  put_digits(out + 2 + zeros, d.digits, d.ndigits);
+  return (size_t)(2 + zeros + d.ndigits);
+}
+
+static size_t put_scientific(char *out, api_decimal d) {
+  int lead = d.exp10 + d.ndigits - 1;
+  size_t n;
+  put_digits(out + 1, d.digits, d.ndigits);
+  out[0] = out[1];
+  if (d.ndigits > 1) {
+    out[1] = '.';
+    n = (size_t)d.ndigits + 1;
+  } else {
+    n = 1;
+  }
+  out[n++] = 'e';
+  if (lead < 0) {
+    out[n++] = '-';
+    lead = -lead;
+  }
+  int len = lead >= 100 ? 3 : lead >= 10 ? 2 : 1;
+  put_digits(out + n, (uint64_t)lead, len);
+  return n + (size_t)len;
+}
+
+/* sign and d: fixed when its leading digit is below 10^fixed_below and
+ * it is an integer below 10^integers_below or at most slack characters
+ * longer than the scientific form. */
+static size_t layout(char *out, bool negative, api_decimal d, int slack,
+                     int integers_below, int fixed_below) {
+  size_t n = 0;
+  if (negative) out[n++] = '-';
+  int lead = d.exp10 + d.ndigits - 1;
+  bool fixed;
+  if (lead >= fixed_below)
+    fixed = false;
+  else if (d.exp10 >= 0 && lead < integers_below)
+    fixed = true;
+  else
+    fixed = fixed_length(d) <= scientific_length(d) + slack;
+  n += fixed ? put_fixed(out + n, d) : put_scientific(out + n, d);
+  out[n] = '\0';
+  return n;
+}
+
+size_t api__decimal_print(char *out, bool negative, api_decimal d) {
+  return layout(out, negative, d, 0, 15, 21);
+}
+
+size_t api__num_print(char *out, double v) {
+  if (!isfinite(v)) {
+    memcpy(out, "null", 5);
+    return 4;
+  }
+  bool negative = signbit(v) != 0;
+  if (v == 0) {
+    size_t n = 0;
+    if (negative) out[n++] = '-';
+    out[n++] = '0';
+    out[n] = '\0';
+    return n;
+  }
+  return api__decimal_print(out, negative, api__shortest_decimal(fabs(v)));
+}
+
+/* ---- within a budget ------------------------------------------------ */
+
+/* The double nearest to digits * 10^exp10, by one correctly rounded
+ * operation on exact operands where it applies; false elsewhere. */
+static bool exact_value(uint64_t digits, int exp10, double *out) {
+  static const double p10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                 1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+  if (digits > ((uint64_t)1 << 53) || exp10 < -22 || exp10 > 22) return false;
+  double m = (double)digits;
+  *out = exp10 >= 0 ? m * p10[exp10] : m / p10[-exp10];
+  return true;
+}
+
+/* The sign of a - d, exactly: the product a * 10^-exp10 is split into
+ * its rounded value and its rounding error (fma), both exact doubles.
+ * UNKNOWN_SIDE where that does not apply (d beyond 2^53, or a power of
+ * ten that is no exact double). */
+#define UNKNOWN_SIDE 2
+static int side_of_decimal(double a, api_decimal d) {
+  static const double p10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                 1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+  if (d.digits <= ((uint64_t)1 << 53) && d.exp10 <= 0 && d.exp10 >= -22) {
+    double scale = p10[-d.exp10];
+    double product = a * scale;
+    double error = fma(a, scale, -product);
+    double m = (double)d.digits;
+    double diff = (product - m) + error;
+    return diff > 0 ? 1 : diff < 0 ? -1 : 0;
+  }
+  if (d.digits <= ((uint64_t)1 << 53) && d.exp10 > 0 && d.exp10 <= 22) {
+    /* m * 10^e against a: a / 10^e compared through its remainder */
+    double scale = p10[d.exp10];
+    double m = (double)d.digits;
+    double product = m * scale;
+    double error = fma(m, scale, -product);
+    double diff = (a - product) - error;
+    return diff > 0 ? 1 : diff < 0 ? -1 : 0;
+  }
+  return UNKNOWN_SIDE;
+}
+
+/* The double digits * 10^exp10 reads back as; false only if it is not
+ * finite. */
+static bool candidate_value(uint64_t digits, int exp10, double *out) {
+  if (exact_value(digits, exp10, out)) return true;
+  char text[API_NUM_PRINT_MAX];
+  layout(text, false, normalised(digits, exp10), 0, 0, 0);
+  *out = strtod(text, NULL);
+  return isfinite(*out);
+}
+
+/* a (> 0, with shortest decimal d) rounded to p < d.ndigits significant
+ * digits, p = 0 meaning the decade above a (0.00087 to 0.001), as the
+ * correctly rounded %.*e would: the shortest digits round the same way
+ * as a itself except on a tie of those digits, where a lies on either
+ * side; its side is found exactly, an exact tie goes to the even
+ * neighbour. *value receives the double the result reads back as; false
+ * when it is zero or not finite. */
+static bool rounded_to(double a, api_decimal d, int p, api_decimal *out,
+                       double *value) {
+  int drop = d.ndigits - p;
+  uint64_t unit = pow10_u64[drop];
+  uint64_t r = d.digits / unit, rest = d.digits % unit;
+  int exp10 = d.exp10 + drop;
+  uint64_t cand = r;
+  if (rest > unit - rest) {
+    cand = r + 1;
+  } else if (rest == unit - rest) {
+    int side = side_of_decimal(a, d);
+    if (side == UNKNOWN_SIDE) {
+      /* the neighbour whose double is nearer */
+      double below;
+      if (r > 0 && candidate_value(r, exp10, &below) &&
+          candidate_value(r + 1, exp10, value) &&
+          fabs(below - a) < fabs(*value - a)) {
+        *value = below;
+        *out = normalised(r, exp10);
+        return true;
+      }
+      cand = r + 1;
+    } else {
+      cand = r + (side > 0 || (side == 0 && r % 2 != 0) ? 1 : 0);
+    }
+  }
+  if (cand == 0 || !candidate_value(cand, exp10, value)) return false;
+  *out = normalised(cand, exp10);
+  return true;
+}
+
+size_t api__num_print_within(char *out, double x, double budget, double *got) {
+  double a = fabs(x);
+  bool negative = x < 0;
+  if (a <= budget) {
+    out[0] = '0';
+    out[1] = '\0';
+    *got = 0.0;
+    return 1;
+  }
+  api_decimal d = api__shortest_decimal(a);
+  int lead = d.exp10 + d.ndigits - 1;
+  int start = d.ndigits;
+  if (budget > 0) {
+    /* digits down to about the budget's decade, one less for the slack
+     * of the estimate */
+    start = lead - floor_log10_pow2(ilogb(budget)) - 1;
+    if (start < 0) start = 0;
+  }
+  for (int p = start; p < d.ndigits; p++) {
+    api_decimal c;
+    double value;
+    if (rounded_to(a, d, p, &c, &value) && fabs(value - a) <= budget) {
+      *got = negative ? -value : value;
+      return layout(out, negative, c, 2, 0, 16);
+    }
+  }
+  *got = x;
+  return layout(out, negative, d, 2, 0, 16);
+}

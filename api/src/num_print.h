@@ -1,0 +1,57 @@
+/* num_print.h - doubles as the shortest decimal that reads back exactly,
+ * and as the shortest decimal within a stated distance, printed into a
+ * caller's buffer without the C library's formatted output.
+ *
+ * Thread-safe and allocation-free: everything is on the caller's stack
+ * and in a constant table.
+ */
+#ifndef KMAPI_NUM_PRINT_H
+#define KMAPI_NUM_PRINT_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+/* Bytes of the buffers the printers below write into, the terminating
+ * NUL included. A JSON number is at most 24 characters (sign, 17 digits,
+ * point, "e-308"); an SVG number, which prefers the fixed form by up to
+ * two characters, at most 26. */
+#define API_NUM_PRINT_MAX 32
+
+/* A positive decimal digits * 10^exp10 with ndigits digits, the last one
+ * non-zero (digits has no trailing zeros). */
+typedef struct api_decimal {
+  uint64_t digits;
+  int exp10;
+  int ndigits;
+} api_decimal;
+
+/* The shortest decimal that reads back as v (round to nearest, ties to
+ * even, as strtod reads); among the shortest ones the nearest to v. v
+ * must be finite and greater than zero. */
+api_decimal api__shortest_decimal(double v);
+
+/* v as a JSON number in its shortest round-trip form, NUL-terminated, in
+ * out[0 .. API_NUM_PRINT_MAX), at most 24 characters. Integers below 1e15
+ * are printed as integers (as %.15g would); others in the shorter of the
+ * fixed and the scientific form ("0.25", "1.5e-7", "2e300"), fixed on a
+ * tie. Negative zero is "-0".
+ * Returns the length. JSON has no infinities: callers check finiteness
+ * first, and a non-finite v prints as "null" rather than as garbage. */
+size_t api__num_print(char *out, double v);
+
+/* Write sign, digits * 10^exp10 into out as api__num_print lays it out;
+ * returns the length (at most 24 for ndigits <= 17 and exponents of
+ * doubles). */
+size_t api__decimal_print(char *out, bool negative, api_decimal d);
+
+/* The shortest decimal (fewest significant digits) within budget of x
+ * among x rounded to 1, 2, ... significant digits, printed for SVG path
+ * data: fixed ("120.5") below 1e16 unless it is more than two characters
+ * longer than the scientific form ("1.2e-7"; no '+' and no leading zeros
+ * in exponents); "0" when |x| <= budget. x must be finite, budget >= 0.
+ * *got receives the double the printed text reads back as. Returns the
+ * length (at most 26). */
+size_t api__num_print_within(char *out, double x, double budget, double *got);
+
+#endif
