@@ -15,16 +15,32 @@ km_usage_error() { echo "$km_prog: $*" >&2; echo "try '$km_prog -h'" >&2; exit 2
 command -v curl >/dev/null || km_die "curl is not installed"
 command -v jq >/dev/null || km_die "jq is not installed"
 
+# km_svg_document_path: the d attributes of every <path> of the SVG
+# document on stdin, joined into one compound path (transforms and other
+# elements are not applied).
+km_svg_document_path() {
+  tr '\n\r\t' '   ' | grep -o '<path[[:space:]][^>]*>' |
+    sed -n -e "s/.*[[:space:]]d[[:space:]]*=[[:space:]]*\"\([^\"]*\)\".*/\1/p" \
+           -e "s/.*[[:space:]]d[[:space:]]*=[[:space:]]*'\([^']*\)'.*/\1/p" | tr '\n' ' ' | sed 's/ *$//'
+}
+
 # km_curve ARG: a curve object (JSON) on stdout. ARG is an SVG path d
-# string ("M 0 0 L 10 0"), a JSON curve object ('{"type": ...}'), @FILE
-# with either of those, or @- for standard input. A file holding a
-# signature (or a /v1/signature answer) becomes a signature curve.
+# string ("M 0 0 L 10 0"; several subpaths make a compound shape), a JSON
+# curve object ('{"type": ...}', a shape among them), @FILE with either
+# of those or an SVG document (its <path>s together are the shape), or @-
+# for standard input. A file holding a signature (or a /v1/signature
+# answer) becomes a signature curve.
 km_curve() {
   local arg=$1 text
   case $arg in
     @-) text=$(cat) ;;
     @*) [ -r "${arg#@}" ] || km_usage_error "cannot read ${arg#@}"; text=$(cat -- "${arg#@}") ;;
     *) text=$arg ;;
+  esac
+  case $text in
+    "<"*|[[:space:]]*"<"*)
+      text=$(printf '%s' "$text" | km_svg_document_path)
+      [ -n "$text" ] || km_usage_error "the SVG document has no <path> with a d attribute" ;;
   esac
   if printf '%s' "$text" | jq -e 'type == "object"' >/dev/null 2>&1; then
     printf '%s' "$text" | jq -c '
@@ -80,6 +96,8 @@ km_morph_options='  -n FRAMES    number of evenly spaced frames (default 11)
   -m METHOD    curvature (default) or linear
   -b BLEND     turning (default) or paper
   -M MATCHES   auto, or pairs of arc-length fractions as JSON: [[0.2,0.3]]
+  -C PAIRS     shapes: pairs of contour indices as JSON, null for a contour
+               that vanishes or appears: [[0,0],[1,null]]
   -c CLOSURE   closed curves: auto, lsq, c0, c1, g2, none
   -a ANCHOR    placement: fit (default), start, centroid
   -O ORIENT    closed curves: auto, keep
@@ -87,24 +105,29 @@ km_morph_options='  -n FRAMES    number of evenly spaced frames (default 11)
   -g DEGREE    3 or 5
   -k           per-frame metrics (length, max |kappa|, self-intersections, ...)
   -d           include each frame'"'"'s SVG path data (svg_d)
+  -p           print one line per frame: t, a tab, the frame'"'"'s path data
+               (for shapes one M...Z per present contour; the pairing of
+               the contours goes to stderr)
   -l LAYOUT    answer in SVG: filmstrip, overlay, animate or curvature_plot
   -o FILE      write the answer to FILE (FILE.svg asks for SVG, filmstrip
                unless -l says otherwise) instead of standard output
   -r FILE      start from the morph request in FILE (JSON); options and
                curves given on the command line replace its fields
-FROM and TO are curves: an SVG path d string ("M 0 0 L 10 0 ..."), a JSON
-curve object, @FILE holding either (or a signature), or @- for stdin.'
+FROM and TO are curves: an SVG path d string ("M 0 0 L 10 0 ..."; several
+subpaths make a compound shape), a JSON curve object (a shape among them),
+@FILE holding either, an SVG document or a signature, or @- for stdin.'
 
 # km_morph_request ARGS...: parse the morph options and curves into the
 # request file $km_req; sets $km_out (output file or empty) and $km_svg
-# (1 when SVG is asked for).
+# (1 when SVG is asked for) and $km_paths (1 for -p).
 km_req=$km_tmp/request.json
 km_morph_request() {
   local opt base='{}' edits=() OPTIND=1
   km_out=
   km_svg=0
+  km_paths=0
   local layout=
-  while getopts ':hn:T:m:b:M:c:a:O:t:g:kdl:o:r:' opt; do
+  while getopts ':hn:T:m:b:M:C:c:a:O:t:g:kdpl:o:r:' opt; do
     case $opt in
       h) km_help; exit 0 ;;
       n) edits+=(--argjson n "$OPTARG" '.frames = $n | del(.times)') ;;
@@ -113,6 +136,7 @@ km_morph_request() {
       b) edits+=(--arg v "$OPTARG" '.blend = $v') ;;
       M) if [ "$OPTARG" = auto ]; then edits+=('.matches = "auto"')
          else edits+=(--argjson v "$OPTARG" '.matches = $v'); fi ;;
+      C) edits+=(--argjson v "$OPTARG" '.contour_matches = $v') ;;
       c) edits+=(--arg v "$OPTARG" '.closure = $v') ;;
       a) edits+=(--arg v "$OPTARG" '.anchor = $v') ;;
       O) edits+=(--arg v "$OPTARG" '.orient = $v') ;;
@@ -120,6 +144,7 @@ km_morph_request() {
       g) edits+=(--argjson v "$OPTARG" '.degree = $v') ;;
       k) edits+=('.metrics = true') ;;
       d) edits+=('.include = ((.include // []) + ["svg_d"] | unique)') ;;
+      p) km_paths=1; edits+=('.include = ((.include // []) + ["svg_d"] | unique)') ;;
       l) layout=$OPTARG ;;
       o) km_out=$OPTARG ;;
       r) [ -r "$OPTARG" ] || km_usage_error "cannot read $OPTARG"; base=$(cat -- "$OPTARG") ;;
@@ -139,7 +164,8 @@ km_morph_request() {
     km_usage_error "give two curves, FROM and TO (or none with -r)"
   fi
   jq -e 'has("from") and has("to")' "$km_req" >/dev/null || km_usage_error "FROM and TO curves are needed"
-  case $km_out in *.svg) [ -n "$layout" ] || layout=filmstrip ;; esac
+  case $km_out in *.svg) [ "$km_paths" = 1 ] || [ -n "$layout" ] || layout=filmstrip ;; esac
+  [ "$km_paths" = 1 ] && [ -n "$layout" ] && km_usage_error "-p prints path data lines; it cannot be combined with -l"
   [ -n "$layout" ] && { km_svg=1; edits+=(--arg l "$layout" '.format = "svg" | .svg = ((.svg // {}) + {layout: $l})'); }
   # Apply the edits one by one: each is [--arg name value ...] filter.
   local i=0 n=${#edits[@]} a=()
@@ -151,6 +177,20 @@ km_morph_request() {
          mv "$km_req.new" "$km_req"; a=(); i=$((i + 1)) ;;
     esac
   done
+}
+
+# km_emit_morph: a morph result as km_emit does, or with -p one "t<TAB>d"
+# line per frame and, for shapes, the pairing of the contours on stderr.
+km_emit_morph() {
+  if [ "$km_paths" = 1 ]; then
+    jq -r --arg p "$km_prog" 'select(has("contour_matches_used")) | .contour_matches_used |
+        map(if .[0] == null then "to \(.[1]) appears" elif .[1] == null then "from \(.[0]) vanishes"
+            else "from \(.[0]) -> to \(.[1])" end) | "\($p): contours: " + join(", ")' "$km_body" >&2
+    jq -r '.frames[] | "\(.t)\t\(if has("contours") then .svg_d else .curve.svg_d end)"' "$km_body" >"$km_body.lines" ||
+      km_die "the answer has no frames"
+    mv "$km_body.lines" "$km_body"
+  fi
+  km_emit
 }
 
 # km_emit: the last answer's body to $km_out or standard output.

@@ -104,7 +104,9 @@ def _morph_request(a):
         req["metrics"] = True
     if a.svg_d:
         req["include"] = sorted(set(req.get("include", []) + ["svg_d"]))
-    layout = a.layout or ("filmstrip" if a.output and a.output.endswith(".svg") else None)
+    if a.paths and a.layout:
+        raise SystemExit(_usage_error("-p prints path data lines; it cannot be combined with -l"))
+    layout = a.layout or ("filmstrip" if a.output and a.output.endswith(".svg") and not a.paths else None)
     if layout:
         req["format"] = "svg"
         req.setdefault("svg", {})["layout"] = layout

@@ -171,5 +171,84 @@ t_usage_errors() {
 }
 check "usage errors (missing curve, unknown option, not a curve) exit with status 2" t_usage_errors
 
+# ------------------------------------------------------ compound shapes
+# Real glyphs and icons of tests/fixtures/compound; what the scripts print
+# is checked by shape_ends.py, which parses the inputs itself.
+FIX=$km_root/tests/fixtures/compound
+PY=/usr/bin/python3
+[ -x "$PY" ] || PY=python3
+shape_d() { jq -r --arg id "$1" '(.glyphs // .icons)[] | select(.id == $id) | .d' "$FIX/$2.json"; }
+# Tolerance of the requests (a 100-unit em, a 24-unit icon box) and the
+# bound on the ends: the tolerance plus 2e-5 of the size for the sampling.
+GLYPH_TOL=0.01 GLYPH_BOUND=0.012 ICON_TOL=0.003 ICON_BOUND=0.0035
+
+# morph_ends NAME FROM TO TOL BOUND [OPTIONS...]: km-morph -p of the pair
+# through the checker.
+morph_ends() {
+  local name=$1 from=$2 to=$3 tol=$4 bound=$5; shift 5
+  "$bin/km-morph" -n 5 -p -t "$tol" "$@" "$from" "$to" >"$work/$name.lines" 2>"$work/$name.err" ||
+    { cat "$work/$name.err"; return 1; }
+  line=$(grep "^km-morph: contours: " "$work/$name.err") || { echo "no pairing on stderr"; cat "$work/$name.err"; return 1; }
+  "$PY" "$here/shape_ends.py" "$from" "$to" "$work/$name.lines" "$line" "$bound" 5
+}
+
+t_shape_pairs() {
+  for pair in "dejavu-serif/0 dejavu-serif/O glyphs" "dejavu-sans/O dejavu-sans/C glyphs" \
+              "dejavu-sans/i dejavu-sans/l glyphs" "mdi/circle-double mdi/target icons"; do
+    set -- $pair
+    jq -e --arg a "$1" --arg b "$2" 'any(.pairs[]; .from == $a and .to == $b)' "$FIX/pairs.json" >/dev/null ||
+      { echo "$1 -> $2 is not in pairs.json"; return 1; }
+    if [ "$3" = glyphs ]; then tol=$GLYPH_TOL bound=$GLYPH_BOUND; else tol=$ICON_TOL bound=$ICON_BOUND; fi
+    out=$(morph_ends pair "$(shape_d "$1" "$3")" "$(shape_d "$2" "$3")" "$tol" "$bound") || { echo "$1 -> $2: $out"; return 1; }
+    echo "$1 -> $2: $out"
+  done
+}
+check "km-morph -p of glyph and icon pairs (ring -> ring, O -> C, i -> l, 4 rings -> 3): ends are the inputs' contours, a valid pairing" t_shape_pairs
+
+t_shape_collapse() {
+  morph_ends oc "$(shape_d dejavu-sans/O glyphs)" "$(shape_d dejavu-sans/C glyphs)" $GLYPH_TOL $GLYPH_BOUND >/dev/null || return 1
+  grep -q "^km-morph: contours: .*from [0-9] vanishes" "$work/oc.err" || { cat "$work/oc.err"; return 1; }
+  # Two subpaths until t = 1, where the counter is a point and left out.
+  [ "$(awk -F '\t' '{ n = gsub(/M/, "M", $2); printf "%s ", n }' "$work/oc.lines")" = "2 2 2 2 1 " ]
+}
+check "km-morph -p of O -> C: the counter vanishes, absent from the last line only" t_shape_collapse
+
+t_shape_svg_file() {
+  # dice-3 as an icon file ships: its die and pips in two <path> elements.
+  d=$(shape_d mdi/dice-3 icons)
+  die=${d%%ZM*}Z
+  pips=M${d#*ZM}
+  printf '<?xml version="1.0"?>\n<svg xmlns="http://www.w3.org/2000/svg"\n viewBox="0 0 24 24">\n <path d="%s"/>\n <path fill="red"\n   d="%s" />\n</svg>\n' \
+    "$die" "$pips" >"$work/dice-3.svg"
+  to=$(shape_d mdi/dice-5 icons)
+  mine='[[0,0],[1,1],[2,2],[3,3],[null,4],[null,5]]'
+  "$bin/km-morph" -n 5 -p -t $ICON_TOL -C "$mine" "@$work/dice-3.svg" "$to" >"$work/dice.lines" 2>"$work/dice.err" ||
+    { cat "$work/dice.err"; return 1; }
+  line=$(grep "^km-morph: contours: " "$work/dice.err")
+  [ "$line" = "km-morph: contours: from 0 -> to 0, from 1 -> to 1, from 2 -> to 2, from 3 -> to 3, to 4 appears, to 5 appears" ] ||
+    { echo "pairing: $line"; return 1; }
+  "$PY" "$here/shape_ends.py" "$d" "$to" "$work/dice.lines" "$line" $ICON_BOUND 5
+}
+check "km-morph reads an SVG file's <path>s as one shape and honours -C contour matches (dice-3 -> dice-5)" t_shape_svg_file
+
+t_shape_job() {
+  from=$(shape_d mdi/circle-double icons) to=$(shape_d mdi/target icons)
+  "$bin/km-job" -q -i 0.05 -n 7 -p -t $ICON_TOL "$from" "$to" >"$work/job.lines" 2>"$work/job.err" || { cat "$work/job.err"; return 1; }
+  "$bin/km-morph" -n 7 -p -t $ICON_TOL "$from" "$to" >"$work/sync.lines" 2>/dev/null || return 1
+  cmp "$work/job.lines" "$work/sync.lines" && grep -q "^km-job: contours: " "$work/job.err"
+}
+check "km-job -p of shapes prints the synchronous morph's lines and the pairing" t_shape_job
+
+t_shape_invalid() {
+  bad=$(jq -cn '{type: "shape", contours: [{type: "svg", d: "M 0 0 L 10 0 L 10 10 Z"}, {type: "svg", d: "M 20 0 L 30 0 L 30 10"}]}')
+  if "$bin/km-morph" "$bad" "M 0 0 L 10 0 L 10 10 Z" >"$work/si.out" 2>"$work/si.err"; then return 1; fi
+  grep -q "at /from/contours/1: contour 1 is open" "$work/si.err" || { cat "$work/si.err"; return 1; }
+  if "$bin/km-morph" "M 0 0 L 10 0 L 10 10 Z" "M 0 0 L 10 0 L 10 10 Z M 20 0 L 20 0 Z" 2>"$work/si2.err"; then return 1; fi
+  grep -q "at /to/d: .*offset 23: subpath 1" "$work/si2.err" || { cat "$work/si2.err"; return 1; }
+  "$bin/km-morph" -p -l animate "$SQUARE100" "$CIRCLE50" 2>"$work/si3.err"; [ $? -eq 2 ] || return 1
+  grep -q "cannot be combined with -l" "$work/si3.err"
+}
+check "a bad contour exits 1 naming /from/contours/1, a bad subpath its offset; -p with -l is a usage error" t_shape_invalid
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
