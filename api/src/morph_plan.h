@@ -91,6 +91,9 @@ bool api__morph_check_size(api_ctx *ctx, api_morph_plan *pl,
 
 /* A frame's metrics object (morph_result.c). */
 cJSON *api__metrics_json(api_ctx *ctx, const km_frame_metrics *m);
+/* The "intersections" object of an answer that asked to avoid crossings
+ * (morph_crossings.c): frames rendered. NULL with the error in ctx. */
+cJSON *api__intersections_json(api_ctx *ctx, const api_morph_plan *pl);
 /* Cubic pieces of a path "M x y C ..." as api_svg_path_d writes it. */
 size_t api__count_pieces(const char *d);
 

@@ -11,6 +11,8 @@
 #include "km/alloc.h"
 #include "morph_plan.h"
 
+/* "intersections" when the request does not say. */
+#define API_DEFAULT_INTERSECTIONS KM_INTERSECTIONS_ALLOW
 /* Frames when neither "frames" nor "times" is given. */
 #define DEFAULT_FRAMES 11
 
@@ -20,6 +22,7 @@ static const char *const closure_names[] = {"auto", "lsq", "c0",
                                             "c1",   "g2",  "none"};
 static const char *const anchor_names[] = {"fit", "start", "centroid"};
 static const char *const orient_names[] = {"auto", "keep"};
+static const char *const intersections_names[] = {"allow", "avoid"};
 static const char *const format_names[] = {"json", "svg"};
 static const char *const layout_names[] = {"filmstrip", "overlay", "animate",
                                            "curvature_plot"};
@@ -37,6 +40,8 @@ _Static_assert(KM_ANCHOR_FIT == 0 && KM_ANCHOR_START == 1 &&
                    KM_ANCHOR_CENTROID == 2,
                "anchor order");
 _Static_assert(KM_ORIENT_AUTO == 0 && KM_ORIENT_KEEP == 1, "orient order");
+_Static_assert(KM_INTERSECTIONS_ALLOW == 0 && KM_INTERSECTIONS_AVOID == 1,
+               "intersections order");
 _Static_assert(API_SVG_FILMSTRIP == 0 && API_SVG_OVERLAY == 1 &&
                    API_SVG_ANIMATE == 2 && API_SVG_CURVATURE_PLOT == 3,
                "layout order");
@@ -266,6 +271,7 @@ static bool parse_times(api_ctx *ctx, const cJSON *root, size_t max_frames,
 
 static bool parse_options(api_ctx *ctx, const cJSON *root, api_morph_plan *pl) {
   int method = 0, blend = 0, closure = 0, anchor = 0, orient = 0;
+  int crossings = API_DEFAULT_INTERSECTIONS;
   int format = 0;
   long degree = 3;
   bool fmt_present = false;
@@ -286,6 +292,8 @@ static bool parse_options(api_ctx *ctx, const cJSON *root, api_morph_plan *pl) {
                         NULL) ||
       !api__member_enum(ctx, root, "", "orient", NAMES(orient_names), &orient,
                         NULL) ||
+      !api__member_enum(ctx, root, "", "intersections",
+                        NAMES(intersections_names), &crossings, NULL) ||
       !api__member_enum(ctx, root, "", "format", NAMES(format_names), &format,
                         &fmt_present) ||
       !api__member_int(ctx, root, "", "degree", false, -1000000, 1000000,
@@ -301,6 +309,7 @@ static bool parse_options(api_ctx *ctx, const cJSON *root, api_morph_plan *pl) {
   pl->opt.closure = (km_closure)closure;
   pl->opt.anchor = (km_anchor)anchor;
   pl->opt.orient = (km_orient)orient;
+  pl->opt.intersections = (km_intersections)crossings;
   pl->opt.degree = (int)degree;
   /* An explicit "format" wins over the Accept header. */
   pl->svg = fmt_present ? format == 1 : false;

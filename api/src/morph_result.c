@@ -181,6 +181,10 @@ static api_status result_json(api_ctx *ctx, api_morph_plan *pl,
                                 : "],\"matches_used\":",
                      item))
     goto oom;
+  if (pl->opt.intersections == KM_INTERSECTIONS_AVOID &&
+      !text_put_item(&t,
+                     ",\"intersections\":", api__intersections_json(ctx, pl)))
+    goto fail;
   if (pl->inc.animate_d) {
     if ((item = pl->shapes ? api__shape_animate_json(ctx, pl)
                            : animate_json(ctx, pl)) == NULL)

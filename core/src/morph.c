@@ -133,41 +133,6 @@ static km_morph *morph_new(km__poll *poll) {
   return m;
 }
 
-/* The morph of a closed pair without matches with `to` started a further
- * fraction dshift of its length along: its inputs are copied, not
- * computed again. */
-static km_status morph_shifted(const km_morph *base, double dshift,
-                               km__poll *poll, km_morph **out, km_error *err) {
-  km_morph *m = morph_new(poll);
-  if (!m) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
-  m->opt = base->opt;
-  m->tol = base->tol;
-  m->closed = base->closed;
-  m->kmax = base->kmax;
-  m->ra = km__malloc(2 * sizeof(double));
-  m->rb = km__malloc(2 * sizeof(double));
-  km_status st = m->ra && m->rb
-                     ? KM_OK
-                     : km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
-  if (!st) {
-    m->ra[0] = m->rb[0] = 0.0;
-    m->ra[1] = m->rb[1] = 1.0;
-    m->nk = 2;
-    st = km__input_copy(&m->in[0], &base->in[0], err);
-  }
-  if (!st) st = km__input_copy(&m->in[1], &base->in[1], err);
-  if (!st)
-    st = km__input_rotate_start(&m->in[1], dshift * m->in[1].sig.length, poll,
-                                err);
-  if (!st) st = plan_frames(m, err);
-  if (st) {
-    km_morph_free(m);
-    return st;
-  }
-  *out = m;
-  return KM_OK;
-}
-
 /* Both inputs made ready and the frame tolerance set. Inputs' signatures
  * are held to a tenth of the tolerance: their error adds to the frames'.
  * The default tolerance, 1e-5 of the longer length, is known only with
@@ -258,6 +223,41 @@ static km_status set_correspondence(km_morph *m, const km_morph_options *opt,
   m->nk = nm + 2;
   m->nuser = nm;
   return KM_OK;
+}
+
+km_status km__morph_variant(const km_morph *base, double dshift,
+                            bool auto_matches, km__poll *poll, km_morph **out,
+                            km_error *err) {
+  km_morph *m = morph_new(poll);
+  if (!m) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  m->opt = base->opt;
+  m->tol = base->tol;
+  m->closed = base->closed;
+  m->kmax = base->kmax;
+  km_morph_options corr = base->opt;
+  corr.matches = NULL;
+  corr.nmatches = 0;
+  corr.auto_matches = auto_matches;
+  km_status st = km__input_copy(&m->in[0], &base->in[0], err);
+  if (!st) st = km__input_copy(&m->in[1], &base->in[1], err);
+  if (!st && dshift > 0)
+    st = km__input_rotate_start(&m->in[1], dshift * m->in[1].sig.length, poll,
+                                err);
+  if (!st) st = set_correspondence(m, &corr, err);
+  if (!st) st = plan_frames(m, err);
+  if (st) {
+    km_morph_free(m);
+    return st;
+  }
+  *out = m;
+  return KM_OK;
+}
+
+/* The morph of a closed pair without matches with `to` started a further
+ * fraction dshift of its length along. */
+static km_status morph_shifted(const km_morph *base, double dshift,
+                               km__poll *poll, km_morph **out, km_error *err) {
+  return km__morph_variant(base, dshift, false, poll, out, err);
 }
 
 /* The morph with the start of a closed `to` chosen by the alignment cost;
@@ -386,6 +386,13 @@ km_status km_morph_create(km_morph **out, const km_morph_input *from,
     km_morph_free(m);
     return km__stopped(err);
   }
+  if (!st && opt->intersections == KM_INTERSECTIONS_AVOID &&
+      opt->method == KM_METHOD_CURVATURE)
+    st = km__avoid_crossings(&m, &poll);
+  if (poll.stopped || st == KM_ECANCELLED) {
+    km_morph_free(m);
+    return km__stopped(err);
+  }
   if (st) return km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
   m->poll = NULL;
   m->opt.stop = NULL;
@@ -437,6 +444,15 @@ done:
   km_curve_free(&f);
   km__free(buf);
   return st;
+}
+
+km_status km__morph_frame(const km_morph *m, double t, km__poll *poll,
+                          km_curve *out, km_error *err) {
+  return frame_impl(m, t, poll, out, NULL, NULL, err);
+}
+
+void km_morph_avoided(const km_morph *m, km_morph_avoidance *out) {
+  *out = m->avoid;
 }
 
 km_status km_morph_frame(const km_morph *m, double t, km_curve *out,

@@ -459,13 +459,40 @@ static size_t deepest_minima(const double *cost, double *cand) {
   return n;
 }
 
+/* The best aligned start in each of nsec equal sectors of the length but
+ * the one about the given start (centred on it), best first: fractions
+ * into cand, costs into costs; returns how many (nsec - 1). */
+static size_t sector_minima(const double *cost, size_t nsec, double *cand,
+                            double *costs) {
+  enum { N = ALIGN_N };
+  size_t n = 0;
+  for (size_t q = 1; q < nsec; q++) {
+    int lo = (int)((2 * q - 1) * N / (2 * nsec)),
+        hi = (int)((2 * q + 1) * N / (2 * nsec));
+    int k = lo;
+    for (int j = lo + 1; j < hi && j < N; j++)
+      if (cost[j] < cost[k]) k = j;
+    size_t pos = n++;
+    while (pos > 0 && costs[pos - 1] > cost[k]) {
+      cand[pos] = cand[pos - 1];
+      costs[pos] = costs[pos - 1];
+      pos--;
+    }
+    cand[pos] = (double)k / N;
+    costs[pos] = cost[k];
+  }
+  return n;
+}
+
 /* The cost of shift k,
  *   sum_j (d_j - mean d)^2 + |pa_j - pb_(j+k)|^2,  d_j = ta_j - tb'_(j+k)
  * (tb' continued by the total turning past the end), expands into sums of
  * squares, prefix sums and the cyclic correlations sum_j ta_j tb_(j+k) and
  * sum_j pa_j . pb_(j+k), which the FFT gives for all k at once. */
-km_status km__best_shifts(const km__input *a, const km__input *b, double *cand,
-                          size_t *n) {
+/* Either the deepest minima (nsec 0) or the sectors' best starts. */
+static km_status shift_minima(const km__input *a, const km__input *b,
+                              double *cand, double *costs, size_t nsec,
+                              size_t *n) {
   enum { N = ALIGN_N };
   double *buf = km__malloc(14 * (size_t)N * sizeof(double));
   if (!buf) return KM_ENOMEM;
@@ -475,9 +502,24 @@ km_status km__best_shifts(const km__input *a, const km__input *b, double *cand,
                   buf + 12 * N, buf + 13 * N, {0, 0, 0, 0, 0, 0}};
   shift_samples(a, b, &w);
   shift_costs(&w, b->sig.turning);
-  *n = deepest_minima(w.cost, cand);
+  if (nsec == 0) {
+    *n = deepest_minima(w.cost, cand);
+  } else {
+    *n = sector_minima(w.cost, nsec, cand, costs);
+    costs[*n] = w.cost[0];
+  }
   km__free(buf);
   return KM_OK;
+}
+
+km_status km__best_shifts(const km__input *a, const km__input *b, double *cand,
+                          size_t *n) {
+  return shift_minima(a, b, cand, NULL, 0, n);
+}
+
+km_status km__sector_shifts(const km__input *a, const km__input *b, size_t nsec,
+                            double *cand, double *costs, size_t *n) {
+  return shift_minima(a, b, cand, costs, nsec, n);
 }
 
 /* An input's copy, signature and tables; a signature computed from its

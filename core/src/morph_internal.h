@@ -55,6 +55,7 @@ struct km_morph {
    * weights' sum and the weighted means */
   double (*place_ab)[5];
   double place_w_sum, place_qa[2], place_qb[2];
+  km_morph_avoidance avoid; /* what intersections AVOID did */
   /* the caller's stop condition while km_morph_create runs, NULL after:
    * frames take their own (km_morph_frame_until) */
   km__poll *poll;
@@ -98,6 +99,31 @@ double km__input_theta_at(const km__input *in, double s);
  * least one). KM_OK or KM_ENOMEM (then nothing written). */
 km_status km__best_shifts(const km__input *a, const km__input *b, double *cand,
                           size_t *n);
+
+/* ---- morphs made from a morph (morph.c) and crossings (morph_avoid.c) */
+
+/* The morph base with its closed `to` started a further fraction dshift of
+ * its length along (0: where it is), with automatic matches or none: its
+ * inputs are copied, not computed again, and it is planned as base was.
+ * Statuses as km_morph_create (err may be NULL). */
+km_status km__morph_variant(const km_morph *base, double dshift,
+                            bool auto_matches, km__poll *poll, km_morph **out,
+                            km_error *err);
+/* The curve of the frame at t, as km_morph_frame_until with poll. */
+km_status km__morph_frame(const km_morph *m, double t, km__poll *poll,
+                          km_curve *out, km_error *err);
+/* intersections AVOID: *mp is replaced by the choice kept (the others are
+ * freed) and its avoid report filled. KM_OK, KM_ENOMEM or KM_ECANCELLED
+ * (then every morph is freed and *mp is NULL). */
+km_status km__avoid_crossings(km_morph **mp, km__poll *poll);
+
+/* Other starts of b: in each of nsec (>= 2) equal sectors of its length
+ * but the one centred on its own start, the start that aligns best with a
+ * (km__best_shifts' cost), best first: fractions of its length into cand
+ * (nsec - 1 places), their costs into costs, then the cost of b's own
+ * start (nsec places); *n (out) how many. KM_OK or KM_ENOMEM. */
+km_status km__sector_shifts(const km__input *a, const km__input *b, size_t nsec,
+                            double *cand, double *costs, size_t *n);
 
 /* Pieces of p restricted to [x0, x1] (x0 < x1, inside p's breaks) into
  * *out (initialised, empty; the caller frees it). KM_ENOMEM, no message. */

@@ -61,6 +61,16 @@ typedef enum km_anchor {
  * then KM_ETURNING). */
 typedef enum km_orient { KM_ORIENT_AUTO, KM_ORIENT_KEEP } km_orient;
 
+/* Frames that cross themselves: ALLOW takes the correspondence as the
+ * alignment chooses it; AVOID, when previews of interior frames of that
+ * choice cross, tries the other choices the morph is free to make (the
+ * start of a closed `to`, automatic matches or none when "auto" was asked
+ * for) and keeps the one whose previews cross least (km_morph_avoided). */
+typedef enum km_intersections {
+  KM_INTERSECTIONS_ALLOW,
+  KM_INTERSECTIONS_AVOID
+} km_intersections;
+
 typedef struct km_morph_options {
   km_morph_method method; /* default curvature */
   km_blend blend;         /* default turning */
@@ -73,10 +83,11 @@ typedef struct km_morph_options {
                              fractions, strictly increasing inside (0, 1)
                              on both sides; borrowed for km_morph_create */
   size_t nmatches;
-  bool auto_matches;   /* without matches: align features (curvature
+  bool auto_matches; /* without matches: align features (curvature
                              extrema, corners) automatically */
-  size_t max_points;   /* control points a frame may have; 0: the core's
+  size_t max_points; /* control points a frame may have; 0: the core's
                              own bound (KM_MAX_OUTPUT_PIECES) */
+  km_intersections intersections; /* default allow */
   const km_stop *stop; /* km_morph_create ends early with KM_ECANCELLED
                              when this asks it to (km/stop.h); NULL, the
                              default: never. Borrowed for the call only:
@@ -207,6 +218,21 @@ km_status km_morph_frame_points(const km_morph *m, double t,
  * pairs (out, 2 cap doubles; may be NULL to ask the count) and returns
  * the count, the given or automatic matches (0 without matches). */
 size_t km_morph_matches_used(const km_morph *m, double *pairs, size_t cap);
+
+/* What km_morph_create's crossing avoidance did (intersections AVOID). */
+typedef struct km_morph_avoidance {
+  bool searched;           /* the first choice's previews crossed, others were
+                            tried */
+  bool changed;            /* another choice was kept */
+  long crossings_before;   /* crossings of the previews of the first choice */
+  long crossings_after;    /* of the choice kept (0: none seen) */
+  long input_crossings[2]; /* self-crossings of from and to themselves */
+  size_t previews;         /* preview frames built */
+} km_morph_avoidance;
+
+/* The report of km_morph_create's avoidance into *out (all zero when
+ * intersections was ALLOW or the inputs are not curvature-morphed). */
+void km_morph_avoided(const km_morph *m, km_morph_avoidance *out);
 
 /* Lengths and turnings (total tangent turn in radians, 2 pi times the
  * turning number for a closed curve) of the two prepared inputs, from

@@ -1,0 +1,93 @@
+/* morph_crossings.c - the "intersections" member of a morph's answer when
+ * the request asked to avoid crossings: which frames still cross, and why.
+ */
+#include <math.h>
+#include <string.h>
+
+#include "km/alloc.h"
+#include "morph_plan.h"
+
+/* Crossings of frame slot f: self-crossings (every contour's, for a
+ * compound frame) plus crossings between contours. From the metrics when
+ * the frame has them, else counted on its curve at tol. */
+static long frame_crossings(const api_morph_plan *pl, const api_frame_slot *f,
+                            double tol) {
+  if (pl->shapes) {
+    long n = f->shape.mutual_intersections;
+    for (size_t k = 0; k < f->shape.ncontours; k++)
+      if (f->shape.present[k]) {
+        long x = f->shape.metrics
+                     ? f->shape.metrics[k].self_intersections
+                     : km_curve_self_intersections(&f->shape.contours[k], tol);
+        n += x > 0 ? x : 0;
+      }
+    return n;
+  }
+  if (pl->metrics) return f->metrics.self_intersections;
+  long x = km_curve_self_intersections(&f->curve, tol);
+  return x > 0 ? x : 0;
+}
+
+/* The tolerance crossings are counted at: the request's, else the core's
+ * default (1e-5 of the longer input). */
+static double count_tolerance(const api_morph_plan *pl) {
+  if (pl->tol > 0) return pl->tol;
+  if (pl->shapes || pl->morph == NULL) return 1e-3;
+  double len[2], turn[2];
+  km_morph_inputs(pl->morph, len, turn);
+  return 1e-5 * fmax(len[0], len[1]);
+}
+
+/* Why frames still cross, or NULL when none does. */
+static const char *crossing_reason(const km_morph_avoidance *a, bool single,
+                                   size_t crossing) {
+  if (crossing == 0) return NULL;
+  if (single && a->input_crossings[0] > 0 && a->input_crossings[1] > 0)
+    return "both inputs cross themselves";
+  if (single && a->input_crossings[0] > 0) return "from crosses itself";
+  if (single && a->input_crossings[1] > 0) return "to crosses itself";
+  if (!single) return "contours of the frames cross themselves or each other";
+  if (!a->searched)
+    return "the frames cross between the previewed times (t = k/8)";
+  return "no start point or choice of matches the morph is free to make "
+         "avoids the crossing";
+}
+
+cJSON *api__intersections_json(api_ctx *ctx, const api_morph_plan *pl) {
+  km_morph_avoidance a;
+  memset(&a, 0, sizeof a);
+  if (!pl->shapes && pl->morph) km_morph_avoided(pl->morph, &a);
+  double tol = count_tolerance(pl);
+  cJSON *o = cJSON_CreateObject(), *frames = cJSON_CreateArray();
+  if (o == NULL || frames == NULL) goto oom;
+  size_t crossing = 0;
+  for (size_t i = 0; i < pl->nframes; i++)
+    if (frame_crossings(pl, &pl->frames[i], tol) > 0) {
+      cJSON *n = cJSON_CreateNumber((double)i);
+      if (n == NULL) goto oom;
+      cJSON_AddItemToArray(frames, n);
+      crossing++;
+    }
+  const char *why = crossing_reason(&a, !pl->shapes, crossing);
+  cJSON *reason = why ? cJSON_CreateString(why) : cJSON_CreateNull();
+  if (reason == NULL) goto oom;
+  cJSON_AddItemToObject(o, "crossing_frames", frames);
+  frames = NULL;
+  cJSON_AddItemToObject(o, "reason", reason);
+  cJSON *changed = cJSON_CreateBool(a.changed);
+  if (!api__add_item(ctx, o, "changed", changed) ||
+      !api__add_num(ctx, o, "previews", (double)a.previews) ||
+      !api__add_num(ctx, o, "preview_crossings_before",
+                    (double)a.crossings_before) ||
+      !api__add_num(ctx, o, "preview_crossings_after",
+                    (double)a.crossings_after)) {
+    cJSON_Delete(o);
+    return NULL;
+  }
+  return o;
+oom:
+  cJSON_Delete(o);
+  cJSON_Delete(frames);
+  api__oom(ctx);
+  return NULL;
+}

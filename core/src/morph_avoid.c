@@ -1,0 +1,156 @@
+/* morph_avoid.c - intersections "avoid": of the choices a morph is free to
+ * make, keep one whose frames do not cross themselves.
+ *
+ * DESIGN. Curvature blending keeps most frames simple, but where the two
+ * sides of a thin stroke pass through each other (a 2 into a 5, a U into
+ * an S) the frames of the aligned correspondence cross at the spine. What
+ * decides it is the correspondence, and part of it is free: where a closed
+ * `to` starts (its seam) and, when the caller asked for automatic matches,
+ * which features are matched. A crossing cannot be undone by placement (a
+ * rigid motion), so those are the choices tried.
+ *
+ * The choice made by the alignment (and by the start search of morph.c)
+ * is previewed first: PREVIEWS interior frames, t = k / (PREVIEWS + 1),
+ * their crossings counted. When none crosses it is kept, untouched, so
+ * frames that did not cross are the same frames. Otherwise other starts
+ * are previewed in order of the alignment cost (km__sector_shifts: the
+ * best start in each sector, so that the candidates spread over the whole
+ * contour - the local minima of the cost alone are few and mostly cross
+ * alike - and the best aligned of those that do not cross is kept, which
+ * keeps the morph from spinning a badly matched blob), automatic matches
+ * before none at each; the first whose previews do not cross is kept,
+ * failing that the one with the fewest crossings (the earlier among
+ * equals).
+ * A candidate stops counting once it has as many crossings as the best so
+ * far. The choice is made once per morph, so every frame comes from one
+ * correspondence and the sequence cannot jump between choices.
+ *
+ * Budget: the inputs' two frames and at most 32 candidates (the first
+ * choice; the best aligned start in each of the other SEAMS - 1 sectors of
+ * a closed `to`, times two when matches are automatic; no matches at the
+ * first start), each at most PREVIEWS frames and their crossing counts -
+ * at most 2 + 7 * 32 = 226 frames. A planned frame is a pass over a few
+ * hundred nodes, so the search costs some tens of frames' work on glyphs;
+ * every preview and plan polls the caller's stop, and the choice kept is
+ * planned like any morph, so the answer's size is predicted from it.
+ */
+#include <limits.h>
+#include <math.h>
+
+#include "bspline_internal.h"
+#include "internal.h"
+#include "km/alloc.h"
+#include "morph_internal.h"
+
+/* Interior frames previewed per candidate, and seam positions tried
+ * (shifts of j / SEAMS of the length). */
+#define PREVIEWS 7
+#define SEAMS 16
+
+/* The crossings of m's preview frames into *count, counting stopped once
+ * cap is reached; *built adds the frames built. A frame that cannot be
+ * built counts as LONG_MAX (the candidate loses); KM_ENOMEM and
+ * KM_ECANCELLED fail the search rather than let another candidate win. */
+static km_status preview_crossings(const km_morph *m, long cap, km__poll *poll,
+                                   long *count, size_t *built) {
+  /* the middle first, then halving the gaps: crossings of thin strokes
+   * are widest in the middle, and a candidate that crosses is mostly
+   * ruled out by its first preview */
+  static const int order[PREVIEWS] = {4, 2, 6, 1, 3, 5, 7};
+  long total = 0;
+  for (int k = 0; k < PREVIEWS && total < cap; k++) {
+    km_curve c;
+    km_curve_init(&c);
+    km_status st =
+        km__morph_frame(m, order[k] / (double)(PREVIEWS + 1), poll, &c, NULL);
+    if (st == KM_ENOMEM || st == KM_ECANCELLED) return st;
+    (*built)++;
+    if (st != KM_OK) {
+      total = LONG_MAX;
+      break;
+    }
+    long x = km__self_intersections(&c, m->tol, poll);
+    km_curve_free(&c);
+    if (x < 0) return poll && poll->stopped ? KM_ECANCELLED : KM_ENOMEM;
+    total += x;
+  }
+  *count = total;
+  return KM_OK;
+}
+
+/* Self-crossings of the frames at t = 0 and 1, the inputs as the morph
+ * traces them, into counts. */
+static km_status input_crossings(const km_morph *m, km__poll *poll,
+                                 long counts[2]) {
+  for (int i = 0; i < 2; i++) {
+    km_curve c;
+    km_curve_init(&c);
+    km_status st = km__morph_frame(m, (double)i, poll, &c, NULL);
+    if (st == KM_ENOMEM || st == KM_ECANCELLED) return st;
+    counts[i] = 0;
+    if (st != KM_OK) continue;
+    long x = km__self_intersections(&c, m->tol, poll);
+    km_curve_free(&c);
+    if (x < 0) return poll && poll->stopped ? KM_ECANCELLED : KM_ENOMEM;
+    counts[i] = x;
+  }
+  return KM_OK;
+}
+
+km_status km__avoid_crossings(km_morph **mp, km__poll *poll) {
+  km_morph *best = *mp;
+  km_morph_avoidance rep = {0};
+  long bx = 0;
+  km_status st = input_crossings(best, poll, rep.input_crossings);
+  if (!st) st = preview_crossings(best, LONG_MAX, poll, &bx, &rep.previews);
+  if (st) goto fail;
+  rep.crossings_before = rep.crossings_after = bx;
+  if (bx == 0) goto done;
+  rep.searched = true;
+  bool auto_m = best->opt.auto_matches && best->opt.nmatches == 0;
+  double shift[SEAMS + 1], cost[SEAMS + 2];
+  size_t nshift = 0;
+  if (best->closed && best->opt.nmatches == 0 &&
+      km__sector_shifts(&best->in[0], &best->in[1], SEAMS, shift + 1, cost + 1,
+                        &nshift)) {
+    st = KM_ENOMEM;
+    goto fail;
+  }
+  shift[0] = 0.0;
+  for (size_t j = 0; j <= nshift && bx > 0; j++) {
+    for (int mode = 0; mode < 2 && bx > 0; mode++) {
+      bool with_auto = mode == 0 ? auto_m : false;
+      if (mode == 1 && !auto_m) break;
+      if (j == 0 && with_auto == auto_m) continue; /* the first choice */
+      km_morph *alt = NULL;
+      st = km__morph_variant(*mp, shift[j], with_auto, poll, &alt, NULL);
+      if (st == KM_ENOMEM || st == KM_ECANCELLED) goto fail;
+      if (st != KM_OK) continue; /* a choice that cannot be planned */
+      long x = 0;
+      st = preview_crossings(alt, bx, poll, &x, &rep.previews);
+      if (st) {
+        km_morph_free(alt);
+        goto fail;
+      }
+      if (x < bx) {
+        if (best != *mp) km_morph_free(best);
+        best = alt;
+        bx = x;
+        rep.changed = true;
+      } else {
+        km_morph_free(alt);
+      }
+    }
+  }
+  rep.crossings_after = bx;
+  if (best != *mp) km_morph_free(*mp);
+done:
+  best->avoid = rep;
+  *mp = best;
+  return KM_OK;
+fail:
+  if (best != *mp) km_morph_free(best);
+  km_morph_free(*mp);
+  *mp = NULL;
+  return st ? st : KM_ENOMEM;
+}
