@@ -11,11 +11,13 @@
  * back exactly (num_print.c) and hand cJSON the text as a raw item.
  */
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
+#include "json_write.h"
 #include "km/alloc.h"
 #include "num_print.h"
 #include "svg.h"
@@ -202,6 +204,119 @@ cJSON *api__signature_json(api_ctx *ctx, const km_signature *sig) {
 fail:
   cJSON_Delete(o);
   return NULL;
+}
+
+/* ------------------------------------- straight into a growing buffer */
+
+bool api__json_num(api_ctx *ctx, api_svg_buf *b, double v, const char *what) {
+  if (!isfinite(v)) return nonfinite(ctx, what);
+  char *at = api__svg_buf_room(b, API_NUM_PRINT_MAX);
+  if (at != NULL) b->len += api__num_print(at, v);
+  return true;
+}
+
+void api__json_string(api_svg_buf *b, const char *s) {
+  static const char hex[] = "0123456789abcdef";
+  const unsigned char *p = (const unsigned char *)s, *run = p;
+  API_JSON_LIT(b, "\"");
+  for (; *p != '\0'; p++) {
+    char esc[6] = {'\\', 'u', '0', '0', 0, 0};
+    size_t n = 2;
+    if (*p >= 0x20 && *p != '"' && *p != '\\') continue;
+    api__json_raw(b, (const char *)run, (size_t)(p - run));
+    run = p + 1;
+    switch (*p) {
+    case '"': esc[1] = '"'; break;
+    case '\\': esc[1] = '\\'; break;
+    case '\b': esc[1] = 'b'; break;
+    case '\f': esc[1] = 'f'; break;
+    case '\n': esc[1] = 'n'; break;
+    case '\r': esc[1] = 'r'; break;
+    case '\t': esc[1] = 't'; break;
+    default:
+      esc[4] = hex[*p >> 4];
+      esc[5] = hex[*p & 15];
+      n = 6;
+    }
+    api__json_raw(b, esc, n);
+  }
+  api__json_raw(b, (const char *)run, (size_t)(p - run));
+  API_JSON_LIT(b, "\"");
+}
+
+bool api__json_nums(api_ctx *ctx, api_svg_buf *b, const double *v, size_t n,
+                    size_t stride) {
+  size_t count = n * stride;
+  if (count > SIZE_MAX / (2 * API_NUM_PRINT_MAX)) return api__oom(ctx);
+  /* the whole array's room at once: a number, its comma or bracket */
+  char *at = api__svg_buf_room(b, 2 + count * (API_NUM_PRINT_MAX + 2));
+  if (at == NULL) return true;
+  char *p = at;
+  *p++ = '[';
+  for (size_t i = 0; i < count; i++) {
+    if (!isfinite(v[i])) {
+      *at = '\0';
+      return nonfinite(ctx, "coordinate");
+    }
+    if (stride == 2 && i % 2 == 0) {
+      if (i > 0) *p++ = ',';
+      *p++ = '[';
+    } else if (i > 0) {
+      *p++ = ',';
+    }
+    p += api__num_print(p, v[i]);
+    if (stride == 2 && i % 2 == 1) *p++ = ']';
+  }
+  *p++ = ']';
+  *p = '\0';
+  b->len += (size_t)(p - at);
+  return true;
+}
+
+bool api__json_curve(api_ctx *ctx, api_svg_buf *b, const km_curve *c,
+                     bool svg_d, double tol) {
+  double length;
+  API_JSON_LIT(b, "{\"degree\":");
+  if (!api__json_num(ctx, b, c->degree, "degree")) return false;
+  API_JSON_LIT(b, ",\"knots\":");
+  if (!api__json_nums(ctx, b, c->knots, c->n + (size_t)c->degree + 1, 1))
+    return false;
+  API_JSON_LIT(b, ",\"control_points\":");
+  if (!api__json_nums(ctx, b, c->cp, c->n, 2)) return false;
+  if (c->w != NULL) {
+    API_JSON_LIT(b, ",\"weights\":");
+    if (!api__json_nums(ctx, b, c->w, c->n, 1)) return false;
+  }
+  if (c->closed)
+    API_JSON_LIT(b, ",\"closed\":true,\"length\":");
+  else
+    API_JSON_LIT(b, ",\"closed\":false,\"length\":");
+  length = km_curve_length(c);
+  if (!api__json_num(ctx, b, length, "length")) return false;
+  if (svg_d) {
+    /* Default tolerance as everywhere: 1e-5 of the curve's length. */
+    char *d = api_svg_path_d(c, tol > 0 ? tol : 1e-5 * length, NULL);
+    if (d == NULL) return api__oom(ctx);
+    API_JSON_LIT(b, ",\"svg_d\":");
+    api__json_string(b, d);
+    km__free(d);
+  }
+  API_JSON_LIT(b, "}");
+  return true;
+}
+
+bool api__json_tree(api_ctx *ctx, api_svg_buf *b, cJSON *item) {
+  if (item == NULL) return false;
+  char *s = cJSON_PrintUnformatted(item);
+  cJSON_Delete(item);
+  if (s == NULL) return api__oom(ctx);
+  api__svg_buf_put(b, s);
+  km__free(s);
+  return true;
+}
+
+bool api__json_done(api_ctx *ctx, const api_svg_buf *b) {
+  return b->failed ? api__oom(ctx) : true;
 }
 
 /* ------------------------------------------------- bounds on the bytes */

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "json_write.h"
 #include "km/alloc.h"
 #include "morph_plan.h"
 
@@ -49,158 +50,120 @@ cJSON *api__metrics_json(api_ctx *ctx, const km_frame_metrics *m) {
   return o;
 }
 
+/* The metrics object as api__metrics_json builds it. */
+static bool metrics_write(api_ctx *ctx, api_svg_buf *b,
+                          const km_frame_metrics *m) {
+  API_JSON_LIT(b, "{\"length\":");
+  if (!api__json_num(ctx, b, m->length, "length")) return false;
+  API_JSON_LIT(b, ",\"max_abs_kappa\":");
+  if (!api__json_num(ctx, b, m->max_abs_kappa, "max_abs_kappa")) return false;
+  API_JSON_LIT(b, ",\"bending_energy\":");
+  if (!api__json_num(ctx, b, m->bending_energy, "bending_energy")) return false;
+  API_JSON_LIT(b, ",\"self_intersections\":");
+  if (!api__json_num(ctx, b, (double)m->self_intersections,
+                     "self_intersections"))
+    return false;
+  API_JSON_LIT(b, ",\"closure_gap\":");
+  if (!api__json_num(ctx, b, m->closure_gap, "closure_gap")) return false;
+  API_JSON_LIT(b, "}");
+  return true;
+}
+
 /* "animate_d": every frame as a path with one common number of cubic
  * pieces, the most any frame needs at the tolerance, so that SMIL or CSS
  * can interpolate between them. */
-static cJSON *animate_json(api_ctx *ctx, const api_morph_plan *pl) {
+static bool animate_write(api_ctx *ctx, api_svg_buf *b,
+                          const api_morph_plan *pl) {
   size_t pieces = 1;
-  cJSON *a;
   for (size_t i = 0; i < pl->nframes; i++) {
     char *d = api_svg_path_d(&pl->frames[i].curve, pl->tol, NULL);
-    if (d == NULL) {
-      api__oom(ctx);
-      return NULL;
-    }
+    if (d == NULL) return api__oom(ctx);
     pieces = api__count_pieces(d) > pieces ? api__count_pieces(d) : pieces;
     km__free(d);
   }
-  a = cJSON_CreateArray();
-  if (a == NULL) {
-    api__oom(ctx);
-    return NULL;
-  }
+  API_JSON_LIT(b, "[");
   for (size_t i = 0; i < pl->nframes; i++) {
     char *d = api_svg_path_d_fixed(&pl->frames[i].curve, pieces);
-    cJSON *s = d != NULL ? cJSON_CreateString(d) : NULL;
+    if (d == NULL) return api__oom(ctx);
+    if (i > 0) API_JSON_LIT(b, ",");
+    api__json_string(b, d);
     km__free(d);
-    if (s == NULL) {
-      cJSON_Delete(a);
-      api__oom(ctx);
-      return NULL;
-    }
-    cJSON_AddItemToArray(a, s);
   }
-  return a;
+  API_JSON_LIT(b, "]");
+  return true;
 }
 
 /* One frame's object: its t, its curve, its metrics when asked for. */
-static cJSON *frame_json(api_ctx *ctx, const api_morph_plan *pl,
-                         const api_frame_slot *f) {
-  cJSON *fo, *c;
-  if (pl->shapes) return api__shape_frame_json(ctx, pl, f);
-  if ((fo = cJSON_CreateObject()) == NULL) {
-    api__oom(ctx);
-    return NULL;
-  }
-  if (!api__add_num(ctx, fo, "t", f->t)) goto fail;
-  if ((c = api__curve_json(ctx, &f->curve, pl->inc.svg_d, pl->tol)) == NULL)
-    goto fail;
-  if (!api__add_item(ctx, fo, "curve", c)) goto fail;
+static bool frame_write(api_ctx *ctx, api_svg_buf *b, const api_morph_plan *pl,
+                        const api_frame_slot *f) {
+  if (pl->shapes)
+    return api__json_tree(ctx, b, api__shape_frame_json(ctx, pl, f));
+  API_JSON_LIT(b, "{\"t\":");
+  if (!api__json_num(ctx, b, f->t, "t")) return false;
+  API_JSON_LIT(b, ",\"curve\":");
+  if (!api__json_curve(ctx, b, &f->curve, pl->inc.svg_d, pl->tol)) return false;
   if (pl->metrics) {
-    if ((c = api__metrics_json(ctx, &f->metrics)) == NULL ||
-        !api__add_item(ctx, fo, "metrics", c))
-      goto fail;
+    API_JSON_LIT(b, ",\"metrics\":");
+    if (!metrics_write(ctx, b, &f->metrics)) return false;
   }
-  return fo;
-fail:
-  cJSON_Delete(fo);
-  return NULL;
+  API_JSON_LIT(b, "}");
+  return true;
 }
 
 /* "matches_used": the [r_from, r_to] pairs the morph matched; [] when
  * none. */
-static cJSON *matches_used_json(api_ctx *ctx, const km_morph *morph) {
+static bool matches_used_write(api_ctx *ctx, api_svg_buf *b,
+                               const km_morph *morph) {
   size_t npairs = km_morph_matches_used(morph, NULL, 0);
   double *pairs = km__malloc((npairs > 0 ? 2 * npairs : 1) * sizeof *pairs);
-  cJSON *mu = NULL;
-  if (pairs == NULL) {
-    api__oom(ctx);
-    return NULL;
-  }
+  bool ok;
+  if (pairs == NULL) return api__oom(ctx);
   npairs = km_morph_matches_used(morph, pairs, npairs);
-  if (npairs > 0)
-    mu = api__num_array_json(ctx, pairs, npairs, 2);
-  else if ((mu = cJSON_CreateArray()) == NULL)
-    api__oom(ctx);
+  ok = api__json_nums(ctx, b, pairs, npairs, 2);
   km__free(pairs);
-  return mu;
-}
-
-/* The answer's text, growing as each part is printed. */
-typedef struct text_out {
-  char *p;
-  size_t len, cap;
-} text_out;
-
-static bool text_put(text_out *t, const char *s, size_t n) {
-  if (t->len + n + 1 > t->cap) {
-    size_t cap = t->cap ? t->cap : 4096;
-    while (cap < t->len + n + 1) cap += cap / 2;
-    char *p = km__realloc(t->p, cap);
-    if (p == NULL) return false;
-    t->p = p;
-    t->cap = cap;
-  }
-  memcpy(t->p + t->len, s, n);
-  t->len += n;
-  t->p[t->len] = '\0';
-  return true;
-}
-
-/* Print item (consumed) after the text key (the separators included). */
-static bool text_put_item(text_out *t, const char *key, cJSON *item) {
-  char *s = item != NULL ? cJSON_PrintUnformatted(item) : NULL;
-  cJSON_Delete(item);
-  bool ok =
-      s != NULL && text_put(t, key, strlen(key)) && text_put(t, s, strlen(s));
-  km__free(s);
   return ok;
 }
 
-/* The JSON answer printed part by part, a frame's tree freed as soon as
- * it is printed: the same text as printing one tree of the whole answer,
- * which would hold some three times the text's size in nodes while it is
- * printed (80 bytes a number against some 20 printed). */
+/* The JSON answer written straight into one buffer, frame after frame;
+ * the compound morph's parts that are still built as trees (morph_shape.c)
+ * are printed into it as they come. */
 static api_status result_json(api_ctx *ctx, api_morph_plan *pl,
                               api_response *out) {
-  text_out t = {NULL, 0, 0};
-  cJSON *method = cJSON_CreateString(api__morph_method_names[pl->opt.method]);
-  if (!text_put_item(&t, "{\"method\":", method) ||
-      !text_put(&t, ",\"frames\":[", 11))
-    goto oom;
+  api_svg_buf b;
+  api__svg_buf_init(&b);
+  API_JSON_LIT(&b, "{\"method\":");
+  api__json_string(&b, api__morph_method_names[pl->opt.method]);
+  API_JSON_LIT(&b, ",\"frames\":[");
   for (size_t i = 0; i < pl->nframes; i++) {
-    cJSON *fo = frame_json(ctx, pl, &pl->frames[i]);
-    if (fo == NULL) goto fail;
-    if (!text_put_item(&t, i > 0 ? "," : "", fo)) goto oom;
+    if (i > 0) API_JSON_LIT(&b, ",");
+    if (!frame_write(ctx, &b, pl, &pl->frames[i])) goto fail;
   }
-  cJSON *item = pl->shapes ? api__shape_pairs_json(ctx, pl)
-                           : matches_used_json(ctx, pl->morph);
-  if (item == NULL) goto fail;
-  if (!text_put_item(&t,
-                     pl->shapes ? "],\"contour_matches_used\":"
-                                : "],\"matches_used\":",
-                     item))
-    goto oom;
-  if (pl->opt.intersections == KM_INTERSECTIONS_AVOID &&
-      !text_put_item(&t,
-                     ",\"intersections\":", api__intersections_json(ctx, pl)))
-    goto fail;
+  if (pl->shapes) {
+    API_JSON_LIT(&b, "],\"contour_matches_used\":");
+    if (!api__json_tree(ctx, &b, api__shape_pairs_json(ctx, pl))) goto fail;
+  } else {
+    API_JSON_LIT(&b, "],\"matches_used\":");
+    if (!matches_used_write(ctx, &b, pl->morph)) goto fail;
+  }
+  if (pl->opt.intersections == KM_INTERSECTIONS_AVOID) {
+    API_JSON_LIT(&b, ",\"intersections\":");
+    if (!api__json_tree(ctx, &b, api__intersections_json(ctx, pl))) goto fail;
+  }
   if (pl->inc.animate_d) {
-    if ((item = pl->shapes ? api__shape_animate_json(ctx, pl)
-                           : animate_json(ctx, pl)) == NULL)
+    API_JSON_LIT(&b, ",\"animate_d\":");
+    if (pl->shapes ? !api__json_tree(ctx, &b, api__shape_animate_json(ctx, pl))
+                   : !animate_write(ctx, &b, pl))
       goto fail;
-    if (!text_put_item(&t, ",\"animate_d\":", item)) goto oom;
   }
-  if (!text_put(&t, "}", 1)) goto oom;
+  API_JSON_LIT(&b, "}");
+  if (!api__json_done(ctx, &b)) goto fail;
   out->status = 200;
   out->content_type = API_CT_JSON;
-  out->body = t.p;
-  out->length = t.len;
+  out->length = b.len;
+  out->body = api__svg_buf_take(&b);
   return 200;
-oom:
-  api__oom(ctx);
 fail:
-  km__free(t.p);
+  api__svg_buf_free(&b);
   api__ctx_problem(ctx, out, pl->request_id);
   return out->status;
 }

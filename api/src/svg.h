@@ -143,6 +143,12 @@ typedef struct api_svg_buf {
 void api__svg_buf_init(api_svg_buf *b);
 void api__svg_buf_free(api_svg_buf *b);
 void api__svg_buf_put(api_svg_buf *b, const char *str);
+/* n bytes of str (no NUL among them needed). */
+void api__svg_buf_put_n(api_svg_buf *b, const char *str, size_t n);
+/* Room for n more bytes and a NUL at the end of the string: where to
+ * write them (the writer then adds what it wrote to len and keeps the
+ * NUL), or NULL after a failure. */
+char *api__svg_buf_room(api_svg_buf *b, size_t n);
 void api__svg_buf_printf(api_svg_buf *b, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
 /* Text with the XML special characters escaped (&<>"'); bytes below 0x20

@@ -59,6 +59,17 @@ static bool reserve(api_svg_buf *b, size_t extra) {
   return true;
 }
 
+char *api__svg_buf_room(api_svg_buf *b, size_t n) {
+  return reserve(b, n) ? b->s + b->len : NULL;
+}
+
+void api__svg_buf_put_n(api_svg_buf *b, const char *str, size_t n) {
+  if (!reserve(b, n)) return;
+  memcpy(b->s + b->len, str, n);
+  b->len += n;
+  b->s[b->len] = '\0';
+}
+
 void api__svg_buf_put(api_svg_buf *b, const char *str) {
   size_t n = strlen(str);
   if (!reserve(b, n)) return;
@@ -111,9 +122,7 @@ void api__svg_buf_num(api_svg_buf *b, double x, double budget, double *err) {
   if (!(budget >= 0.0) || !isfinite(budget)) budget = 0.0;
   size_t n = api__num_print_within(text, x, budget, &got);
   if (err && fabs(got - x) > *err) *err = fabs(got - x);
-  if (!reserve(b, n)) return;
-  memcpy(b->s + b->len, text, n + 1);
-  b->len += n;
+  api__svg_buf_put_n(b, text, n);
 }
 
 char *api__svg_buf_take(api_svg_buf *b) {

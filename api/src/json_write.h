@@ -1,0 +1,40 @@
+/* json_write.h - JSON answers written straight into one growing buffer
+ * (an api_svg_buf), as cJSON_PrintUnformatted would print the same tree
+ * but without building one: no node per number, no second pass.
+ *
+ * Every writer returns false when the answer cannot be written: a
+ * non-finite number (422 no-convergence recorded in ctx, as the tree
+ * writers of internal.h do). Out of memory is sticky in the buffer
+ * (b->failed) and reported once by api__json_done.
+ */
+#ifndef KMAPI_JSON_WRITE_H
+#define KMAPI_JSON_WRITE_H
+
+#include "internal.h"
+#include "svg.h"
+
+/* Literal JSON text (punctuation, keys with their quotes and colon). */
+static inline void api__json_raw(api_svg_buf *b, const char *text, size_t n) {
+  api__svg_buf_put_n(b, text, n);
+}
+#define API_JSON_LIT(b, lit) api__json_raw((b), (lit), sizeof(lit) - 1)
+
+/* A finite number in its shortest round-trip form; what names it in the
+ * error when it is not finite. */
+bool api__json_num(api_ctx *ctx, api_svg_buf *b, double v, const char *what);
+/* A string, quoted and escaped as cJSON escapes it. */
+void api__json_string(api_svg_buf *b, const char *s);
+/* n values (stride 1) or n points (stride 2, [x,y] each) as an array. */
+bool api__json_nums(api_ctx *ctx, api_svg_buf *b, const double *v, size_t n,
+                    size_t stride);
+/* A curve as the contract's Curve (output) object, as api__curve_json. */
+bool api__json_curve(api_ctx *ctx, api_svg_buf *b, const km_curve *c,
+                     bool svg_d, double tol);
+/* A cJSON tree (consumed) printed into the buffer, for the parts of an
+ * answer still built as trees. NULL item: false (the builder has recorded
+ * its error). */
+bool api__json_tree(api_ctx *ctx, api_svg_buf *b, cJSON *item);
+/* true when everything was written; else records 503 out of memory. */
+bool api__json_done(api_ctx *ctx, const api_svg_buf *b);
+
+#endif
