@@ -136,4 +136,9 @@ cJSON *api__shape_pairs_json(api_ctx *ctx, const api_morph_plan *pl);
  * contours, each slot with one common number of pieces. */
 cJSON *api__shape_animate_json(api_ctx *ctx, const api_morph_plan *pl);
 
+/* The SVG document of a compound morph's rendered frames in the request's
+ * layout, each frame filled under the fill rule of the nearer end
+ * (from's for t < 0.5), whose nesting it keeps. NULL when out of memory. */
+char *api__shape_svg(const api_morph_plan *pl);
+
 #endif

@@ -168,26 +168,10 @@ fail:
   return out->status;
 }
 
-/* The filmstrip of a compound morph: each frame filled under the fill
- * rule of the nearer end (from's for t < 0.5), whose nesting it keeps. */
-static char *shape_svg(const api_morph_plan *pl) {
-  api_svg_shape_frame *fr = km__malloc(pl->nframes * sizeof *fr);
-  char *doc;
-  if (fr == NULL) return NULL;
-  for (size_t i = 0; i < pl->nframes; i++) {
-    fr[i].t = pl->frames[i].t;
-    fr[i].shape = &pl->frames[i].shape;
-    fr[i].fill = fr[i].t < 0.5 ? pl->sfrom.fill : pl->sto.fill;
-  }
-  doc = api_svg_shape_document(fr, pl->nframes, &pl->svgopt);
-  km__free(fr);
-  return doc;
-}
-
 static api_status result_svg(api_ctx *ctx, api_morph_plan *pl,
                              api_response *out) {
   api_svg_frame *fr = pl->shapes ? NULL : km__malloc(pl->nframes * sizeof *fr);
-  char *doc = pl->shapes ? shape_svg(pl) : NULL;
+  char *doc = pl->shapes ? api__shape_svg(pl) : NULL;
   if (fr != NULL) {
     for (size_t i = 0; i < pl->nframes; i++) {
       fr[i].t = pl->frames[i].t;

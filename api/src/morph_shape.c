@@ -125,11 +125,6 @@ bool api__shape_check_request(api_ctx *ctx, api_morph_plan *pl) {
                         "arc-length matches pair points of two single "
                         "curves; pair the contours of shapes with "
                         "\"contour_matches\"");
-  if (pl->svg && pl->svgopt.layout != API_SVG_FILMSTRIP)
-    return api__invalid(ctx, "/svg/layout",
-                        "compound shapes are drawn as a filmstrip only: "
-                        "ask for \"layout\": \"filmstrip\" (or JSON, whose "
-                        "svg_d gives each frame's path)");
   return true;
 }
 
@@ -255,6 +250,13 @@ void api__shape_render(api_morph_plan *pl, api_frame_slot *f,
 #define SHAPE_FRAME_FIXED 200
 #define SHAPE_SLOT_FIXED 400
 #define SHAPE_DOC_FIXED 4096
+/* A curvature plot's number (px, within API_SVG_PX_BUDGET), a corner's
+ * tick with its title, a legend line, and a panel's axes, ticks, labels
+ * and clip path. */
+#define API_PX_NUM_BYTES 12
+#define SHAPE_CORNER_BYTES 240
+#define SHAPE_LEGEND_BYTES 240
+#define SHAPE_PANEL_FIXED 4096
 
 /* Degree and rationality of the frames' curves: the method's degree for
  * curvature morphs, the inputs' highest for linear ones. */
@@ -305,6 +307,33 @@ static km_status slot_points(const api_morph_plan *pl, const km_stop *stop,
   return st;
 }
 
+/* Bytes an SVG layout adds to a slot of `points` control points, per
+ * frame (*once: per document), beyond its one path a frame: the
+ * animation's value of at most 400 pieces (its first frame once more as
+ * the path's d), the curvature plot's trace (samples as
+ * svg_curvature_plot.c takes them: a budget per trace shared by the spans
+ * of kappa, fewer than the control points, at least three a span, at most
+ * 4,002), its corner ticks and legend line, and its panel's axes. */
+static size_t layout_bytes(const api_morph_plan *pl, size_t points,
+                           size_t npairs, size_t *once) {
+  *once = 0;
+  if (pl->svgopt.layout == API_SVG_ANIMATE) {
+    size_t pieces = 2 * points < 16 ? 16 : 2 * points > 400 ? 400 : 2 * points;
+    size_t value = 16 + API_SVG_NUM_BYTES * (2 + 6 * pieces);
+    *once = value;
+    return value;
+  }
+  if (pl->svgopt.layout != API_SVG_CURVATURE_PLOT) return 0;
+  size_t traces = pl->nframes * (npairs ? npairs : 1);
+  size_t budget = traces > 0 ? 400000 / traces : 1600;
+  budget = budget > 1600 ? 1600 : budget < 100 ? 100 : budget;
+  size_t samples = budget + points > 3 * points ? budget + points : 3 * points;
+  samples = samples + 2 > 4002 ? 4002 : samples + 2;
+  *once = SHAPE_PANEL_FIXED;
+  return samples * 2 * API_PX_NUM_BYTES + SHAPE_CORNER_BYTES * points +
+         SHAPE_LEGEND_BYTES;
+}
+
 /* Upper bound on the answer's bytes for slots of points[] control
  * points. */
 static size_t predict_bytes(const api_morph_plan *pl, const size_t *points,
@@ -312,24 +341,31 @@ static size_t predict_bytes(const api_morph_plan *pl, const size_t *points,
   int degree;
   bool rational;
   bool hermite = pl->opt.method == KM_METHOD_CURVATURE;
-  size_t per = SHAPE_FRAME_FIXED;
+  size_t per = SHAPE_FRAME_FIXED, once_all = 0;
   frame_kind(pl, &degree, &rational);
   for (size_t j = 0; j < npairs; j++) {
     size_t paths = (pl->inc.svg_d ? 1 : 0) + (pl->inc.animate_d ? 1 : 0);
-    size_t numbers = api__path_numbers(points[j], degree, hermite);
-    /* an SVG document holds each slot's path once a frame, nothing else */
+    size_t numbers = api__path_numbers(points[j], degree, hermite), once = 0;
+    /* an SVG document holds each slot's path once a frame, and what its
+     * layout adds */
     size_t slot =
         pl->svg ? 64
                 : SHAPE_SLOT_FIXED +
                       api__curve_json_bytes(points[j], degree, rational, false);
-    if (pl->svg) paths = 1;
+    if (pl->svg) {
+      paths = 1;
+      if (points[j] > SIZE_MAX / 4096) return SIZE_MAX;
+      slot += layout_bytes(pl, points[j], npairs, &once);
+      once_all += once;
+    }
     if (numbers > (SIZE_MAX / 4 - slot) / (API_SVG_NUM_BYTES + 1))
       return SIZE_MAX;
     slot += paths * (16 + API_SVG_NUM_BYTES * numbers);
     if (slot > SIZE_MAX / 4 - per) return SIZE_MAX;
     per += slot;
   }
-  size_t fixed = SHAPE_DOC_FIXED + (2 * API_JSON_NUM_BYTES + 3) * npairs;
+  size_t fixed =
+      SHAPE_DOC_FIXED + once_all + (2 * API_JSON_NUM_BYTES + 3) * npairs;
   if (pl->nframes > 0 && per > (SIZE_MAX - fixed) / pl->nframes)
     return SIZE_MAX;
   return fixed + per * pl->nframes;
@@ -550,4 +586,26 @@ oom:
   km__free(collapse);
   cJSON_Delete(a);
   return NULL;
+}
+
+char *api__shape_svg(const api_morph_plan *pl) {
+  size_t n = km_shape_morph_pairs(pl->smorph, NULL, 0);
+  api_svg_shape_frame *fr = km__malloc(pl->nframes * sizeof *fr);
+  km_shape_pair *pairs = km__malloc((n ? n : 1) * sizeof *pairs);
+  double *collapse = collapse_points(pl->smorph, n);
+  char *doc = NULL;
+  if (fr == NULL || pairs == NULL || collapse == NULL) goto done;
+  km_shape_morph_pairs(pl->smorph, pairs, n);
+  for (size_t i = 0; i < pl->nframes; i++) {
+    fr[i].t = pl->frames[i].t;
+    fr[i].shape = &pl->frames[i].shape;
+    fr[i].fill = fr[i].t < 0.5 ? pl->sfrom.fill : pl->sto.fill;
+  }
+  api_svg_shape_morph m = {fr, pl->nframes, n, pairs, collapse};
+  doc = api_svg_shape_document(&m, &pl->svgopt);
+done:
+  km__free(fr);
+  km__free(pairs);
+  km__free(collapse);
+  return doc;
 }

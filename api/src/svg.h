@@ -103,12 +103,28 @@ typedef struct api_svg_shape_frame {
   km_fill_rule fill; /* the rule its path is filled under */
 } api_svg_shape_frame;
 
-/* A complete, well-formed SVG filmstrip of a compound morph: per frame one
- * path of its present contours, filled (opt->stroke at 35% opacity) under
- * the frame's fill rule and stroked; opt's layout is not looked at (the
- * caller refuses the others), its sizes and stroke are. NULL on
- * out-of-memory. */
-char *api_svg_shape_document(const api_svg_shape_frame *frames, size_t n,
+/* A compound morph as its document draws it: n frames of nslots slots,
+ * what each slot pairs, and where a collapsed slot is a point. */
+typedef struct api_svg_shape_morph {
+  const api_svg_shape_frame *frames;
+  size_t n;
+  size_t nslots;
+  const km_shape_pair *pairs; /* nslots: the contours each slot morphs */
+  const double *collapse;     /* 2 per slot: a collapsed contour's point,
+                                 NaN for a paired slot */
+} api_svg_shape_morph;
+
+/* A complete, well-formed SVG document of a compound morph in opt's
+ * layout (NULL: a filmstrip with defaults). Shapes are filled under each
+ * frame's fill rule and stroked: the filmstrip one filled path a frame
+ * (opt->stroke at 35% opacity), the overlay every frame's path along the
+ * colour ramp (12% opacity), the animation one path whose <animate> of
+ * "d" has one value a frame, all of one command structure (a collapsed
+ * contour drawn at its point, see api_svg_shape_frame_d; the fill rule
+ * switched discretely where it changes), and the curvature plot one
+ * labelled panel per slot with a trace per frame where its contour is
+ * present. NULL on out-of-memory. */
+char *api_svg_shape_document(const api_svg_shape_morph *m,
                              const api_svg_options *opt);
 
 /* As api_svg_path_d_fixed, with the closing "Z" written when with_z is true

@@ -1,6 +1,8 @@
 /* svg_curvature_plot.c - the curvature plot layout: kappa against
  * normalised arc length s/L for every frame, along the colour ramp, with
- * corners as ticks, axes, and a legend of t values or a colour bar.
+ * corners as ticks, axes, and a legend of t values or a colour bar. A
+ * compound morph gets one such panel per contour pair, stacked and
+ * labelled with the pair.
  */
 #include <math.h>
 #include <stdio.h>
@@ -78,6 +80,12 @@ static double nice_step(double range) {
 /* The plot's geometry: the frames' samples, the range of kappa shown,
  * the margins and the plot area in px. */
 typedef struct plot {
+  double ox, oy, w, h; /* the panel's place in the document, px */
+  const char *clip_id; /* of the panel's clip path */
+  const char *label;   /* above the panel, or NULL */
+  const char *missing; /* legend note for a frame without a trace */
+  bool ramp;           /* draw the colour ramp when the legend is one */
+  size_t share;        /* traces sharing the document's sample budget */
   series *se;          /* one per frame */
   double lo, hi, step; /* kappa shown and its tick step */
   bool clipped;        /* kappa beyond [lo, hi] is drawn at its edge */
@@ -95,14 +103,15 @@ static double py(const plot *p, double v) {
 }
 
 /* Every frame's samples of kappa, its signature computed here when the
- * frame brought none (or left out when that fails); *total counts them.
+ * frame brought none (or left out when that fails, save for want of
+ * memory, which fails the document); *total counts them.
  * NULL when out of memory; a sampling that fails sets c->b.failed. */
-static series *plot_series(api_svg_doc *c, size_t *total) {
+static series *plot_series(api_svg_doc *c, size_t share, size_t *total) {
   series *se = km__calloc(c->n ? c->n : 1, sizeof *se);
   if (!se) return NULL;
-  /* Samples per frame: smooth curves for a few frames, a bounded document
+  /* Samples per trace: smooth curves for a few traces, a bounded document
    * for many. */
-  size_t budget = 400000 / c->n;
+  size_t budget = 400000 / share;
   if (budget > 1600) budget = 1600;
   if (budget < 100) budget = 100;
   *total = 0;
@@ -110,10 +119,13 @@ static series *plot_series(api_svg_doc *c, size_t *total) {
     km_signature_init(&se[i].own);
     se[i].sig = c->f[i].sig;
     if (!se[i].sig && c->f[i].curve) {
-      if (km_signature_compute(c->f[i].curve, 0, &se[i].own, NULL) == KM_OK) {
+      km_status st = km_signature_compute(c->f[i].curve, 0, &se[i].own, NULL);
+      if (st == KM_OK) {
         se[i].has_own = true;
         se[i].sig = &se[i].own;
       }
+      /* a trace left out for want of memory would be a wrong answer */
+      if (st == KM_ENOMEM) c->b.failed = true;
     }
     if (se[i].sig && !sample_kappa(&se[i], budget)) c->b.failed = true;
     *total += se[i].n;
@@ -171,17 +183,19 @@ static void plot_range(api_svg_doc *c, plot *p, size_t total) {
  * them, for a colour ramp below when it does not. */
 static void plot_layout(const api_svg_doc *c, plot *p) {
   p->legend_list = c->n <= 12;
-  p->ml = 64;
+  p->ml = p->ox + 64;
   p->mr = p->legend_list ? 100 : 16;
-  p->mt = 16;
-  p->mb = p->legend_list ? 48 : 72;
-  p->pw = fmax(c->W - p->ml - p->mr, 10);
-  p->ph = fmax(c->H - p->mt - p->mb, 10);
+  p->mt = p->oy + (p->label != NULL ? 30 : 16);
+  p->mb = p->legend_list || !p->ramp ? 48 : 72;
+  p->pw = fmax(p->ox + p->w - p->ml - p->mr, 10);
+  p->ph = fmax(p->oy + p->h - p->mt - p->mb, 10);
 }
 
 /* The plot area's clip path, and the group of axes and labels opened. */
 static void plot_clip_open(api_svg_doc *c, const plot *p) {
-  api__svg_buf_put(&c->b, "<defs><clipPath id=\"km-plot\"><rect x=\"");
+  api__svg_buf_put(&c->b, "<defs><clipPath id=\"");
+  api__svg_buf_put(&c->b, p->clip_id);
+  api__svg_buf_put(&c->b, "\"><rect x=\"");
   api__svg_px(c, p->ml);
   api__svg_buf_put(&c->b, "\" y=\"");
   api__svg_px(c, p->mt);
@@ -252,17 +266,21 @@ static void plot_axis_labels(api_svg_doc *c, const plot *p) {
   api__svg_buf_put(&c->b, "\" y=\"");
   api__svg_px(c, p->mt + p->ph + 34);
   api__svg_buf_put(&c->b, "\" text-anchor=\"middle\" font-size=\"12\">"
-                          "normalised arc length s/L</text>\n<text x=\"14\" "
-                          "y=\"");
+                          "normalised arc length s/L</text>\n<text x=\"");
+  api__svg_px(c, p->ox + 14);
+  api__svg_buf_put(&c->b, "\" y=\"");
   api__svg_px(c, p->mt + 0.5 * p->ph);
   api__svg_buf_put(&c->b, "\" text-anchor=\"middle\" font-size=\"12\" "
-                          "transform=\"rotate(-90 14 ");
+                          "transform=\"rotate(-90 ");
+  api__svg_px(c, p->ox + 14);
+  api__svg_buf_put(&c->b, " ");
   api__svg_px(c, p->mt + 0.5 * p->ph);
   api__svg_buf_put(&c->b, p->clipped
                               ? ")\">curvature \xce\xba (clipped)</text>\n"
                               : ")\">curvature \xce\xba</text>\n");
-  api__svg_buf_put(&c->b, "</g>\n<g clip-path=\"url(#km-plot)\" fill=\"none\" "
-                          "stroke-linejoin=\"round\">\n");
+  api__svg_buf_put(&c->b, "</g>\n<g clip-path=\"url(#");
+  api__svg_buf_put(&c->b, p->clip_id);
+  api__svg_buf_put(&c->b, ")\" fill=\"none\" stroke-linejoin=\"round\">\n");
 }
 
 /* Corners: tangent jumps as vertical ticks at their s/L from the zero
@@ -325,52 +343,91 @@ static void plot_legend(api_svg_doc *c, const plot *p) {
       api__svg_frame_colour(c, i, col);
       double y = p->mt + 8 + 16 * (double)i;
       api__svg_buf_put(&c->b, "<line x1=\"");
-      api__svg_px(c, c->W - p->mr + 10);
+      api__svg_px(c, p->ox + p->w - p->mr + 10);
       api__svg_buf_put(&c->b, "\" y1=\"");
       api__svg_px(c, y);
       api__svg_buf_put(&c->b, "\" x2=\"");
-      api__svg_px(c, c->W - p->mr + 30);
+      api__svg_px(c, p->ox + p->w - p->mr + 30);
       api__svg_buf_put(&c->b, "\" y2=\"");
       api__svg_px(c, y);
       api__svg_buf_put(&c->b, "\" stroke-width=\"3\" stroke=\"");
       api__svg_buf_put(&c->b, col);
       api__svg_buf_put(&c->b, "\"/>\n<text x=\"");
-      api__svg_px(c, c->W - p->mr + 34);
+      api__svg_px(c, p->ox + p->w - p->mr + 34);
       api__svg_buf_put(&c->b, "\" y=\"");
       api__svg_px(c, y + 4);
       api__svg_buf_put(&c->b, "\" " API_SVG_FONT
                               " font-size=\"11\" fill=\"#333333\">");
       api__svg_t_label(c, c->f[i].t);
-      if (!p->se[i].n) api__svg_buf_put(&c->b, " (no signature)");
+      if (!p->se[i].n) api__svg_buf_put(&c->b, p->missing);
       api__svg_buf_put(&c->b, "</text>\n");
     }
-  } else {
-    api__svg_ramp_legend(c, p->ml, c->H - 10, p->pw);
+  } else if (p->ramp) {
+    api__svg_ramp_legend(c, p->ml, p->oy + p->h - 10, p->pw);
   }
+}
+
+/* The panel p (its place, ids and label set) of the frames c->f. */
+static void plot_panel(api_svg_doc *c, plot *p) {
+  size_t total = 0;
+  if ((p->se = plot_series(c, p->share, &total)) == NULL) {
+    c->b.failed = true;
+    return;
+  }
+  plot_range(c, p, total);
+  plot_layout(c, p);
+  if (p->label != NULL) {
+    api__svg_buf_put(&c->b, "<text x=\"");
+    api__svg_px(c, p->ml);
+    api__svg_buf_put(&c->b, "\" y=\"");
+    api__svg_px(c, p->oy + 20);
+    api__svg_buf_put(&c->b, "\" " API_SVG_FONT " font-size=\"13\" "
+                            "fill=\"#333333\">");
+    api__svg_buf_escaped(&c->b, p->label);
+    api__svg_buf_put(&c->b, "</text>\n");
+  }
+  plot_clip_open(c, p);
+  plot_x_ticks(c, p);
+  plot_y_ticks(c, p);
+  plot_axis_labels(c, p);
+  for (size_t i = 0; i < c->n; i++)
+    if (p->se[i].n) plot_curve(c, p, i);
+  api__svg_buf_put(&c->b, "</g>\n");
+  plot_legend(c, p);
+  series_free(p->se, c->n);
+  p->se = NULL;
 }
 
 void api__svg_curvature_plot(api_svg_doc *c, const api_svg_options *o) {
   plot p;
-  size_t total = 0;
   c->W = o->width > 0 ? o->width : 640.0;
   c->H = o->height > 0 ? o->height : 400.0;
   char title[80];
   snprintf(title, sizeof title, "kmorph curvature plot of %zu frames", c->n);
   api__svg_doc_open(c, title);
   memset(&p, 0, sizeof p);
-  if ((p.se = plot_series(c, &total)) == NULL) {
-    c->b.failed = true;
-    return;
-  }
-  plot_range(c, &p, total);
-  plot_layout(c, &p);
-  plot_clip_open(c, &p);
-  plot_x_ticks(c, &p);
-  plot_y_ticks(c, &p);
-  plot_axis_labels(c, &p);
-  for (size_t i = 0; i < c->n; i++)
-    if (p.se[i].n) plot_curve(c, &p, i);
-  api__svg_buf_put(&c->b, "</g>\n");
-  plot_legend(c, &p);
-  series_free(p.se, c->n);
+  p.w = c->W;
+  p.h = c->H;
+  p.clip_id = "km-plot";
+  p.missing = " (no signature)";
+  p.ramp = true;
+  p.share = c->n;
+  plot_panel(c, &p);
+}
+
+void api__svg_curvature_panel(api_svg_doc *c, double y, double h, size_t k,
+                              size_t npanels, const char *label) {
+  plot p;
+  char id[40];
+  memset(&p, 0, sizeof p);
+  snprintf(id, sizeof id, "km-plot-%zu", k);
+  p.oy = y;
+  p.w = c->W;
+  p.h = h;
+  p.clip_id = id;
+  p.label = label;
+  p.missing = " (point)";
+  p.ramp = k + 1 == npanels;
+  p.share = c->n * (npanels ? npanels : 1);
+  plot_panel(c, &p);
 }

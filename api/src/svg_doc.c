@@ -262,29 +262,34 @@ void api__svg_ramp_legend(api_svg_doc *c, double x, double y, double w) {
   api__svg_buf_put(&c->b, "</text>\n");
 }
 
+void api__svg_doc_init(api_svg_doc *c, const api_svg_options *opt,
+                       api_svg_options *o) {
+  if (opt)
+    *o = *opt;
+  else {
+    memset(o, 0, sizeof *o);
+    o->layout = API_SVG_FILMSTRIP;
+  }
+  /* Absurd sizes would make documents no renderer can allocate. */
+  if (!(o->width <= 1e5)) o->width = 0;
+  if (!(o->height <= 1e5)) o->height = 0;
+  memset(c, 0, sizeof *c);
+  api__svg_buf_init(&c->b);
+  c->sw = o->stroke_width > 0 && o->stroke_width < 1e3 ? o->stroke_width : 1.5;
+  c->stroke = colour_or(o->stroke, DEF_STROKE);
+  c->from_s = colour_or(o->from_color, DEF_FROM);
+  c->to_s = colour_or(o->to_color, DEF_TO);
+  if (!parse_hex(c->from_s, &c->from)) parse_hex(DEF_FROM, &c->from);
+  if (!parse_hex(c->to_s, &c->to)) parse_hex(DEF_TO, &c->to);
+}
+
 char *api_svg_morph_document(const api_svg_frame *frames, size_t n,
                              const api_svg_options *opt) {
   api_svg_options o;
-  if (opt)
-    o = *opt;
-  else {
-    memset(&o, 0, sizeof o);
-    o.layout = API_SVG_FILMSTRIP;
-  }
-  /* Absurd sizes would make documents no renderer can allocate. */
-  if (!(o.width <= 1e5)) o.width = 0;
-  if (!(o.height <= 1e5)) o.height = 0;
   api_svg_doc c;
-  memset(&c, 0, sizeof c);
-  api__svg_buf_init(&c.b);
+  api__svg_doc_init(&c, opt, &o);
   c.f = frames;
   c.n = frames ? n : 0;
-  c.sw = o.stroke_width > 0 && o.stroke_width < 1e3 ? o.stroke_width : 1.5;
-  c.stroke = colour_or(o.stroke, DEF_STROKE);
-  c.from_s = colour_or(o.from_color, DEF_FROM);
-  c.to_s = colour_or(o.to_color, DEF_TO);
-  if (!parse_hex(c.from_s, &c.from)) parse_hex(DEF_FROM, &c.from);
-  if (!parse_hex(c.to_s, &c.to)) parse_hex(DEF_TO, &c.to);
   if (c.n == 0) {
     c.W = o.width > 0 ? o.width : 200;
     c.H = o.height > 0 ? o.height : 40;

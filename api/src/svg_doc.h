@@ -40,6 +40,11 @@ typedef struct api_svg_doc {
   const char *from_s, *to_s; /* colour strings as written */
 } api_svg_doc;
 
+/* An empty document for options opt (NULL: defaults), which are copied
+ * into *o with absurd sizes dropped: the stroke, its width and the colour
+ * ramp taken from them or their defaults. c->f and c->n are left 0. */
+void api__svg_doc_init(api_svg_doc *c, const api_svg_options *opt,
+                       api_svg_options *o);
 /* A document coordinate, printed within API_SVG_PX_BUDGET. */
 void api__svg_px(api_svg_doc *c, double v);
 /* Open a <path> element whose transform maps the frames' box bb, scaled by
@@ -77,5 +82,12 @@ void api__svg_filmstrip(api_svg_doc *c, const api_svg_options *o);
 void api__svg_overlay(api_svg_doc *c, const api_svg_options *o);
 void api__svg_animate(api_svg_doc *c, const api_svg_options *o);
 void api__svg_curvature_plot(api_svg_doc *c, const api_svg_options *o);
+/* Panel k of npanels of a compound morph's curvature plot: the frames
+ * c->f (one contour's pair, NULL curves where it is collapsed) across the
+ * document, from y down h px, under `label`; the colour ramp, when the
+ * legend is one, under the last panel only. The caller opens the
+ * document. */
+void api__svg_curvature_panel(api_svg_doc *c, double y, double h, size_t k,
+                              size_t npanels, const char *label);
 
 #endif

@@ -195,6 +195,32 @@ static void morph_svg_layouts_answer_503_when_out_of_memory(void **state) {
   both_loops("POST /v1/morph animate_d", API_ROUTE_MORPH, NULL, false, body);
 }
 
+/* A compound morph whose second square vanishes: its SVG layouts and its
+ * animate_d, where the collapsed square is drawn at its point. */
+static void shape_svg_layouts_answer_503_when_out_of_memory(void **state) {
+  static const char *const layouts[] = {"filmstrip", "overlay", "animate",
+                                        "curvature_plot"};
+  static const char two[] = "{\"type\":\"svg\",\"d\":\"M 0 0 H 1 V 1 H 0 Z "
+                            "M 3 0 H 4 V 1 H 3 Z\"}";
+  static const char one[] = "{\"type\":\"svg\",\"d\":\"M 0 0 H 1 V 1 H 0 Z\"}";
+  char body[1024], name[64];
+  (void)state;
+  for (size_t i = 0; i < sizeof layouts / sizeof layouts[0]; i++) {
+    snprintf(body, sizeof body,
+             "{\"from\":%s,\"to\":%s,\"frames\":3,\"format\":\"svg\","
+             "\"svg\":{\"layout\":\"%s\"},\"tolerance\":1e-3}",
+             two, one, layouts[i]);
+    snprintf(name, sizeof name, "POST /v1/morph shapes SVG %s", layouts[i]);
+    both_loops(name, API_ROUTE_MORPH, NULL, false, body);
+  }
+  snprintf(body, sizeof body,
+           "{\"from\":%s,\"to\":%s,\"frames\":3,"
+           "\"include\":[\"animate_d\"],\"tolerance\":1e-3}",
+           two, one);
+  both_loops("POST /v1/morph shapes animate_d", API_ROUTE_MORPH, NULL, false,
+             body);
+}
+
 static void prepared_morph_answers_503_when_out_of_memory(void **state) {
   char body[1024];
   (void)state;
@@ -213,6 +239,7 @@ static const struct CMUnitTest tests[] = {
     cmocka_unit_test(morph_linear_auto_answers_503_when_out_of_memory),
     cmocka_unit_test(morph_svg_answers_503_when_out_of_memory),
     cmocka_unit_test(morph_svg_layouts_answer_503_when_out_of_memory),
+    cmocka_unit_test(shape_svg_layouts_answer_503_when_out_of_memory),
     cmocka_unit_test(prepared_morph_answers_503_when_out_of_memory),
 };
 

@@ -12,6 +12,7 @@
  */
 #include <math.h>
 #include <stdlib.h>
+#include <unistd.h>
 
 #include "api_testutil.h"
 #include "testmain.h"
@@ -271,10 +272,10 @@ static void animate_d_keeps_one_structure(void **state) {
  * on that point. */
 static void collapsed_contour_is_a_point_inside_its_host(void **state) {
   (void)state;
-  const int nframes = 41;
+  const int nframes = 21;
   for (size_t c = 0; c < sizeof CASES / sizeof CASES[0]; c++) {
     char *body = pair_request(CASES[c].from, CASES[c].to,
-                              ",\"frames\":41,\"include\":[\"animate_d\"]");
+                              ",\"frames\":21,\"include\":[\"animate_d\"]");
     cJSON *j = at_expect_json(MORPH, body);
     const cJSON *ad = member(j, "animate_d");
     const cJSON *used = member(j, "contour_matches_used");
@@ -309,15 +310,15 @@ static void collapsed_contour_is_a_point_inside_its_host(void **state) {
                     "paired contour\n",
                     CASES[c].from, CASES[c].to, slot, x[0], x[1]);
       assert_true(inside);
-      /* a frame 1/40 from the end: scaled by 1/40 about a point 1/40 of
-       * the way back along its path, so within 2/40 of the size (its
+      /* a frame 1/20 from the end: scaled by 1/20 about a point 1/20 of
+       * the way back along its path, so within 2/20 of the size (its
        * travel and its own extent are each within the size) */
       double r = spread_about(&pn, (size_t)slot, x);
-      if (!(r <= 2.0 / 40 * size && r > 0))
+      if (!(r <= 2.0 / 20 * size && r > 0))
         print_error("%s -> %s: slot %d next to its end spreads %g about its "
                     "point, size %g\n",
                     CASES[c].from, CASES[c].to, slot, r, size);
-      assert_true(r <= 2.0 / 40 * size && r > 0);
+      assert_true(r <= 2.0 / 20 * size && r > 0);
       path_free(&pe);
       path_free(&pn);
     }
@@ -327,9 +328,336 @@ static void collapsed_contour_is_a_point_inside_its_host(void **state) {
   }
 }
 
+/* ---- SVG documents ---- */
+
+static const char *const LAYOUTS[] = {"filmstrip", "overlay", "animate",
+                                      "curvature_plot"};
+
+/* Write text to a fresh file under build/, its name into name. */
+static void write_temp(const char *text, char name[64]) {
+  strcpy(name, "build/shapesvg-XXXXXX");
+  int fd = mkstemp(name);
+  assert_true(fd >= 0);
+  FILE *f = fdopen(fd, "w");
+  assert_non_null(f);
+  assert_true(fputs(text, f) >= 0);
+  assert_int_equal(fclose(f), 0);
+}
+
+/* Exit status of cmd, its first line of output in out. */
+static int run(const char *cmd, char *out, size_t cap) {
+  FILE *p = popen(cmd, "r");
+  char sink[256];
+  assert_non_null(p);
+  out[0] = '\0';
+  if (!fgets(out, (int)cap, p)) out[0] = '\0';
+  while (fgets(sink, sizeof sink, p)) {
+  }
+  return pclose(p);
+}
+
+/* The document parses as XML (libxml2's xmllint) and renders (librsvg) to
+ * a PNG that is not empty. */
+static void check_xml_and_render(const char *doc, const char *what) {
+  char svg[64], png[64], cmd[256], line[256];
+  write_temp(doc, svg);
+  snprintf(cmd, sizeof cmd, "xmllint --noout %s 2>&1", svg);
+  int st = run(cmd, line, sizeof line);
+  if (st != 0) print_error("%s: xmllint: %s\n", what, line);
+  assert_int_equal(st, 0);
+  write_temp("", png);
+  snprintf(cmd, sizeof cmd, "rsvg-convert -f png -o %s %s 2>&1", png, svg);
+  st = run(cmd, line, sizeof line);
+  if (st != 0) print_error("%s: rsvg-convert: %s\n", what, line);
+  assert_int_equal(st, 0);
+  FILE *f = fopen(png, "rb");
+  assert_non_null(f);
+  assert_int_equal(fseek(f, 0, SEEK_END), 0);
+  assert_true(ftell(f) > 100);
+  fclose(f);
+  unlink(svg);
+  unlink(png);
+}
+
+/* The SVG answer to body through the prepared plan, checked against the
+ * size it was predicted to take before any frame (caller frees). */
+static char *svg_answer(const char *body) {
+  api_config cfg;
+  api_request req;
+  api_response err, res;
+  api_morph_plan *plan = NULL;
+  api_config_default(&cfg);
+  memset(&req, 0, sizeof req);
+  req.route = MORPH;
+  req.body = body;
+  req.length = strlen(body);
+  int st = api_morph_prepare(&cfg, &req, 10, &plan, &err);
+  if (st != API_STEP_DONE) print_error("prepare: %s\n", err.body);
+  assert_int_equal(st, API_STEP_DONE);
+  size_t bound = api_morph_predicted_bytes(plan);
+  assert_int_equal(api_morph_result(plan, &res), 200);
+  assert_string_equal(res.content_type, "image/svg+xml");
+  if (bound < res.length)
+    print_error("%zu bytes against a bound of %zu\n", res.length, bound);
+  assert_true(bound >= res.length);
+  char *doc = malloc(res.length + 1);
+  assert_non_null(doc);
+  memcpy(doc, res.body, res.length + 1);
+  api_morph_plan_free(plan);
+  api_response_free(&res);
+  return doc;
+}
+
+static char *layout_request(const morph_case *mc, const char *layout,
+                            int frames) {
+  char extra[160];
+  snprintf(extra, sizeof extra,
+           ",\"frames\":%d,\"format\":\"svg\",\"svg\":{\"layout\":\"%s\"}",
+           frames, layout);
+  return pair_request(mc->from, mc->to, extra);
+}
+
+static size_t count(const char *s, const char *what) {
+  size_t n = 0;
+  for (const char *p = strstr(s, what); p != NULL; p = strstr(p + 1, what)) n++;
+  return n;
+}
+
+/* Every layout of every case is XML that renders, within its bound. */
+static void every_layout_parses_and_renders(void **state) {
+  (void)state;
+  for (size_t c = 0; c < sizeof CASES / sizeof CASES[0]; c++)
+    for (size_t l = 0; l < 4; l++) {
+      char *body = layout_request(&CASES[c], LAYOUTS[l], 5), what[128];
+      char *doc = svg_answer(body);
+      snprintf(what, sizeof what, "%s -> %s %s", CASES[c].from, CASES[c].to,
+               LAYOUTS[l]);
+      check_xml_and_render(doc, what);
+      free(doc);
+      free(body);
+    }
+}
+
+/* The value of attribute `name` of the element at p (malloc'd). */
+static char *attribute(const char *p, const char *name) {
+  char key[64];
+  snprintf(key, sizeof key, " %s=\"", name);
+  const char *end = strchr(p, '>'), *a = strstr(p, key);
+  if (a == NULL || a > end) return NULL;
+  a += strlen(key);
+  const char *z = strchr(a, '"');
+  char *v = malloc((size_t)(z - a) + 1);
+  assert_non_null(v);
+  memcpy(v, a, (size_t)(z - a));
+  v[z - a] = '\0';
+  return v;
+}
+
+/* Filled paths of doc: each has fill-rule `rule`; their count. */
+static size_t filled_paths(const char *doc, const char *rule) {
+  size_t n = 0;
+  for (const char *p = strstr(doc, "<path "); p != NULL;
+       p = strstr(p + 1, "<path ")) {
+    char *fill = attribute(p, "fill"), *fr = attribute(p, "fill-rule");
+    if (fill != NULL && strcmp(fill, "none") != 0) {
+      if (fr == NULL || strcmp(fr, rule) != 0)
+        print_error("a filled path with fill-rule %s, not %s\n",
+                    fr ? fr : "(none)", rule);
+      assert_non_null(fr);
+      assert_string_equal(fr, rule);
+      n++;
+    }
+    free(fill);
+    free(fr);
+  }
+  return n;
+}
+
+/* Two unit squares side by side against one; evenodd on both sides. */
+#define SQUARE_AT(x0, x1)                                                      \
+  "{\"type\":\"bspline\",\"degree\":1,\"knots\":[0,0,1,2,3,4,4],"              \
+  "\"control_points\":[[" #x0 ",0],[" #x1 ",0],[" #x1 ",1],[" #x0 ",1],[" #x0  \
+  ",0]],\"closed\":true}"
+#define SHAPE(rule, ...)                                                       \
+  "{\"type\":\"shape\",\"fill_rule\":\"" rule "\",\"contours\":[" __VA_ARGS__  \
+  "]}"
+
+/* The filmstrip, the overlay and the animation fill every shape under its
+ * fill rule: one filled path a frame, one for the animation; and where the
+ * two ends' rules differ the animation switches its rule at t = 0.5. */
+static void fills_carry_the_fill_rule(void **state) {
+  (void)state;
+  static const size_t want[3] = {3, 3, 1};
+  for (size_t l = 0; l < 3; l++) {
+    char body[2048];
+    snprintf(
+        body, sizeof body,
+        "{\"from\":" SHAPE(
+            "evenodd",
+            SQUARE_AT(0, 1) "," SQUARE_AT(
+                3, 4)) ",\"to\":" SHAPE("evenodd",
+                                        SQUARE_AT(0, 1)) ",\"frames\":3,"
+                                                         "\"format\":\"svg\","
+                                                         "\"svg\":{"
+                                                         "\"layout\":\"%s\"}}",
+        LAYOUTS[l]);
+    char *doc = svg_answer(body);
+    assert_int_equal(filled_paths(doc, "evenodd"), want[l]);
+    assert_int_equal(count(doc, "fill-rule=\"nonzero\""), 0);
+    free(doc);
+    char *gl = layout_request(&CASES[0], LAYOUTS[l], 3);
+    doc = svg_answer(gl);
+    assert_int_equal(filled_paths(doc, "nonzero"), want[l]);
+    free(doc);
+    free(gl);
+  }
+  /* evenodd to nonzero: the rule of the nearer end, switched at 0.5 */
+  char *doc = svg_answer("{\"from\":" SHAPE(
+      "evenodd",
+      SQUARE_AT(0, 1) "," SQUARE_AT(
+          3, 4)) ",\"to\":" SHAPE("nonzero",
+                                  SQUARE_AT(0, 1) "," SQUARE_AT(
+                                      3, 4)) ",\"frames\":3,\"format\":\"svg\","
+                                             "\"svg\":{\"layout\":"
+                                             "\"animate\"}}");
+  const char *a = strstr(doc, "<animate attributeName=\"fill-rule\"");
+  assert_non_null(a);
+  char *values = attribute(a, "values"), *mode = attribute(a, "calcMode");
+  assert_string_equal(values, "evenodd;nonzero;nonzero");
+  assert_string_equal(mode, "discrete");
+  free(values);
+  free(mode);
+  free(doc);
+}
+
+/* The animation's values split at ';' into paths (malloc'd, *n of them). */
+static char **split_values(const char *v, size_t *n) {
+  size_t cap = count(v, ";") + 1, len;
+  char **out = malloc(cap * sizeof *out);
+  assert_non_null(out);
+  *n = 0;
+  for (const char *p = v;; p += len + 1) {
+    const char *z = strchr(p, ';');
+    len = z != NULL ? (size_t)(z - p) : strlen(p);
+    out[*n] = malloc(len + 1);
+    assert_non_null(out[*n]);
+    memcpy(out[*n], p, len);
+    out[(*n)++][len] = '\0';
+    if (z == NULL) break;
+  }
+  return out;
+}
+
+/* The animate layout: one <animate> of "d" with a value a frame and as
+ * many key times, every value of the first one's commands and numbers,
+ * one subpath a slot, the collapsed slot one point inside a paired
+ * contour. */
+static void animation_values_share_one_structure(void **state) {
+  (void)state;
+  for (size_t c = 0; c < sizeof CASES / sizeof CASES[0]; c++) {
+    char *body = layout_request(&CASES[c], "animate", 9);
+    char *doc = svg_answer(body);
+    assert_int_equal(count(doc, "<animate attributeName=\"d\""), 1);
+    const char *a = strstr(doc, "<animate attributeName=\"d\"");
+    char *values = attribute(a, "values"), *keys = attribute(a, "keyTimes");
+    size_t n, nk;
+    char **vs = split_values(values, &n), **ks = split_values(keys, &nk);
+    assert_int_equal(n, 9);
+    assert_int_equal(nk, 9);
+    path first, p;
+    path_parse(vs[0], &first);
+    assert_int_equal(first.nsub, (size_t)CASES[c].slots);
+    for (size_t i = 0; i < n; i++) {
+      path_parse(vs[i], &p);
+      if (strcmp(p.structure, first.structure) != 0)
+        print_error("%s -> %s: value %zu is %s, the first %s\n", CASES[c].from,
+                    CASES[c].to, i, p.structure, first.structure);
+      assert_int_equal(p.nsub, first.nsub);
+      assert_string_equal(p.structure, first.structure);
+      /* a collapsed slot at the ends: one point inside another subpath */
+      for (size_t k = 0; (i == 0 || i + 1 == n) && k < p.nsub; k++) {
+        if (spread_about(&p, k, p.pts[k]) > 1e-9 * drawing_size(&p)) continue;
+        bool inside = false;
+        for (size_t h = 0; h < p.nsub; h++) {
+          size_t np;
+          if (h == k || spread_about(&p, h, p.pts[h]) == 0) continue;
+          double *q = subpath_polyline(&p, h, &np);
+          inside = inside || winding(q, np, p.pts[k]) != 0;
+          free(q);
+        }
+        assert_true(inside);
+      }
+      path_free(&p);
+      free(vs[i]);
+      free(ks[i]);
+    }
+    path_free(&first);
+    free(vs);
+    free(ks);
+    free(values);
+    free(keys);
+    free(doc);
+    free(body);
+  }
+}
+
+/* The curvature plot: one labelled panel per contour pair, each with one
+ * trace per frame where the pair's contour is present (as the JSON answer
+ * to the same morph says), none where it is a point. */
+static void curvature_plot_has_a_panel_per_pair(void **state) {
+  (void)state;
+  for (size_t c = 0; c < sizeof CASES / sizeof CASES[0]; c++) {
+    char *body = layout_request(&CASES[c], "curvature_plot", 5);
+    char *jbody = pair_request(CASES[c].from, CASES[c].to, ",\"frames\":5");
+    char *doc = svg_answer(body);
+    cJSON *j = at_expect_json(MORPH, jbody);
+    const cJSON *frames = member(j, "frames");
+    int slots = CASES[c].slots;
+    assert_int_equal(count(doc, "<g id=\"km-pair-"), (size_t)slots);
+    for (int k = 0; k < slots; k++) {
+      char id[40], label[40];
+      snprintf(id, sizeof id, "<g id=\"km-pair-%d\">", k);
+      snprintf(label, sizeof label, ">pair %d: contour", k);
+      const char *g = strstr(doc, id), *end;
+      assert_non_null(g);
+      /* the panel runs to the next one or the document's end */
+      end = strstr(g + 1, "<g id=\"km-pair-");
+      if (end == NULL) end = strstr(g, "</svg>");
+      assert_non_null(end);
+      /* the panel's label names the pair */
+      const char *lab = strstr(g, label);
+      char alt[40];
+      snprintf(alt, sizeof alt, ">pair %d: (appears)", k);
+      const char *lab2 = strstr(g, alt);
+      assert_true((lab != NULL && lab < end) || (lab2 != NULL && lab2 < end));
+      size_t traces = 0, present = 0;
+      for (const char *p = strstr(g, "<path "); p != NULL && p < end;
+           p = strstr(p + 1, "<path "))
+        traces++;
+      const cJSON *f;
+      cJSON_ArrayForEach(f, frames) {
+        present += cJSON_IsObject(cJSON_GetArrayItem(member(f, "contours"), k));
+      }
+      if (traces != present)
+        print_error("%s -> %s: panel %d has %zu traces, %zu frames with its "
+                    "contour\n",
+                    CASES[c].from, CASES[c].to, k, traces, present);
+      assert_int_equal(traces, present);
+    }
+    cJSON_Delete(j);
+    free(doc);
+    free(jbody);
+    free(body);
+  }
+}
+
 static const struct CMUnitTest tests[] = {
     cmocka_unit_test(animate_d_keeps_one_structure),
     cmocka_unit_test(collapsed_contour_is_a_point_inside_its_host),
+    cmocka_unit_test(every_layout_parses_and_renders),
+    cmocka_unit_test(fills_carry_the_fill_rule),
+    cmocka_unit_test(animation_values_share_one_structure),
+    cmocka_unit_test(curvature_plot_has_a_panel_per_pair),
 };
 
 TM_SUITE("api_shape_svg", tests, NULL, NULL);

@@ -347,10 +347,6 @@ static void contours_past_the_limit_are_refused(void **state) {
 static void what_shapes_do_not_take_is_named(void **state) {
   (void)state;
   at_problem(MORPH,
-             "{\"from\":" RING ",\"to\":" RING ",\"format\":\"svg\","
-             "\"svg\":{\"layout\":\"overlay\"}}",
-             422, "/svg/layout");
-  at_problem(MORPH,
              "{\"from\":" RING ",\"to\":" RING ",\"matches\":[[0.5,0.5]]}", 422,
              "/matches");
   at_problem(MORPH,
