@@ -327,9 +327,34 @@ static void snap_knots(km__hcurve *b, const km__hcurve *a, double snap) {
   }
 }
 
+/* Interior knots within snap of a domain end are that end: a span
+ * narrower than rounding there (left by a seam moved onto a knot) is
+ * dropped with its control points. The basis functions of the remaining
+ * points depend only on the remaining knots, so the trace is unchanged up
+ * to the sliver's width; the end points are kept exactly, so a closed
+ * curve stays closed. In place; h->n shrinks. */
+static void drop_end_slivers(km__hcurve *h, double snap) {
+  size_t p = (size_t)h->degree, n = h->n, nk = n + p + 1, dim = (size_t)h->dim;
+  double *U = h->knots, *P = h->pw, t0 = U[0], t1 = U[nk - 1];
+  size_t head = 0, tail = 0;
+  while (p + 1 + head < n && U[p + 1 + head] <= t0 + snap) head++;
+  while (n - 1 - tail > p + head && U[n - 1 - tail] >= t1 - snap) tail++;
+  if (head == 0 && tail == 0) return;
+  /* the first point moves onto the start it replaces, the last likewise */
+  memcpy(P + head * dim, P, dim * sizeof *P);
+  memcpy(P + (n - 1 - tail) * dim, P + (n - 1) * dim, dim * sizeof *P);
+  memmove(P, P + head * dim, (n - head - tail) * dim * sizeof *P);
+  memmove(U, U + head, (nk - head - tail) * sizeof *U);
+  h->n = n - head - tail;
+  for (size_t i = 0; i <= p; i++) {
+    U[i] = t0;
+    U[h->n + p - i] = t1;
+  }
+}
+
 /* Both curves on [0, 1], of the larger degree, with one merged knot vector
  * (multiplicity the larger of the two; knots closer than 1e-13 are taken
- * as one) and both rational if either is (unit weights for a polynomial
+ * as one, and as the domain's end within 1e-13 of it) and both rational if either is (unit weights for a polynomial
  * one). Traces unchanged, closed flags kept. Returns KM_OK, KM_EINVAL,
  * KM_ENOMEM; on failure neither output is written; outputs owned by the
  * caller. Thread-safe. */
@@ -358,6 +383,8 @@ km_status km_curve_make_compatible(const km_curve *a, const km_curve *b,
   if (st) goto cleanup;
   reparam_knots(ha.knots, ha.n + (size_t)ha.degree + 1, ha.degree, 0.0, 1.0);
   reparam_knots(hb.knots, hb.n + (size_t)hb.degree + 1, hb.degree, 0.0, 1.0);
+  drop_end_slivers(&ha, 1e-13);
+  drop_end_slivers(&hb, 1e-13);
   st = km__h_elevate(&ea, &ha, q - a->degree);
   if (st) goto cleanup;
   st = km__h_elevate(&eb, &hb, q - b->degree);

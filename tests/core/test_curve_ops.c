@@ -424,6 +424,57 @@ static void make_compatible_merges_knots_equal_up_to_rounding(void **state) {
   km_curve_free(&ob);
 }
 
+/* Curvature of c at t from its first two derivatives. */
+static double curvature_at(const km_curve *c, double t) {
+  double d[3][2];
+  km_curve_eval(c, t, 2, d);
+  double sp = hypot(d[1][0], d[1][1]);
+  return (d[1][0] * d[2][1] - d[1][1] * d[2][0]) / (sp * sp * sp);
+}
+
+static void make_compatible_drops_slivers_at_the_ends(void **state) {
+  (void)state;
+  /* A closed curve whose seam was moved next to a knot carries spans a
+   * few ulps wide at its ends (a circle's seam moved to within 2e-16 of
+   * a knot, as a closed morph's start search leaves it); kept, they
+   * become spans of nearly repeated control points whose second
+   * derivative is rounding divided by (2e-16)^2, the curvature 1e16 where
+   * the circle's is 1 / R. */
+  km_curve c, c1, s, a, oa, ob;
+  make_circle(&c);
+  assert_status(km_curve_insert_knot(&c1, &c, 2e-16, 2, NULL), KM_OK);
+  assert_status(km_curve_insert_knot(&s, &c1, 1 - 1.5e-16, 2, NULL), KM_OK);
+  assert_int_equal(s.n, c.n + 4);
+  make_poly_cubic(&a);
+  assert_status(km_curve_make_compatible(&a, &s, &oa, &ob, NULL), KM_OK);
+  assert_memory_equal(oa.knots, ob.knots, (oa.n + 4) * sizeof(double));
+  /* no span narrower than the inputs' own (0.05 and 0.25 wide) */
+  for (size_t i = 3; i < ob.n; i++) {
+    double w = ob.knots[i + 1] - ob.knots[i];
+    assert_true(w == 0.0 || w > 0.01);
+  }
+  assert_on_circle(&ob, 999);
+  assert_true(ob.closed);
+  assert_true(ob.cp[0] == ob.cp[2 * (ob.n - 1)] &&
+              ob.cp[1] == ob.cp[2 * (ob.n - 1) + 1]);
+  /* the circle's curvature everywhere, the ends and their sides too */
+  for (int i = 0; i <= 1000; i++) {
+    double t = i / 1000.0;
+    assert_rel(curvature_at(&ob, t), 1.0 / R, 1e-9);
+  }
+  for (double t = 1e-17; t < 1e-12; t *= 10) {
+    assert_rel(curvature_at(&ob, t), 1.0 / R, 1e-9);
+    assert_rel(curvature_at(&ob, 1 - t), 1.0 / R, 1e-9);
+  }
+  assert_is_poly(&oa, 0, 1);
+  km_curve_free(&c);
+  km_curve_free(&c1);
+  km_curve_free(&s);
+  km_curve_free(&a);
+  km_curve_free(&oa);
+  km_curve_free(&ob);
+}
+
 static void reparam_maps_domain_linearly(void **state) {
   (void)state;
   km_curve c, r;
@@ -476,6 +527,7 @@ static const struct CMUnitTest tests[] = {
     cmocka_unit_test(make_compatible_gives_same_degree_and_knots),
     cmocka_unit_test(make_compatible_of_two_random_nurbs),
     cmocka_unit_test(make_compatible_merges_knots_equal_up_to_rounding),
+    cmocka_unit_test(make_compatible_drops_slivers_at_the_ends),
     cmocka_unit_test(reparam_maps_domain_linearly),
     cmocka_unit_test(transform_moves_circle_rigidly),
 };

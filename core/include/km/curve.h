@@ -139,7 +139,8 @@ km_status km_curve_elevate(km_curve *out, const km_curve *c, int times,
 /* Make a and b compatible: both reparameterised linearly onto [0, 1],
  * raised to the larger degree, one merged knot vector (each knot with the
  * larger of its two multiplicities; knots closer than 1e-13 are taken as
- * one), both rational if either is (unit weights for a polynomial one).
+ * one, and an interior knot within 1e-13 of an end as that end), both
+ * rational if either is (unit weights for a polynomial one).
  * The traces and closed flags are unchanged; *out_a and *out_b are owned
  * by the caller, and on failure neither is written. Returns KM_OK,
  * KM_EINVAL (a or b not a curve), KM_EKNOTS (the merged knot vectors do
