@@ -15,13 +15,73 @@ km_usage_error() { echo "$km_prog: $*" >&2; echo "try '$km_prog -h'" >&2; exit 2
 command -v curl >/dev/null || km_die "curl is not installed"
 command -v jq >/dev/null || km_die "jq is not installed"
 
-# km_svg_document_path: the d attributes of every <path> of the SVG
-# document on stdin, joined into one compound path (transforms and other
-# elements are not applied).
-km_svg_document_path() {
-  tr '\n\r\t' '   ' | grep -o '<path[[:space:]][^>]*>' |
-    sed -n -e "s/.*[[:space:]]d[[:space:]]*=[[:space:]]*\"\([^\"]*\)\".*/\1/p" \
-           -e "s/.*[[:space:]]d[[:space:]]*=[[:space:]]*'\([^']*\)'.*/\1/p" | tr '\n' ' ' | sed 's/ *$//'
+# km_path_contours_jq: a jq definition. path_contours: the subpaths of the
+# SVG path data in ., each a d of its own starting with an absolute moveto
+# (relative data after it keeps its meaning) and closed with Z (SVG fills
+# an open subpath as if closed; icon sets such as @mdi/svg close only
+# their last one); movetos that draw nothing are dropped.
+km_path_contours_jq='
+def path_contours:
+  def finish: (if .cur != null and .drawn then .out += [.cur + (if .closed then "" else "Z" end)] else . end) | .cur = null;
+  def at: "M\(.sx),\(.sy)";
+  {toks: [scan("[A-Za-z]|[-+]?(?:[0-9]+\\.?[0-9]*|\\.[0-9]+)(?:[eE][-+]?[0-9]+)?")],
+   i: 0, cmd: null, out: [], cur: null, drawn: false, closed: false, x: 0, y: 0, sx: 0, sy: 0}
+  | until(.i >= (.toks | length);
+      (if (.toks[.i] | test("^[A-Za-z]$")) then .cmd = .toks[.i] | .i += 1
+       elif .cmd == null or .cmd == "Z" or .cmd == "z" then error("path data: a command expected before \(.toks[.i])")
+       else . end)
+      | (.cmd | ascii_upcase) as $up
+      | ({M: 2, L: 2, H: 1, V: 1, C: 6, S: 4, Q: 4, T: 2, A: 7, Z: 0}[$up] // error("path data: unknown command \(.cmd)")) as $n
+      | .args = []
+      | reduce range($n) as $k (.;
+          if .i >= (.toks | length) or (.toks[.i] | test("^[A-Za-z]$")) then error("path data: a number expected after \(.cmd)")
+          elif $up == "A" and ($k == 3 or $k == 4) and (.toks[.i] | length) > 1 and (.toks[.i] | test("^[01]")) then
+            .args += [.toks[.i][0:1]] | .toks[.i] |= .[1:]
+          else .args += [.toks[.i]] | .i += 1 end)
+      | (.args | map(tonumber)) as $v
+      | (.cmd != $up) as $rel
+      | if $up == "M" then
+          finish | .x = (if $rel then .x else 0 end) + $v[0] | .y = (if $rel then .y else 0 end) + $v[1]
+          | .sx = .x | .sy = .y | .cur = at | .drawn = false | .closed = false
+        else
+          (if .cur == null or .closed then finish | .cur = at | .drawn = false | .closed = false else . end)
+          | .cur += .cmd + (.args | join(" "))
+          | if $up == "Z" then .x = .sx | .y = .sy | .closed = true
+            else .drawn = true
+              | if $up == "H" then .x = (if $rel then .x else 0 end) + $v[0]
+                elif $up == "V" then .y = (if $rel then .y else 0 end) + $v[0]
+                else .x = (if $rel then .x else 0 end) + $v[-2] | .y = (if $rel then .y else 0 end) + $v[-1] end
+            end
+        end
+      | .cmd |= (if . == "M" then "L" elif . == "m" then "l" else . end))
+  | finish | .out;
+'
+
+# km_svg_document_curve: the curve (JSON) of the SVG document on stdin: the
+# contours of all its <path> elements, closed, as one shape under their
+# fill rule (a path's own fill-rule attribute or style, else evenodd when a
+# <svg> or <g> element says so). Transforms and other elements are not
+# applied.
+km_svg_document_curve() {
+  local flat outer=nonzero tag d rule
+  flat=$(tr '\n\r\t' '   ')
+  printf '%s' "$flat" | grep -o '<\(svg\|g\)[[:space:]][^>]*>' |
+    grep -q "fill-rule[[:space:]]*[:=][[:space:]]*[\"']\{0,1\}evenodd" && outer=evenodd
+  printf '%s' "$flat" | grep -o '<path[[:space:]][^>]*>' | while IFS= read -r tag; do
+    d=$(printf '%s' "$tag" | sed -n -e "s/.*[[:space:]]d[[:space:]]*=[[:space:]]*\"\([^\"]*\)\".*/\1/p" \
+                                     -e "s/.*[[:space:]]d[[:space:]]*=[[:space:]]*'\([^']*\)'.*/\1/p")
+    rule=$(printf '%s' "$tag" | sed -n "s/.*fill-rule[[:space:]]*[:=][[:space:]]*[\"']\{0,1\}\(evenodd\|nonzero\).*/\1/p")
+    [ -n "$d" ] && jq -cn --arg d "$d" --arg r "${rule:-$outer}" '{d: $d, rule: $r}'
+  done | jq -cs "$km_path_contours_jq"'
+    if length == 0 then error("the SVG document has no <path> with a d attribute") else . end
+    | (map(.rule) | unique) as $rules
+    | if ($rules | length) > 1 then error("its <path>s have different fill rules") else . end
+    | (map(.d | path_contours) | add) as $c
+    | if ($c | length) == 0 then error("its paths draw nothing")
+      elif ($c | length) == 1 then {type: "svg", d: $c[0]}
+      elif $rules[0] == "evenodd" then {type: "shape", contours: ($c | map({type: "svg", d: .})), fill_rule: "evenodd"}
+      else {type: "svg", d: ($c | join(" "))} end' 2>"$km_tmp/svgerr" ||
+    km_usage_error "not a usable SVG document: $(sed 's/^jq: error ([^)]*): //' "$km_tmp/svgerr" | head -n 1)"
 }
 
 # km_curve ARG: a curve object (JSON) on stdout. ARG is an SVG path d
@@ -29,7 +89,8 @@ km_svg_document_path() {
 # curve object ('{"type": ...}', a shape among them), @FILE with either
 # of those or an SVG document (its <path>s together are the shape), or @-
 # for standard input. A file holding a signature (or a /v1/signature
-# answer) becomes a signature curve.
+# answer) becomes a signature curve. An SVG document gives its paths'
+# contours, closed, as one shape under their fill rule.
 km_curve() {
   local arg=$1 text
   case $arg in
@@ -38,9 +99,7 @@ km_curve() {
     *) text=$arg ;;
   esac
   case $text in
-    "<"*|[[:space:]]*"<"*)
-      text=$(printf '%s' "$text" | km_svg_document_path)
-      [ -n "$text" ] || km_usage_error "the SVG document has no <path> with a d attribute" ;;
+    "<"*|[[:space:]]*"<"*) printf '%s' "$text" | km_svg_document_curve; return ;;
   esac
   if printf '%s' "$text" | jq -e 'type == "object"' >/dev/null 2>&1; then
     printf '%s' "$text" | jq -c '

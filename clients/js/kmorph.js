@@ -269,10 +269,82 @@ export function curve(input) {
   throw new TypeError("a curve is an SVG path string, an array of contours or a curve object");
 }
 
-/** A compound shape {type: "shape", contours, fill_rule?}: each contour a
- * closed Curve or the `d` of one closed subpath; fillRule "nonzero" (the
- * service's default) or "evenodd" decides which contours are holes. */
+/** Arguments of each path command, and which of them are arc flags
+ * (written as one digit, possibly without a separator: "a1 1 0 01 5 5"). */
+const PATH_ARITY = { M: 2, L: 2, H: 1, V: 1, C: 6, S: 4, Q: 4, T: 2, A: 7, Z: 0 };
+const NUMBER = /[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?/y;
+
+/** The commands of SVG path data as [{cmd, args: [text...]}], one entry
+ * per command letter or implicit repetition. Throws a SyntaxError naming
+ * the offset of anything else. */
+function pathCommands(d) {
+  const out = [];
+  let i = 0, cmd = null;
+  const skip = () => { while (i < d.length && /[\s,]/.test(d[i])) i++; };
+  const number = (flag) => {
+    skip();
+    if (flag && (d[i] === "0" || d[i] === "1")) return d[i++];
+    NUMBER.lastIndex = i;
+    const m = NUMBER.exec(d);
+    if (!m) throw new SyntaxError(`path data: a number expected at offset ${i}`);
+    i += m[0].length;
+    return m[0];
+  };
+  for (skip(); i < d.length; skip()) {
+    if (/[A-Za-z]/.test(d[i])) {
+      if (!(d[i].toUpperCase() in PATH_ARITY)) throw new SyntaxError(`path data: unknown command ${d[i]} at offset ${i}`);
+      cmd = d[i++];
+    } else if (cmd === null || /[Zz]/.test(cmd)) throw new SyntaxError(`path data: a command expected at offset ${i}`);
+    const n = PATH_ARITY[cmd.toUpperCase()], args = [];
+    for (let k = 0; k < n; k++) args.push(number(cmd.toUpperCase() === "A" && (k === 3 || k === 4)));
+    out.push({ cmd, args });
+    /* Pairs after a moveto are linetos of the same relativity. */
+    if (cmd === "M") cmd = "L"; else if (cmd === "m") cmd = "l";
+  }
+  return out;
+}
+
+/** The subpaths of SVG path data, each as a `d` of its own that starts
+ * with an absolute moveto (so relative data after it keeps its meaning)
+ * and, with `close` (the default), ends with Z: SVG fills an open
+ * subpath as if it were closed, and a shape's contours must be closed
+ * (icon sets such as @mdi/svg close only their last subpath). Movetos
+ * that draw nothing are dropped. */
+export function pathContours(d, { close = true } = {}) {
+  const out = [];
+  let x = 0, y = 0, sx = 0, sy = 0, cur = null, closed = false;
+  const finish = () => {
+    if (cur && cur.drawn) out.push(cur.text + (close && !closed ? "Z" : ""));
+    cur = null;
+  };
+  for (const { cmd, args } of pathCommands(d)) {
+    const up = cmd.toUpperCase(), rel = cmd !== up, v = args.map(Number);
+    if (up === "M") {
+      finish();
+      x = (rel ? x : 0) + v[0]; y = (rel ? y : 0) + v[1]; sx = x; sy = y;
+      cur = { text: `M${x},${y}`, drawn: false };
+      closed = false;
+      continue;
+    }
+    if (!cur) cur = { text: `M${sx},${sy}`, drawn: false };
+    if (closed) { finish(); cur = { text: `M${sx},${sy}`, drawn: false }; closed = false; }
+    cur.text += cmd + args.join(" ");
+    if (up === "Z") { x = sx; y = sy; closed = true; continue; }
+    cur.drawn = true;
+    if (up === "H") x = (rel ? x : 0) + v[0];
+    else if (up === "V") y = (rel ? y : 0) + v[0];
+    else { x = (rel ? x : 0) + v[v.length - 2]; y = (rel ? y : 0) + v[v.length - 1]; }
+  }
+  finish();
+  return out;
+}
+
+/** A compound shape {type: "shape", contours, fill_rule?}: contours are
+ * closed Curves or `d` strings of one closed subpath each, or the whole
+ * shape is one `d` string, split by pathContours (and closed); fillRule
+ * "nonzero" (the service's default) or "evenodd" decides the holes. */
 export function shape(contours, { fillRule } = {}) {
+  if (typeof contours === "string") contours = pathContours(contours);
   if (!Array.isArray(contours) || contours.length === 0)
     throw new TypeError("a shape needs an array of at least one contour");
   const out = { type: "shape", contours: contours.map(curve) };

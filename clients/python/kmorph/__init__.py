@@ -42,7 +42,7 @@ import urllib.request
 
 __all__ = [
     "Client", "KmorphError", "JobCancelled", "ContourError", "DEFAULT_URL",
-    "curve", "shape", "morph_request",
+    "curve", "shape", "path_contours", "morph_request",
     "eval_curve", "curve_to_path", "sample_points", "frame_paths",
     "is_compound", "contour_pairs", "frame_contours", "frame_contour_paths",
     "frame_path", "interpolator", "bounds",
@@ -312,10 +312,104 @@ def curve(value):
     raise TypeError("a curve is an SVG path string, a list of contours or a curve dict")
 
 
+_PATH_ARITY = {"M": 2, "L": 2, "H": 1, "V": 1, "C": 6, "S": 4, "Q": 4, "T": 2, "A": 7, "Z": 0}
+_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+_SEPARATORS = re.compile(r"[\s,]*")
+
+
+def _path_commands(d):
+    """The commands of SVG path data as [(cmd, [arg text, ...])], one per
+    command letter or implicit repetition; arc flags may be one digit
+    without a separator ("a1 1 0 01 5 5"). Raises ValueError naming the
+    offset of anything else."""
+    out, i, cmd = [], 0, None
+
+    def skip(i):
+        return _SEPARATORS.match(d, i).end()
+
+    i = skip(i)
+    while i < len(d):
+        if d[i].isalpha():
+            if d[i].upper() not in _PATH_ARITY:
+                raise ValueError("path data: unknown command %s at offset %d" % (d[i], i))
+            cmd = d[i]
+            i += 1
+        elif cmd is None or cmd in "Zz":
+            raise ValueError("path data: a command expected at offset %d" % i)
+        args = []
+        for k in range(_PATH_ARITY[cmd.upper()]):
+            i = skip(i)
+            if cmd.upper() == "A" and k in (3, 4) and d[i:i + 1] in ("0", "1"):
+                args.append(d[i])
+                i += 1
+                continue
+            m = _NUMBER.match(d, i)
+            if not m:
+                raise ValueError("path data: a number expected at offset %d" % i)
+            args.append(m.group(0))
+            i = m.end()
+        out.append((cmd, args))
+        # Pairs after a moveto are linetos of the same relativity.
+        cmd = {"M": "L", "m": "l"}.get(cmd, cmd)
+        i = skip(i)
+    return out
+
+
+def path_contours(d, close=True):
+    """The subpaths of SVG path data, each as a d of its own that starts
+    with an absolute moveto (so relative data after it keeps its meaning)
+    and, with `close` (the default), ends with Z: SVG fills an open
+    subpath as if it were closed, and a shape's contours must be closed
+    (icon sets such as @mdi/svg close only their last subpath). Movetos
+    that draw nothing are dropped."""
+    out = []
+    x = y = sx = sy = 0.0
+    cur = None          # [text, drawn]
+    closed = False
+
+    def finish():
+        if cur and cur[1]:
+            out.append(cur[0] + ("Z" if close and not closed else ""))
+
+    for cmd, args in _path_commands(d):
+        up, v = cmd.upper(), [float(a) for a in args]
+        rel = cmd != up
+        if up == "M":
+            finish()
+            x, y = (x if rel else 0.0) + v[0], (y if rel else 0.0) + v[1]
+            sx, sy = x, y
+            cur, closed = ["M%s,%s" % (_num_text(x), _num_text(y)), False], False
+            continue
+        if cur is None or closed:
+            finish()
+            cur, closed = ["M%s,%s" % (_num_text(sx), _num_text(sy)), False], False
+        cur[0] += cmd + " ".join(args)
+        if up == "Z":
+            x, y, closed = sx, sy, True
+            continue
+        cur[1] = True
+        if up == "H":
+            x = (x if rel else 0.0) + v[0]
+        elif up == "V":
+            y = (y if rel else 0.0) + v[0]
+        else:
+            x, y = (x if rel else 0.0) + v[-2], (y if rel else 0.0) + v[-1]
+    finish()
+    return out
+
+
+def _num_text(v):
+    return repr(int(v)) if v == int(v) and abs(v) < 1e15 else repr(v)
+
+
 def shape(contours, fill_rule=None):
-    """A compound shape {"type": "shape", "contours": [...]}: each contour
-    a closed curve dict or the d of one closed subpath; fill_rule
-    "nonzero" (the service's default) or "evenodd" decides the holes."""
+    """A compound shape {"type": "shape", "contours": [...]}: contours are
+    closed curve dicts or d strings of one closed subpath each, or the
+    whole shape is one d string, split by path_contours (and closed);
+    fill_rule "nonzero" (the service's default) or "evenodd" decides the
+    holes."""
+    if isinstance(contours, str):
+        contours = path_contours(contours)
     contours = list(contours)
     if not contours:
         raise ValueError("a shape needs at least one contour")

@@ -4,7 +4,8 @@ Subcommands: signature, reconstruct, morph, job, status, cancel, health.
 Curves are SVG path d strings ("M 0 0 L 10 0"; several subpaths make a
 compound shape), JSON curve objects (a shape among them), or @FILE / @-
 holding either, or an SVG document whose <path> elements together are
-the shape (a file with a signature becomes a signature curve). Errors
+the shape, each subpath closed as SVG fills it, under the document's
+fill rule (a file with a signature becomes a signature curve). Errors
 print the service's problem detail on stderr and exit 1; usage errors
 exit 2.
 """
@@ -13,7 +14,8 @@ import json
 import sys
 import xml.etree.ElementTree as ET
 
-from . import Client, JobCancelled, KmorphError, DEFAULT_URL, contour_pairs, frame_path, is_compound
+from . import (Client, JobCancelled, KmorphError, DEFAULT_URL, contour_pairs, frame_path, is_compound,
+               path_contours, shape)
 
 
 def _read_arg(text):
@@ -54,22 +56,53 @@ def curve_arg(text):
     if s[:1] in ("M", "m"):
         return {"type": "svg", "d": s}
     if s.startswith("<"):
-        return {"type": "svg", "d": _svg_document_path(s)}
+        return _svg_document_curve(s)
     raise SystemExit(_usage_error("not an SVG path (must start with M), SVG document nor JSON: %.60s" % s))
 
 
-def _svg_document_path(text):
-    """The d of every <path> of an SVG document, joined: one compound
-    shape (transforms and other elements are not applied)."""
+def _fill_rule_of(el, inherited):
+    rule = el.get("fill-rule")
+    for decl in (el.get("style") or "").split(";"):
+        key, _, value = decl.partition(":")
+        if key.strip() == "fill-rule":
+            rule = value.strip()
+    return rule if rule in ("nonzero", "evenodd") else inherited
+
+
+def _svg_document_curve(text):
+    """The curve of an SVG document: the contours of all its <path>
+    elements, closed (as SVG fills them), as one shape under their fill
+    rule (inherited as in SVG). Transforms and other elements are not
+    applied."""
     try:
         root = ET.fromstring(text)
     except ET.ParseError as e:
         raise SystemExit(_usage_error("not a well-formed SVG document: %s" % e))
-    ds = [el.get("d").strip() for el in root.iter()
-          if el.tag.rsplit("}", 1)[-1] == "path" and (el.get("d") or "").strip()]
-    if not ds:
+    found = []
+
+    def walk(el, rule):
+        rule = _fill_rule_of(el, rule)
+        if el.tag.rsplit("}", 1)[-1] == "path" and (el.get("d") or "").strip():
+            found.append((el.get("d"), rule))
+        for child in el:
+            walk(child, rule)
+    walk(root, "nonzero")
+    if not found:
         raise SystemExit(_usage_error("the SVG document has no <path> with a d attribute"))
-    return " ".join(ds)
+    rules = sorted({r for _, r in found})
+    if len(rules) > 1:
+        raise SystemExit(_usage_error("the SVG document's <path>s have different fill rules"))
+    try:
+        contours = [c for d, _ in found for c in path_contours(d)]
+    except ValueError as e:
+        raise SystemExit(_usage_error("in the SVG document: %s" % e))
+    if not contours:
+        raise SystemExit(_usage_error("the SVG document's paths draw nothing"))
+    if len(contours) == 1:
+        return {"type": "svg", "d": contours[0]}
+    if rules[0] == "evenodd":
+        return shape(contours, fill_rule="evenodd")
+    return {"type": "svg", "d": " ".join(contours)}
 
 
 def _morph_request(a):

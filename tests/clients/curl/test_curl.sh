@@ -231,6 +231,28 @@ t_shape_svg_file() {
 }
 check "km-morph reads an SVG file's <path>s as one shape and honours -C contour matches (dice-3 -> dice-5)" t_shape_svg_file
 
+t_shape_svg_fill() {
+  # Two squares of the same turn: inside both the winding number is 2, so
+  # the inner one is a hole under evenodd (said on a <g>) and filled under
+  # nonzero (the default).
+  sq="M0 0h10v10h-10zM2 2h6v6h-6z"
+  printf '<svg xmlns="http://www.w3.org/2000/svg"><g fill-rule="evenodd"><path d="%s"/></g></svg>' "$sq" >"$work/eo.svg"
+  printf '<svg xmlns="http://www.w3.org/2000/svg"><path d="%s"/></svg>' "$sq" >"$work/nz.svg"
+  [ "$("$bin/km-signature" "@$work/eo.svg" | jq -c '[.roles, .fill_rule]')" = '[["outer","hole"],"evenodd"]' ] || return 1
+  [ "$("$bin/km-signature" "@$work/nz.svg" | jq -c '.roles')" = '["outer","outer"]' ] || return 1
+  # The lock as mdi ships it (only its last subpath closed) morphs, its
+  # contours closed as SVG fills them: frame 0 is the closed fixture.
+  src=$(jq -r '.icons[] | select(.id == "mdi/lock") | .d_source' "$FIX/icons.json")
+  printf '<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 24 24">\n<path d="%s"/>\n</svg>\n' "$src" >"$work/lock.svg"
+  if "$bin/km-morph" -n 2 "$src" "$(shape_d mdi/lock-outline icons)" 2>"$work/lock.err" >/dev/null; then return 1; fi
+  grep -q "subpath 0 .* is open" "$work/lock.err" || { cat "$work/lock.err"; return 1; }
+  "$bin/km-morph" -n 5 -p -t $ICON_TOL "@$work/lock.svg" "$(shape_d mdi/lock-outline icons)" >"$work/lock.lines" 2>"$work/lock.err" ||
+    { cat "$work/lock.err"; return 1; }
+  "$PY" "$here/shape_ends.py" "$(shape_d mdi/lock icons)" "$(shape_d mdi/lock-outline icons)" "$work/lock.lines" \
+    "$(grep "^km-morph: contours: " "$work/lock.err")" $ICON_BOUND 5
+}
+check "an SVG file keeps its fill rule (evenodd makes a hole) and its open subpaths are closed (mdi's lock morphs)" t_shape_svg_fill
+
 t_shape_job() {
   from=$(shape_d mdi/circle-double icons) to=$(shape_d mdi/target icons)
   "$bin/km-job" -q -i 0.05 -n 7 -p -t $ICON_TOL "$from" "$to" >"$work/job.lines" 2>"$work/job.err" || { cat "$work/job.err"; return 1; }

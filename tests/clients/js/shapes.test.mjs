@@ -10,7 +10,7 @@ import assert from "node:assert/strict";
 import { readFileSync } from "node:fs";
 import path from "node:path";
 import { startDaemon, ROOT } from "../lib/daemon.mjs";
-import { Client, KmorphError, curve, shape, morphRequest, isCompound, contourPairs, frameContours,
+import { Client, KmorphError, curve, shape, pathContours, morphRequest, isCompound, contourPairs, frameContours,
          frameContourPaths, framePath, framePaths, interpolator, bounds } from "../../../clients/js/kmorph.js";
 
 const FIXTURES = path.join(ROOT, "tests", "fixtures", "compound");
@@ -323,4 +323,55 @@ test("a bad contour is a KmorphError naming /from/contours/K; a bad subpath name
   });
   await assert.rejects(km.morph(morphRequest(good, shape([good, { type: "points", points: [[1, 1]], closed: true }]))),
                        (e) => e.contourErrors()[0].pointer.startsWith("/to/contours/1"));
+});
+
+test("pathContours closes an icon's open subpaths as SVG fills them: the shipped d is a 422, its contours morph", async () => {
+  const icon = byId.get("mdi/lock"), to = pathOf("mdi/lock-outline");
+  assert.notEqual(icon.d_source, icon.d, "mdi ships this icon with open subpaths");
+  await assert.rejects(km.morph(morphRequest(icon.d_source, to, { frames: 2 })), (e) => {
+    assert.equal(e.status, 422);
+    assert.deepEqual(e.contourErrors().map((c) => [c.side, c.contour]), [["from", 0]]);
+    return true;
+  });
+  const parts = pathContours(icon.d_source);
+  assert.equal(parts.length, icon.subpaths);
+  /* Each contour is the same point set as that subpath of the closed d. */
+  const closed = subpaths(icon.d);
+  parts.forEach((p, k) => {
+    assert.match(p, /^M[^Mm]*[Zz]$/);
+    const mine = subpaths(p);
+    assert.equal(mine.length, 1);
+    assert.ok(hausdorff(mine[0], closed[k]) < 1e-9, `contour ${k}`);
+  });
+  const a = await km.morph(morphRequest(parts.join(" "), to, { frames: 3, tolerance: TOL.icon }));
+  const b = await km.morph(morphRequest(icon.d, to, { frames: 3, tolerance: TOL.icon }));
+  assert.deepEqual(a, b);
+});
+
+test("pathContours starts each contour with an absolute moveto: relative subpaths stay where they were", () => {
+  /* Two squares, the second placed by a relative moveto from the open
+   * first one's last point (10, 30): its corners are (15, 35) and (25, 45). */
+  const d = "m 10 10 h 20 v 20 h -20 m 5 5 h 10 v 10 h -10";
+  const parts = pathContours(d);
+  assert.equal(parts.length, 2);
+  const box = (pts) => [Math.min(...pts.map((p) => p[0])), Math.min(...pts.map((p) => p[1])),
+                        Math.max(...pts.map((p) => p[0])), Math.max(...pts.map((p) => p[1]))];
+  assert.deepEqual(box(subpaths(parts[0])[0]), [10, 10, 30, 30]);
+  assert.deepEqual(box(subpaths(parts[1])[0]), [15, 35, 25, 45]);
+  /* Closing adds the fourth side: the perimeter is 4 times the side. */
+  assert.ok(Math.abs(polyLength(subpaths(parts[1])[0]) - 40) < 1e-9);
+  assert.deepEqual(pathContours("M 0 0 M 1 1 L 2 1 L 2 2 Z", { close: false }), ["M1,1L2 1L2 2Z"]);
+  assert.deepEqual(pathContours("M0 0h5v5Z", { close: false }), ["M0,0h5v5Z"]);
+  assert.throws(() => pathContours("M 0 0 X 1"), /offset 6/);
+});
+
+test("a shape from one d under evenodd makes an inner square of the same turn a hole; nonzero fills it", async () => {
+  const d = "M 0 0 L 10 0 L 10 10 L 0 10 Z M 2 2 L 8 2 L 8 8 L 2 8 Z";
+  const evenodd = await km.signature(shape(d, { fillRule: "evenodd" }));
+  const nonzero = await km.signature(shape(d));
+  /* The inner square's region is inside both contours: winding number 2,
+   * filled under nonzero, empty (even) under evenodd. */
+  assert.deepEqual(evenodd.roles, ["outer", "hole"]);
+  assert.equal(evenodd.fill_rule, "evenodd");
+  assert.deepEqual(nonzero.roles, ["outer", "outer"]);
 });

@@ -152,7 +152,11 @@ class Polyline:
 def hausdorff(p, q, reach):
     """Symmetric Hausdorff distance of two dense polylines, infinity when
     it exceeds reach (every third point queried against every segment)."""
-    cell = max(reach, 1e-9)
+    xs = [pt[0] for pt in p + q]
+    ys = [pt[1] for pt in p + q]
+    # Cells no smaller than 1/256 of the extent, so that a tight reach does
+    # not make a grid of more cells than segments.
+    cell = max(reach, (max(xs) - min(xs) + max(ys) - min(ys)) / 512, 1e-12)
     a, b = Polyline(p, cell), Polyline(q, cell)
     h = 0.0
     for pt in p[::3]:

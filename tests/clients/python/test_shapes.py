@@ -23,7 +23,7 @@ sys.path.insert(0, os.path.join(ROOT, "tests", "clients", "lib"))
 import kmdaemon  # noqa: E402
 from svgpath import subpaths, hausdorff, poly_length  # noqa: E402
 import kmorph  # noqa: E402
-from kmorph import (Client, KmorphError, ContourError, curve, shape, morph_request,  # noqa: E402
+from kmorph import (Client, KmorphError, ContourError, curve, shape, path_contours, morph_request,  # noqa: E402
                     is_compound, contour_pairs, frame_contours, frame_contour_paths,
                     frame_path, frame_paths, interpolator, bounds)
 
@@ -225,6 +225,46 @@ class ShapeTest(unittest.TestCase):
         self.assertEqual((c.side, c.contour, c.offset), ("to", 1, bad.index("M 20")))
 
 
+    def test_path_contours_close_an_icons_open_subpaths_and_they_morph(self):
+        icon, to = SHAPES["mdi/lock"], SHAPES["mdi/lock-outline"]["d"]
+        self.assertNotEqual(icon["d_source"], icon["d"])
+        with self.assertRaises(KmorphError) as cm:
+            self.km.morph(morph_request(icon["d_source"], to, frames=2))
+        self.assertEqual([(c.side, c.contour) for c in cm.exception.contour_errors()], [("from", 0)])
+        parts = path_contours(icon["d_source"])
+        self.assertEqual(len(parts), icon["subpaths"])
+        for k, (p, want) in enumerate(zip(parts, subpaths(icon["d"]))):
+            self.assertRegex(p, r"^M[^Mm]*[Zz]$")
+            self.assertLess(hausdorff(subpaths(p)[0], want, 1e-6), 1e-9, "contour %d" % k)
+        a = self.km.morph(morph_request(" ".join(parts), to, frames=3, tolerance=TOL["icon"]))
+        b = self.km.morph(morph_request(icon["d"], to, frames=3, tolerance=TOL["icon"]))
+        self.assertEqual(a, b)
+
+    def test_path_contours_keep_relative_subpaths_where_they_were(self):
+        # The second square is placed by a relative moveto from the open
+        # first one's last point (10, 30): corners (15, 35) and (25, 45).
+        parts = path_contours("m 10 10 h 20 v 20 h -20 m 5 5 h 10 v 10 h -10")
+        self.assertEqual(len(parts), 2)
+
+        def box(pts):
+            return (min(p[0] for p in pts), min(p[1] for p in pts), max(p[0] for p in pts), max(p[1] for p in pts))
+        self.assertEqual(box(subpaths(parts[0])[0]), (10, 10, 30, 30))
+        self.assertEqual(box(subpaths(parts[1])[0]), (15, 35, 25, 45))
+        self.assertAlmostEqual(poly_length(subpaths(parts[1])[0]), 40, delta=1e-9)
+        self.assertEqual(path_contours("M 0 0 M 1 1 L 2 1 L 2 2 Z", close=False), ["M1,1L2 1L2 2Z"])
+        self.assertEqual(path_contours("M0 0h5v5Z", close=False), ["M0,0h5v5Z"])
+        with self.assertRaisesRegex(ValueError, "offset 6"):
+            path_contours("M 0 0 X 1")
+
+    def test_evenodd_makes_an_inner_square_of_the_same_turn_a_hole(self):
+        d = "M 0 0 L 10 0 L 10 10 L 0 10 Z M 2 2 L 8 2 L 8 8 L 2 8 Z"
+        # Inside both contours the winding number is 2: filled under
+        # nonzero, empty (even) under evenodd.
+        eo = self.km.signature(shape(d, fill_rule="evenodd"))
+        self.assertEqual((eo["roles"], eo["fill_rule"]), (["outer", "hole"], "evenodd"))
+        self.assertEqual(self.km.signature(shape(d))["roles"], ["outer", "outer"])
+
+
 class ShapeCommandLineTest(unittest.TestCase):
     def run_cli(self, *args):
         env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "clients", "python"), KMORPH_URL=url())
@@ -251,6 +291,37 @@ class ShapeCommandLineTest(unittest.TestCase):
         first = subpaths(lines[0].split("\t")[1], 16)
         for k, want in enumerate(subpaths(frm["d"])):
             self.assertLessEqual(hausdorff(first[k], want, 0.02), TOL["icon"] + MARGIN["icon"])
+
+    def test_svg_documents_close_their_subpaths_and_keep_their_fill_rule(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            def doc(name, text):
+                path = os.path.join(tmp, name)
+                with open(path, "w", encoding="utf-8") as f:
+                    f.write(text)
+                return "@" + path
+            squares = "M0 0h10v10h-10zM2 2h6v6h-6z"
+            eo = doc("eo.svg", '<svg xmlns="http://www.w3.org/2000/svg"><g style="fill-rule: evenodd">'
+                               '<path d="%s"/></g></svg>' % squares)
+            nz = doc("nz.svg", '<svg xmlns="http://www.w3.org/2000/svg"><path d="%s"/></svg>' % squares)
+            roles = []
+            for arg in (eo, nz):
+                r = self.run_cli("signature", arg)
+                self.assertEqual(r.returncode, 0, r.stderr)
+                roles.append(json.loads(r.stdout)["roles"])
+            self.assertEqual(roles, [["outer", "hole"], ["outer", "outer"]])
+            # The lock as mdi ships it, open subpaths and all.
+            lock = doc("lock.svg", '<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 24 24">'
+                                   '<path d="%s"/></svg>' % SHAPES["mdi/lock"]["d_source"])
+            r = self.run_cli("morph", "-n", "3", "-p", "-t", "0.003", lock, SHAPES["mdi/lock-outline"]["d"])
+            self.assertEqual(r.returncode, 0, r.stderr)
+            first = subpaths(r.stdout.splitlines()[0].split("\t")[1], 16)
+            self.assertEqual(len(first), 3)
+            for got, want in zip(first, subpaths(SHAPES["mdi/lock"]["d"])):
+                self.assertLessEqual(hausdorff(got, want, 0.02), TOL["icon"] + MARGIN["icon"])
+            mixed = doc("mixed.svg", '<svg><path d="M0 0h1v1z"/><path fill-rule="evenodd" d="M2 2h1v1z"/></svg>')
+            r = self.run_cli("signature", mixed)
+            self.assertEqual(r.returncode, 2)
+            self.assertIn("different fill rules", r.stderr)
 
     def test_a_bad_contour_exits_1_naming_it(self):
         r = self.run_cli("morph", json.dumps(shape(["M 0 0 L 10 0 L 10 10 Z", "M 20 0 L 30 0 L 30 10"])),
