@@ -87,9 +87,10 @@ static size_t predict_bytes(const api_morph_plan *pl, size_t points) {
   bool hermite = pl->opt.method == KM_METHOD_CURVATURE;
   size_t numbers = api__path_numbers(points, degree, hermite);
   if (pl->svg) {
-    /* one path a frame, the animation's values repeat every frame's */
+    /* one path a frame, the animation's values repeat every frame's; a
+     * curvature plot draws kappa only, not the frames' paths */
     size_t per_path = 64 + PX_NUM_BYTES * numbers;
-    per = FRAME_FIXED_BYTES + per_path;
+    per = FRAME_FIXED_BYTES + (pl->want_sig ? 0 : per_path);
     if (pl->svgopt.layout == API_SVG_ANIMATE) per += per_path;
     if (pl->want_sig) {
       /* kappa samples as svg_curvature_plot.c takes them: a budget per

@@ -15,8 +15,13 @@
  *     cubic:   |C - H| <= h^4 / 384   * B_3(k0, k1, k2)
  *     quintic: |C - H| <= h^6 / 46080 * B_5(k0, k1, k2, k3, k4)
  * with k_j bounds on |kappa^(j)| over the piece (Bernstein coefficients of
- * the restricted polynomial). Pieces are split until the bound meets the
- * tolerance; the reported error is this bound plus rounding, so it is
+ * the restricted polynomial). That is a bound at equal s. A cubic piece
+ * may instead take the end speeds of a circular arc of its turning
+ * (shape_bound): its parameter then leaves arc length between the knots,
+ * but its distance to the curve drops from O(h^4) to O(h^6) where kappa
+ * varies little (the unit circle at 1e-9: 64 pieces, not 260). Pieces are
+ * split until the bound meets the tolerance, each taking the smaller of
+ * the two; the reported error is the largest bound plus rounding, so it is
  * never below the true error.
  */
 #include <math.h>
@@ -178,13 +183,106 @@ typedef struct out_piece {
   double m4;     /* bound on |C''''| over the piece */
   double h;      /* arc length */
   double j2, j3; /* sums of the jumps of |C''|, |C'''| inside */
+  double a0, a1; /* cubics: |B'| at each end in the piece variable, h for
+                  * a piece Hermite in arc length */
+  double lambda; /* a shape piece's own a / h (0: Hermite in arc length) */
 } out_piece;
+
+/* sup over u of the integral of K(u, t) |t - u| dt, K the (nonnegative)
+ * Peano kernel of two-point cubic Hermite interpolation on [0, 1]: 1/2560,
+ * reached at u = 1/2 (rounded up here, so the bound errs high) */
+#define PEANO_K_LEVER (1.0 / 2550.0)
+
+/* The end speed of a cubic Bezier circular arc of length h turning phi:
+ * tangent legs 4/3 tan(phi/4) of the radius. */
+static double arc_speed(double h, double phi) {
+  return fabs(phi) > 1e-4 ? 4.0 * h * tan(phi / 4.0) / phi
+                          : h * (1.0 + phi * phi / 48.0);
+}
+
+/* A cubic piece that follows the curve's shape rather than its arc length.
+ *
+ * B is the cubic with the exact positions and unit tangents at both ends
+ * and end speeds a0, a1 in its variable u in [0, 1]. For any smooth
+ * increasing sigma with sigma(0) = s0, sigma(1) = s0 + h, sigma'(0) = a0,
+ * sigma'(1) = a1, B is the cubic Hermite interpolant of D = C o sigma,
+ * which runs along the exact curve. With the cubic sigma of those end data,
+ * in the Frenet frame of C
+ *   D'''' = Tg T + Nm N,
+ *   Tg = -3 k k' s'^4 - 6 k^2 s'^2 s'',
+ *   Nm = k'' s'^4 + 6 k' s'^2 s'' + 3 k s''^2 + k s' (4 s''' - k^2 s'^3)
+ * (k and its derivatives at sigma(u), s = sigma). End speeds near those of
+ * a circular arc (arc_speed) make 4 s''' cancel k^2 s'^3 up to the
+ * variation of k, so on a circle Nm is O(h^6) where the arc-length
+ * Hermite error is O(h^4). The Peano kernel K of the error e = B - D is
+ * nonnegative, so in the frame at D(u)
+ *   |e.N| <= max|Nm| / 384 + max|Tg| K0 max|s'| PEANO_K_LEVER,
+ *   |e.T| <= max|Tg| / 384 + max|Nm| K0 max|s'| PEANO_K_LEVER
+ * (T(t).N(u) = sin(theta(t) - theta(u)), |theta(t) - theta(u)| <=
+ * K0 max|s'| |t - u|). B(u) lies e.T along the tangent and e.N across it
+ * from the point D(u) of C; the point of C an arc length e.T further is
+ * within K0 (e.T)^2 / 2 of D(u) + (e.T) T, so every B(u) is within
+ *   |e.N| + K0 (e.T)^2 / 2
+ * of a point of C, and by continuity (the ends match) every point of C on
+ * the piece is as near a point of B. Returns that bound, or INFINITY where
+ * the estimate does not apply (sigma not increasing). k's ranges come from
+ * the Bernstein coefficients of kappa piece kc restricted to [u0, u1]
+ * (length hp). */
+static double shape_bound(const double *kc, int dk, double hp, double u0,
+                          double u1, double a0, double a1) {
+  double c[MAXD], dc[MAXD];
+  double h = (u1 - u0) * hp;
+  km__bern_restrict(kc, dk, u0, u1, c);
+  double klo = c[0], khi = c[0];
+  for (int i = 1; i <= dk; i++) {
+    klo = fmin(klo, c[i]);
+    khi = fmax(khi, c[i]);
+  }
+  double k1 = 0.0, k2 = 0.0;
+  if (dk >= 1) {
+    km__bern_derivative(c, dk, h, dc);
+    k1 = km__bern_abs_bound(dc, dk - 1);
+    if (dk >= 2) {
+      km__bern_derivative(dc, dk - 1, h, c);
+      k2 = km__bern_abs_bound(c, dk - 2);
+    }
+  }
+  double k0 = fmax(fabs(klo), fabs(khi));
+  double ksq_lo = klo <= 0.0 && khi >= 0.0 ? 0.0 : fmin(klo * klo, khi * khi);
+  /* sigma = s0 + h u + d0 u (1 - u)^2 - d1 u^2 (1 - u), d = a - h:
+   * sigma' = h + d0 - (4 d0 + 2 d1) u + 3 (d0 + d1) u^2 (its range from
+   * the ends and the vertex), sigma'' linear, sigma''' = 6 (d0 + d1) */
+  double d0 = a0 - h, d1 = a1 - h;
+  double sp_lo = fmin(a0, a1), sp_hi = fmax(a0, a1);
+  double qa = 3.0 * (d0 + d1), qb = -(4.0 * d0 + 2.0 * d1);
+  if (qa != 0.0) {
+    double uv = -qb / (2.0 * qa);
+    if (uv > 0.0 && uv < 1.0) {
+      double v = h + d0 + qb * uv + qa * uv * uv;
+      sp_lo = fmin(sp_lo, v);
+      sp_hi = fmax(sp_hi, v);
+    }
+  }
+  if (!(sp_lo > 0.0)) return INFINITY;
+  double s2 = fmax(fabs(qb), fabs(qb + 2.0 * qa)), s3 = 2.0 * qa;
+  double p2 = sp_hi * sp_hi, p4 = p2 * p2;
+  double w = fmax(fabs(4.0 * s3 - k0 * k0 * p2 * sp_hi),
+                  fabs(4.0 * s3 - ksq_lo * sp_lo * sp_lo * sp_lo));
+  double nm =
+      k2 * p4 + 6.0 * k1 * p2 * s2 + 3.0 * k0 * s2 * s2 + k0 * sp_hi * w;
+  double tg = 3.0 * k0 * k1 * p4 + 6.0 * k0 * k0 * p2 * s2;
+  double lever = k0 * sp_hi * PEANO_K_LEVER;
+  double across = nm / 384.0 + tg * lever;
+  double along = tg / 384.0 + nm * lever;
+  return across + 0.5 * k0 * along * along;
+}
 
 typedef struct plan {
   out_piece *p;
   size_t n, cap;
   size_t limit;   /* pieces allowed (KM_MAX_OUTPUT_PIECES beyond the input's) */
   km__poll *poll; /* the caller's stop condition, or NULL */
+  bool arc_length_only; /* no shape pieces: Hermite in arc length */
 } plan;
 
 static km_status plan_push(plan *pl, out_piece op) {
@@ -204,25 +302,55 @@ static km_status plan_push(plan *pl, out_piece op) {
   return KM_OK;
 }
 
+/* An output piece of theta piece i over [u0, u1]: a shape piece (end speeds
+ * of the arc of its turning, shape_bound) where that bounds it closer than
+ * arc-length Hermite, which it can for cubics turning less than 2 rad. */
+static out_piece make_piece(const theta_pieces *tp, size_t i, double u0,
+                            double u1, int degree, bool arc_length_only) {
+  int dk = tp->kappa.degree;
+  double hp = tp->kappa.x[i + 1] - tp->kappa.x[i], h = (u1 - u0) * hp;
+  const double *kc = tp->kappa.c + i * (size_t)(dk + 1);
+  double kb[5];
+  km__kappa_bounds(kc, dk, hp, u0, u1, degree == 3 ? 3 : 5, kb);
+  double e = hermite_bound(degree, kb, h);
+  out_piece op = {i, i,   u0,  u1, e, e / fmax(pow(h, 4) / 384.0, 1e-300),
+                  h, 0.0, 0.0, h,  h, 0.0};
+  if (degree != 3 || arc_length_only) return op;
+  const double *tc = tp->theta.c + i * (size_t)(dk + 2);
+  double phi = km__bern_eval(tc, dk + 1, u1) - km__bern_eval(tc, dk + 1, u0);
+  if (!(fabs(phi) < 2.0)) return op;
+  double a = arc_speed(h, phi);
+  double es = shape_bound(kc, dk, hp, u0, u1, a, a);
+  if (!(es < e)) return op;
+  op.bound = es;
+  op.m4 = INFINITY; /* not merged across breaks of kappa */
+  op.a0 = op.a1 = a;
+  op.lambda = a / h;
+  return op;
+}
+
 static km_status plan_range(plan *pl, const theta_pieces *tp, size_t i,
                             double u0, double u1, int degree, double tol,
                             int depth) {
-  int dk = tp->kappa.degree;
-  double h = tp->kappa.x[i + 1] - tp->kappa.x[i];
-  const double *kc = tp->kappa.c + i * (size_t)(dk + 1);
-  double kb[5];
-  int nd = degree == 3 ? 3 : 5;
-  km__kappa_bounds(kc, dk, h, u0, u1, nd, kb);
-  double e = hermite_bound(degree, kb, (u1 - u0) * h);
-  if (e <= tol || depth > 60) {
-    double hh = (u1 - u0) * h;
-    out_piece op = {i,  i,   u0, u1, e, e / fmax(pow(hh, 4) / 384.0, 1e-300),
-                    hh, 0.0, 0.0};
-    return plan_push(pl, op);
-  }
+  out_piece op = make_piece(tp, i, u0, u1, degree, pl->arc_length_only);
+  if (op.bound <= tol || depth > 60) return plan_push(pl, op);
   /* split into as many equal parts as the bound's order suggests */
-  int order = degree == 3 ? 4 : 6;
-  double parts = ceil(pow(e / tol, 1.0 / order) * 1.05);
+  int order = op.lambda > 0.0 ? 6 : (degree == 3 ? 4 : 6);
+  double parts = ceil(pow(op.bound / tol, 1.0 / order) * 1.05);
+  if (op.lambda == 0.0 && degree == 3) {
+    /* a turn of 2 rad or more: parts that turn less may be shape pieces */
+    int dk = tp->kappa.degree;
+    const double *tc = tp->theta.c + i * (size_t)(dk + 2);
+    double phi = km__bern_eval(tc, dk + 1, u1) - km__bern_eval(tc, dk + 1, u0);
+    if (fabs(phi) >= 2.0) {
+      /* sized by the bound on the first of the parts turning < 2 rad */
+      double p0 = ceil(fabs(phi) / 1.9);
+      out_piece sub = make_piece(tp, i, u0, u0 + (u1 - u0) / p0, degree,
+                                 pl->arc_length_only);
+      double per = sub.lambda > 0.0 ? pow(sub.bound / tol, 1.0 / 6.0) : 1.0;
+      parts = fmin(parts, ceil(p0 * fmax(per, 1.0) * 1.05));
+    }
+  }
   if (parts < 2) parts = 2;
   if (parts > 1e6) parts = 1e6;
   int np = (int)parts;
@@ -293,6 +421,7 @@ static void merge_cubic(plan *pl, const theta_pieces *tp, double tol) {
         cur.j2 = s2;
         cur.j3 = s3;
         cur.bound = e;
+        cur.a0 = cur.a1 = h;
         continue;
       }
     }
@@ -301,6 +430,117 @@ static void merge_cubic(plan *pl, const theta_pieces *tp, double tol) {
   }
   pl->p[w++] = cur;
   pl->n = w;
+}
+
+/* Neighbouring shape pieces of one theta piece merged greedily while the
+ * merged piece's bound meets the tolerance: equal parts are too many
+ * where the curvature varies along the piece. */
+static km_status merge_shape(plan *pl, const theta_pieces *tp, double tol) {
+  if (pl->n == 0) return KM_OK;
+  size_t w = 0;
+  out_piece cur = pl->p[0];
+  for (size_t j = 1; j < pl->n; j++) {
+    out_piece nx = pl->p[j];
+    if (km__poll_stop(pl->poll, 8)) return KM_ECANCELLED;
+    if (cur.lambda > 0.0 && nx.lambda > 0.0 && nx.piece == cur.piece &&
+        nx.u0 == cur.u1) {
+      out_piece m = make_piece(tp, cur.piece, cur.u0, nx.u1, 3, false);
+      if (m.lambda > 0.0 && m.bound <= tol) {
+        cur = m;
+        continue;
+      }
+    }
+    pl->p[w++] = cur;
+    cur = nx;
+  }
+  pl->p[w++] = cur;
+  pl->n = w;
+  return KM_OK;
+}
+
+static bool theta_jumps(const theta_pieces *tp, const out_piece *a,
+                        const out_piece *b) {
+  int dt = tp->theta.degree;
+  double tha =
+      km__bern_eval(tp->theta.c + a->piece_end * (size_t)(dt + 1), dt, a->u1);
+  double thb =
+      km__bern_eval(tp->theta.c + b->piece * (size_t)(dt + 1), dt, b->u0);
+  return fabs(thb - tha) > 1e-13;
+}
+
+/* The cubic B-spline is C1 at a smooth junction, so both sides' end speeds
+ * are in proportion to their lengths: a0 / h of a piece equals a1 / h of
+ * the one before. There it is the mean of the two pieces' own (a / h of a
+ * shape piece, 1 of one Hermite in arc length), or 1 next to a piece that
+ * spans breaks of kappa (its bound holds for a = h only). Every piece
+ * within one piece of kappa is then bounded again with the speeds it got,
+ * by shape_bound (which holds for any speeds) or, at a = h, the Hermite
+ * bound if smaller; *over is set when one exceeds tol (that piece's bound
+ * is then INFINITY). */
+static km_status settle_speeds(plan *pl, const theta_pieces *tp, double tol,
+                               bool *over) {
+  *over = false;
+  for (size_t j = 0; j < pl->n; j++) {
+    if (km__poll_stop(pl->poll, 8)) return KM_ECANCELLED;
+    out_piece *op = &pl->p[j];
+    bool flexible = op->piece == op->piece_end;
+    double own = op->lambda > 0.0 ? op->lambda : 1.0;
+    double l0 = own, l1 = own;
+    if (j > 0 && !theta_jumps(tp, &pl->p[j - 1], op)) {
+      const out_piece *q = &pl->p[j - 1];
+      l0 = flexible && q->piece == q->piece_end
+               ? 0.5 * (own + (q->lambda > 0.0 ? q->lambda : 1.0))
+               : 1.0;
+    }
+    if (j + 1 < pl->n && !theta_jumps(tp, op, &pl->p[j + 1])) {
+      const out_piece *q = &pl->p[j + 1];
+      l1 = flexible && q->piece == q->piece_end
+               ? 0.5 * (own + (q->lambda > 0.0 ? q->lambda : 1.0))
+               : 1.0;
+    }
+    if (!flexible) continue; /* a = h, bounded when merged */
+    op->a0 = l0 * op->h;
+    op->a1 = l1 * op->h;
+    int dk = tp->kappa.degree;
+    size_t i = op->piece;
+    double hp = tp->kappa.x[i + 1] - tp->kappa.x[i];
+    const double *kc = tp->kappa.c + i * (size_t)(dk + 1);
+    double e = shape_bound(kc, dk, hp, op->u0, op->u1, op->a0, op->a1);
+    if (l0 == 1.0 && l1 == 1.0) {
+      double kb[3];
+      km__kappa_bounds(kc, dk, hp, op->u0, op->u1, 3, kb);
+      e = fmin(e, hermite_bound(3, kb, op->h));
+    }
+    op->bound = e;
+    if (!(e <= tol)) {
+      op->bound = INFINITY;
+      *over = true;
+    }
+  }
+  return KM_OK;
+}
+
+/* Pieces whose settled bound exceeds tol planned again in two halves. */
+static km_status split_over(plan *pl, const theta_pieces *tp, double tol) {
+  plan next = {NULL, 0, 0, pl->limit, pl->poll, false};
+  km_status st = KM_OK;
+  for (size_t j = 0; j < pl->n && !st; j++) {
+    out_piece op = pl->p[j];
+    if (op.bound <= tol) {
+      st = plan_push(&next, op);
+      continue;
+    }
+    double mid = 0.5 * (op.u0 + op.u1);
+    st = plan_range(&next, tp, op.piece, op.u0, mid, 3, tol, 0);
+    if (!st) st = plan_range(&next, tp, op.piece, mid, op.u1, 3, tol, 0);
+  }
+  if (st) {
+    km__free(next.p);
+    return st;
+  }
+  km__free(pl->p);
+  *pl = next;
+  return KM_OK;
 }
 
 km_status km_reconstruct(const km_signature *sig, int degree, double tol,
@@ -332,13 +572,11 @@ km_status km_reconstruct_until(const km_signature *sig, int degree, double tol,
  * junction decided (which sets the knots' multiplicities), then the
  * Hermite pieces' Bezier points written as one B-spline. */
 
-/* The output pieces of every theta piece within 0.9 tol; a cubic's
- * neighbours merged where the bound allows. */
-static km_status plan_pieces(plan *pl, const theta_pieces *tp, int degree,
-                             double tol, const km_signature *sig,
-                             km_error *err) {
+/* The output pieces of every theta piece within tol. */
+static km_status plan_all(plan *pl, const theta_pieces *tp, int degree,
+                          double tol, const km_signature *sig, km_error *err) {
   for (size_t i = 0; i < tp->theta.m; i++) {
-    km_status st = plan_range(pl, tp, i, 0.0, 1.0, degree, 0.9 * tol, 0);
+    km_status st = plan_range(pl, tp, i, 0.0, 1.0, degree, tol, 0);
     if (st == KM_ECANCELLED) {
       km__stopped(err);
       return st;
@@ -351,8 +589,42 @@ static km_status plan_pieces(plan *pl, const theta_pieces *tp, int degree,
                                       : "out of memory",
                       pl->limit, degree, fabs(sig->turning) / (2 * KM_PI));
   }
-  if (degree == 3) merge_cubic(pl, tp, 0.9 * tol);
   return KM_OK;
+}
+
+/* The output pieces within 0.9 tol; a cubic's neighbours merged where the
+ * bound allows and their end speeds settled (pieces split where that
+ * breaks the bound). Should settling not end within a few rounds, the
+ * cubic is planned Hermite in arc length throughout, as it always can. */
+static km_status plan_pieces(plan *pl, const theta_pieces *tp, int degree,
+                             double tol, const km_signature *sig,
+                             km_error *err) {
+  km_status st = plan_all(pl, tp, degree, 0.9 * tol, sig, err);
+  if (st || degree != 3) return st;
+  if (merge_shape(pl, tp, 0.9 * tol)) return km__stopped(err);
+  merge_cubic(pl, tp, 0.9 * tol);
+  for (int round = 0;; round++) {
+    bool over;
+    if (settle_speeds(pl, tp, 0.9 * tol, &over)) return km__stopped(err);
+    if (!over) return KM_OK;
+    if (round == 12) {
+      pl->n = 0;
+      pl->arc_length_only = true;
+      st = plan_all(pl, tp, degree, 0.9 * tol, sig, err);
+      if (st) return st;
+      merge_cubic(pl, tp, 0.9 * tol);
+      continue;
+    }
+    st = split_over(pl, tp, 0.9 * tol);
+    if (st == KM_ECANCELLED) return km__stopped(err);
+    if (st)
+      return km__fail(err, st, KM_FIELD_TOLERANCE, -1, NAN,
+                      st == KM_ELIMIT ? "the curve needs more than %zu pieces "
+                                        "of degree %d at this tolerance: "
+                                        "loosen the tolerance"
+                                      : "out of memory",
+                      pl->limit, degree);
+  }
 }
 
 /* pos[2 j], pos[2 j + 1]: the position at the start of output piece j
@@ -443,8 +715,8 @@ static void piece_bezier(const plan *pl, const theta_pieces *tp,
   if (p == 3) {
     for (int a = 0; a < 2; a++) {
       Q[0][a] = P0[a];
-      Q[1][a] = P0[a] + h / 3.0 * T0[a];
-      Q[2][a] = P1[a] - h / 3.0 * T1[a];
+      Q[1][a] = P0[a] + op->a0 / 3.0 * T0[a];
+      Q[2][a] = P1[a] - op->a1 / 3.0 * T1[a];
       Q[3][a] = P1[a];
     }
     return;
@@ -530,7 +802,7 @@ km_status km__reconstruct(const km_signature *sig, int degree, double tol,
   if (!(tol > 0) || !isfinite(tol)) tol = 1e-5 * L;
   if (tol < KM_MIN_RELATIVE_TOLERANCE * L) tol = KM_MIN_RELATIVE_TOLERANCE * L;
   theta_pieces tp;
-  plan pl = {NULL, 0, 0, 0, poll};
+  plan pl = {NULL, 0, 0, 0, poll, false};
   double *pos = NULL;
   int *cont = NULL;
   km_curve c;

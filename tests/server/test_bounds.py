@@ -239,8 +239,9 @@ class ResultMemory(ContractCase):
     def test_slow_readers_share_the_result(self):
         d = Daemon("--access-log", "0")
         try:
+            # frames of some 2 KB each: 3,000 make over 4 MiB
             body = {"from": circle_svg(10.0), "to": square_svg(15.0),
-                    "frames": 2000, "tolerance": 1e-4}
+                    "frames": 3000, "tolerance": 1e-4}
             r = d.request("POST", "/v1/jobs", body=body)
             self.assertEqual(r.status, 202, r.body[:300])
             jid = r.json()["id"]

@@ -3,9 +3,10 @@
  * C(s) = start + integral of (cos theta, sin theta). theta is exact (the
  * antiderivative of a spline); positions are integrated by adaptive
  * Gauss-Legendre to near machine precision; the result is a piecewise
- * Hermite B-spline in the arc-length parameter (degree 3: C1, degree 5: C2)
- * whose pieces are chosen so a rigorous a-priori bound on the distance to
- * the exact curve stays within the tolerance.
+ * Hermite B-spline (degree 3: C1, degree 5: C2) whose knots are the arc
+ * lengths of its joins on the exact curve, and whose pieces are chosen so
+ * a rigorous a-priori bound on the distance to the exact curve stays
+ * within the tolerance.
  *
  * The signature given must be a valid one (made by km_signature_create or
  * km_signature_compute; it is not checked again). The point of the exact
@@ -24,14 +25,18 @@
  * (tol <= 0 or NaN: 1e-5 * length; raised to at least
  * KM_MIN_RELATIVE_TOLERANCE * length). Corners become knots of
  * multiplicity `degree`. The curve's parameter is arc length of the exact
- * curve at its knots.
+ * curve at its knots (there the two meet); between knots a cubic piece
+ * may follow the shape rather than the arc length (the end speeds of a
+ * circular arc), which takes far fewer pieces.
  *   out          (out) the curve, owned by the caller (km_curve_free).
  *                out->closed is set when sig->closed and the exact curve
  *                closes to within tol (then the last point is made equal
  *                to the first).
  *   error_bound  (out, may be NULL) an upper bound on the distance
- *                between out and the exact curve at equal s; never
- *                smaller than the true error.
+ *                between out and the exact curve as point sets: every
+ *                point of either is within it of a point of the other,
+ *                piece by piece between the knots; never smaller than
+ *                the true error. Degree 5 holds it at equal s too.
  * Returns KM_OK, KM_EDEGREE (degree not 3 or 5; KM_FIELD_DEGREE),
  * KM_ELIMIT (more output pieces than KM_MAX_OUTPUT_PIECES beyond two per
  * piece of sig, or than KM_MAX_PIECES; KM_FIELD_TOLERANCE: a looser
