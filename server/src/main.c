@@ -12,9 +12,9 @@
  * process.
  *
  * The connection limits are lowered, if need be, so that every connection
- * libmicrohttpd may accept has a descriptor under RLIMIT_NOFILE: at its
- * own limit libmicrohttpd stops polling the listening socket, while out
- * of descriptors accept fails with EMFILE as fast as it is retried.
+ * the daemon may accept has its descriptors under RLIMIT_NOFILE: at its
+ * limit the front stops polling the listening socket, while out of
+ * descriptors accept fails with EMFILE as fast as it is retried.
  */
 #include <dirent.h>
 #include <errno.h>
@@ -104,18 +104,19 @@ static unsigned long open_fds(unsigned long limit) {
 
 /* Lower --max-connections and --reserved-connections so that they, the
  * descriptors open now and those the daemon opens besides connections fit
- * under RLIMIT_NOFILE. Besides connections: the listening socket and an
- * epoll set and an eventfd per I/O thread (1 + 2 n, as counted in
- * /proc/PID/fd), a file served from the web root per I/O thread, a
- * reopened log, and 8 spare. Returns 0, or -1 (with a message) when not
+ * under RLIMIT_NOFILE. A connection holds three (the client's socket and
+ * a socket pair to libmicrohttpd, front.h). Besides connections: the
+ * listening socket, an epoll set and an eventfd per I/O thread and per
+ * relay thread (1 + 4 n, as counted in /proc/PID/fd), a file served from
+ * the web root per I/O thread, a reopened log, and 8 spare. Returns 0, or -1 (with a message) when not
  * one connection per I/O thread fits. */
 static int fit_connections_to_fds(srv_config *cfg, srv_log *log) {
   struct rlimit rl;
   if (getrlimit(RLIMIT_NOFILE, &rl) != 0 || rl.rlim_cur == RLIM_INFINITY)
     return 0;
   unsigned long limit = (unsigned long)rl.rlim_cur;
-  unsigned long used = open_fds(limit) + 1 + 3ul * cfg->io_threads + 1 + 8;
-  unsigned long room = limit > used ? limit - used : 0;
+  unsigned long used = open_fds(limit) + 1 + 5ul * cfg->io_threads + 1 + 8;
+  unsigned long room = limit > used ? (limit - used) / 3 : 0;
   unsigned long want = (unsigned long)cfg->max_connections + cfg->reserved;
   if (room >= want) return 0;
   if (room < 2ul * cfg->io_threads) {

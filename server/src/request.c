@@ -9,6 +9,7 @@
 
 #include "compute.h"
 #include "endpoints.h"
+#include "framing.h"
 #include "reply.h"
 #include "route.h"
 #include "util.h"
@@ -264,6 +265,17 @@ static enum MHD_Result on_first_call(srv_server *s, struct MHD_Connection *c,
   return on_headers(r);
 }
 
+/* The body is in. A chunked body the front refused inside (framing.h)
+ * ends with a trailer field carrying why: that is the answer. */
+static enum MHD_Result body_done(srv_req *r) {
+  const char *refused = MHD_lookup_connection_value(r->conn, MHD_FOOTER_KIND,
+                                                    SRV_FRAMING_REFUSED_FIELD);
+  if (refused == NULL) return dispatch(r);
+  r->must_close = true;
+  return srv__problem(r, 400, "/problems/bad-request", "Bad request", refused,
+                      NULL, NULL);
+}
+
 enum MHD_Result srv__on_request(void *cls, struct MHD_Connection *c,
                                 const char *url, const char *method,
                                 const char *version, const char *upload,
@@ -280,7 +292,7 @@ enum MHD_Result srv__on_request(void *cls, struct MHD_Connection *c,
     return on_body(r, upload, n);
   }
   switch (atomic_load(&r->phase)) {
-  case PH_BODY: return dispatch(r);
+  case PH_BODY: return body_done(r);
   case PH_READY:
     atomic_fetch_sub(&s->suspended, 1);
     r->counted = false;

@@ -55,6 +55,12 @@ static const double ACCEPT_PAUSE = 0.25;
  * pauses here. */
 static void mhd_log(void *cls, const char *fmt, va_list ap) {
   srv_server *s = cls;
+  /* Connections reach libmicrohttpd through a socket pair (front.h),
+   * which has no TCP options to set or buffers to push; the front sets
+   * TCP_NODELAY on the client's socket itself. */
+  if (strncmp(fmt, "Setting %s option to %s state failed", 36) == 0 ||
+      strncmp(fmt, "Failed to push the data from buffers", 36) == 0)
+    return;
   char msg[512];
   vsnprintf(msg, sizeof msg, fmt, ap);
   size_t n = strlen(msg);
@@ -77,7 +83,6 @@ srv_server *srv_server_create(const srv_config *cfg, srv_log *logger) {
   s->cfg = *cfg;
   s->logger = logger;
   s->log = srv_log_stream(logger);
-  s->quiesced_fd = MHD_INVALID_SOCKET;
   atomic_init(&s->draining, false);
   atomic_init(&s->abort_compute, false);
   atomic_init(&s->suspended, 0);
@@ -117,44 +122,41 @@ srv_server *srv_server_create(const srv_config *cfg, srv_log *logger) {
 }
 
 int srv_server_start(srv_server *s) {
-  struct sockaddr_storage ss;
-  memset(&ss, 0, sizeof ss);
+  srv_front_options fo = {.bind = s->cfg.bind,
+                          .port = s->cfg.port,
+                          .threads = s->cfg.io_threads,
+                          .max_connections =
+                              s->cfg.max_connections + s->cfg.reserved,
+                          .drain_time = s->cfg.send_time,
+                          .access_log = s->cfg.access_log,
+                          .logger = s->logger,
+                          .log = s->log};
+  s->front = srv_front_listen(&fo);
+  if (s->front == NULL) return -1;
   unsigned flags = MHD_USE_AUTO_INTERNAL_THREAD | MHD_ALLOW_SUSPEND_RESUME |
-                   MHD_USE_ERROR_LOG;
-  struct sockaddr_in *v4 = (struct sockaddr_in *)&ss;
-  struct sockaddr_in6 *v6 = (struct sockaddr_in6 *)&ss;
-  if (inet_pton(AF_INET, s->cfg.bind, &v4->sin_addr) == 1) {
-    v4->sin_family = AF_INET;
-    v4->sin_port = htons((uint16_t)s->cfg.port);
-  } else if (inet_pton(AF_INET6, s->cfg.bind, &v6->sin6_addr) == 1) {
-    v6->sin6_family = AF_INET6;
-    v6->sin6_port = htons((uint16_t)s->cfg.port);
-    flags |= MHD_USE_IPv6;
-  } else {
-    fprintf(s->log, "kmorphd: --bind \"%s\" is not an IPv4 or IPv6 address\n",
-            s->cfg.bind);
-    return -1;
-  }
+                   MHD_USE_ERROR_LOG | MHD_USE_NO_LISTEN_SOCKET | MHD_USE_ITC;
+  /* The front holds connections to --max-connections plus the reserved
+   * ones; libmicrohttpd's own limit is twice that, so that it is never
+   * the one reached: the front's count falls as soon as it closes a
+   * connection, libmicrohttpd's only once it notices, and in 0.9.75 an
+   * I/O thread at its share of the limit was seen to leave a request on
+   * another of its connections unread for seconds. */
   s->daemon = MHD_start_daemon(
-      flags, (uint16_t)s->cfg.port, NULL, NULL, &srv__on_request, s,
-      MHD_OPTION_EXTERNAL_LOGGER, &mhd_log, s, MHD_OPTION_SOCK_ADDR,
-      (struct sockaddr *)&ss, MHD_OPTION_THREAD_POOL_SIZE,
-      (unsigned int)s->cfg.io_threads, MHD_OPTION_CONNECTION_LIMIT,
-      (unsigned int)(s->cfg.max_connections + s->cfg.reserved),
+      flags, 0, NULL, NULL, &srv__on_request, s, MHD_OPTION_EXTERNAL_LOGGER,
+      &mhd_log, s, MHD_OPTION_THREAD_POOL_SIZE, (unsigned int)s->cfg.io_threads,
+      MHD_OPTION_CONNECTION_LIMIT,
+      (unsigned int)(2 * (s->cfg.max_connections + s->cfg.reserved)),
       MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned int)s->cfg.per_ip,
       MHD_OPTION_CONNECTION_TIMEOUT, (unsigned int)s->cfg.timeout,
       MHD_OPTION_NOTIFY_CONNECTION, &on_connection, s,
       MHD_OPTION_NOTIFY_COMPLETED, &srv__on_completed, s,
       MHD_OPTION_URI_LOG_CALLBACK, &srv__on_uri, s, MHD_OPTION_END);
   if (s->daemon == NULL) {
-    fprintf(s->log, "kmorphd: cannot listen on %s port %u (in use?)\n",
-            s->cfg.bind, s->cfg.port);
+    fprintf(s->log, "kmorphd: cannot start the HTTP daemon\n");
     return -1;
   }
-  const union MHD_DaemonInfo *info =
-      MHD_get_daemon_info(s->daemon, MHD_DAEMON_INFO_BIND_PORT);
-  s->port = info ? info->port : s->cfg.port;
-  return 0;
+  s->port = srv_front_port(s->front);
+  return srv_front_start(s->front, s->daemon);
 }
 
 unsigned srv_server_port(const srv_server *s) {
@@ -187,14 +189,10 @@ static bool requests_done(srv_server *s) {
 static const double ABORT_WAIT = 2.0;
 
 /* Refuse new connections at once, so that load balancers and clients
- * move on: libmicrohttpd stops polling the listening socket, and
- * shutdown() takes it out of the LISTEN state (connect gets ECONNREFUSED,
- * connections not yet accepted are reset). The descriptor itself stays
- * open until the HTTP daemon stops, as libmicrohttpd's threads may still
- * hold its number. */
+ * move on: the front's listening socket leaves the LISTEN state (connect
+ * gets ECONNREFUSED, connections not yet accepted are reset). */
 static void stop_listening(srv_server *s) {
-  s->quiesced_fd = MHD_quiesce_daemon(s->daemon);
-  if (s->quiesced_fd != MHD_INVALID_SOCKET) shutdown(s->quiesced_fd, SHUT_RDWR);
+  srv_front_stop_listening(s->front);
 }
 
 int srv_server_shutdown(srv_server *s) {
@@ -228,14 +226,13 @@ int srv_server_shutdown(srv_server *s) {
             (size_t)atomic_load(&s->inflight));
   MHD_stop_daemon(s->daemon);
   s->daemon = NULL;
-  if (s->quiesced_fd != MHD_INVALID_SOCKET) close(s->quiesced_fd);
-  s->quiesced_fd = MHD_INVALID_SOCKET;
   return 0;
 }
 
 void srv_server_destroy(srv_server *s) {
   if (s == NULL) return;
   if (s->daemon != NULL) MHD_stop_daemon(s->daemon);
+  srv_front_destroy(s->front); /* after: it flushes what the daemon wrote */
   srv_pool_destroy(s->pool);
   srv_jobs_destroy(s->jobs);
   if (s->store) s->store->ops->destroy(s->store);

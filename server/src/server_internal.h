@@ -22,6 +22,7 @@
 #include <stdio.h>
 
 #include "config.h"
+#include "front.h"
 #include "http_guard.h"
 #include "jobs.h"
 #include "jobstore.h"
@@ -39,8 +40,7 @@ struct srv_server {
   srv_log *logger; /* rate-limits libmicrohttpd's messages */
   struct MHD_Daemon *daemon; /* written by the main thread after start:
                               * I/O threads get theirs from the connection */
-  MHD_socket quiesced_fd;    /* the listening socket after quiesce, or
-                           * MHD_INVALID_SOCKET; closed after the stop */
+  srv_front *front;          /* accepts, frames and relays (front.h) */
   unsigned port;             /* the port bound (cfg.port may be 0) */
   srv_pool *pool;            /* compute workers and their bounded queue */
   srv_jobstore *store;       /* jobs' states and results */
