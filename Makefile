@@ -228,8 +228,9 @@ run: deps build
 	  $(CLI) signature < docs/examples/circle-signature.json; fi
 
 bench: deps bench-morph
-	@$(MAKE) --no-print-directory build/bench/bench_core
+	@$(MAKE) --no-print-directory build/bench/bench_core build/bench/bench_avoid
 	build/bench/bench_core
+	build/bench/bench_avoid
 
 # 60-frame morphs (bench/bench_morph.c), and the shapes.json pairs beside
 # flubber from npm (bench/flubber, a benchmark-only dependency; skipped
@@ -246,6 +247,10 @@ bench-morph: deps
 	build/bench/bench_morph build/bench/flubber.txt
 
 build/bench/bench_morph: bench/bench_morph.c $(LIBCORE)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) $(CORE_INC) $(CJSON_CFLAGS) $< -o $@ $(LIBCORE) $(CJSON_LIBS) -lm $(LDFLAGS)
+
+build/bench/bench_avoid: bench/bench_avoid.c $(LIBCORE)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) $(CORE_INC) $(CJSON_CFLAGS) $< -o $@ $(LIBCORE) $(CJSON_LIBS) -lm $(LDFLAGS)
 

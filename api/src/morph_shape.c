@@ -342,6 +342,8 @@ static size_t predict_bytes(const api_morph_plan *pl, const size_t *points,
   bool rational;
   bool hermite = pl->opt.method == KM_METHOD_CURVATURE;
   size_t per = SHAPE_FRAME_FIXED, once_all = 0;
+  if (pl->opt.intersections == KM_INTERSECTIONS_AVOID)
+    per += 24; /* the frame's index in intersections/crossing_frames */
   frame_kind(pl, &degree, &rational);
   for (size_t j = 0; j < npairs; j++) {
     size_t paths = (pl->inc.svg_d ? 1 : 0) + (pl->inc.animate_d ? 1 : 0);

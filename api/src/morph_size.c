@@ -111,6 +111,8 @@ static size_t predict_bytes(const api_morph_plan *pl, size_t points) {
       per += 16 + svg_num_bytes(M, 0.25 * pl->tol) * numbers;
     if (pl->inc.animate_d) /* to 1e-6 of the frame's extent */
       per += 16 + svg_num_bytes(M, 1e-6 * M) * numbers;
+    if (pl->opt.intersections == KM_INTERSECTIONS_AVOID)
+      per += 24; /* the frame's index in intersections/crossing_frames */
   }
   /* matches_used: at most max_control_points pairs */
   size_t matches = pl->opt.auto_matches ? 64 : pl->opt.nmatches;

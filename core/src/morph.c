@@ -226,12 +226,12 @@ static km_status set_correspondence(km_morph *m, const km_morph_options *opt,
 }
 
 km_status km__morph_variant(const km_morph *base, double dshift,
-                            bool auto_matches, km__poll *poll, km_morph **out,
-                            km_error *err) {
+                            bool auto_matches, double tol, km__poll *poll,
+                            km_morph **out, km_error *err) {
   km_morph *m = morph_new(poll);
   if (!m) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   m->opt = base->opt;
-  m->tol = base->tol;
+  m->tol = tol > 0 ? tol : base->tol;
   m->closed = base->closed;
   m->kmax = base->kmax;
   km_morph_options corr = base->opt;
@@ -257,7 +257,7 @@ km_status km__morph_variant(const km_morph *base, double dshift,
  * fraction dshift of its length along. */
 static km_status morph_shifted(const km_morph *base, double dshift,
                                km__poll *poll, km_morph **out, km_error *err) {
-  return km__morph_variant(base, dshift, false, poll, out, err);
+  return km__morph_variant(base, dshift, false, 0.0, poll, out, err);
 }
 
 /* The morph with the start of a closed `to` chosen by the alignment cost;

@@ -46,6 +46,10 @@
  * (shifts of j / SEAMS of the length). */
 #define PREVIEWS 7
 #define SEAMS 16
+/* Candidates are planned and previewed at this multiple of the morph's
+ * tolerance (a crossing of stroke sides is wider by orders of magnitude),
+ * the one kept planned again at the morph's own and previewed again. */
+#define COARSER 10.0
 
 /* The crossings of m's preview frames into *count, counting stopped once
  * cap is reached; *built adds the frames built. A frame that cannot be
@@ -97,60 +101,77 @@ static km_status input_crossings(const km_morph *m, km__poll *poll,
   return KM_OK;
 }
 
+/* The choice kept by the search: the start shift and whether matched. */
+typedef struct choice {
+  double shift;
+  bool with_auto;
+  long crossings;
+} choice;
+
 km_status km__avoid_crossings(km_morph **mp, km__poll *poll) {
-  km_morph *best = *mp;
+  km_morph *base = *mp, *alt = NULL;
   km_morph_avoidance rep = {0};
   long bx = 0;
-  km_status st = input_crossings(best, poll, rep.input_crossings);
-  if (!st) st = preview_crossings(best, LONG_MAX, poll, &bx, &rep.previews);
+  km_status st = input_crossings(base, poll, rep.input_crossings);
+  if (!st) st = preview_crossings(base, LONG_MAX, poll, &bx, &rep.previews);
   if (st) goto fail;
   rep.crossings_before = rep.crossings_after = bx;
   if (bx == 0) goto done;
   rep.searched = true;
-  bool auto_m = best->opt.auto_matches && best->opt.nmatches == 0;
-  double shift[SEAMS + 1], cost[SEAMS + 2];
+  bool auto_m = base->opt.auto_matches && base->opt.nmatches == 0;
+  double shift[SEAMS], cost[SEAMS];
   size_t nshift = 0;
-  if (best->closed && best->opt.nmatches == 0 &&
-      km__sector_shifts(&best->in[0], &best->in[1], SEAMS, shift + 1, cost + 1,
+  if (base->closed && base->opt.nmatches == 0 &&
+      km__sector_shifts(&base->in[0], &base->in[1], SEAMS, shift + 1, cost + 1,
                         &nshift)) {
     st = KM_ENOMEM;
     goto fail;
   }
   shift[0] = 0.0;
-  for (size_t j = 0; j <= nshift && bx > 0; j++) {
-    for (int mode = 0; mode < 2 && bx > 0; mode++) {
+  choice best = {0.0, auto_m, bx};
+  for (size_t j = 0; j <= nshift && best.crossings > 0; j++) {
+    for (int mode = 0; mode < 2 && best.crossings > 0; mode++) {
       bool with_auto = mode == 0 ? auto_m : false;
       if (mode == 1 && !auto_m) break;
       if (j == 0 && with_auto == auto_m) continue; /* the first choice */
-      km_morph *alt = NULL;
-      st = km__morph_variant(*mp, shift[j], with_auto, poll, &alt, NULL);
+      st = km__morph_variant(base, shift[j], with_auto, COARSER * base->tol,
+                             poll, &alt, NULL);
       if (st == KM_ENOMEM || st == KM_ECANCELLED) goto fail;
       if (st != KM_OK) continue; /* a choice that cannot be planned */
       long x = 0;
-      st = preview_crossings(alt, bx, poll, &x, &rep.previews);
-      if (st) {
-        km_morph_free(alt);
-        goto fail;
-      }
-      if (x < bx) {
-        if (best != *mp) km_morph_free(best);
-        best = alt;
-        bx = x;
-        rep.changed = true;
-      } else {
-        km_morph_free(alt);
-      }
+      st = preview_crossings(alt, best.crossings, poll, &x, &rep.previews);
+      km_morph_free(alt);
+      alt = NULL;
+      if (st) goto fail;
+      if (x < best.crossings) best = (choice){shift[j], with_auto, x};
     }
   }
-  rep.crossings_after = bx;
-  if (best != *mp) km_morph_free(*mp);
+  if (best.crossings < bx) {
+    /* the choice at the morph's own tolerance, kept if it still crosses
+     * less than the first */
+    long x = 0;
+    st = km__morph_variant(base, best.shift, best.with_auto, 0.0, poll, &alt,
+                           NULL);
+    if (st == KM_ENOMEM || st == KM_ECANCELLED) goto fail;
+    if (!st) st = preview_crossings(alt, bx, poll, &x, &rep.previews);
+    if (st == KM_ENOMEM || st == KM_ECANCELLED) goto fail;
+    if (!st && x < bx) {
+      km_morph_free(base);
+      base = alt;
+      alt = NULL;
+      rep.changed = true;
+      rep.crossings_after = x;
+    }
+    km_morph_free(alt);
+    alt = NULL;
+  }
 done:
-  best->avoid = rep;
-  *mp = best;
+  base->avoid = rep;
+  *mp = base;
   return KM_OK;
 fail:
-  if (best != *mp) km_morph_free(best);
-  km_morph_free(*mp);
+  km_morph_free(alt);
+  km_morph_free(base);
   *mp = NULL;
   return st ? st : KM_ENOMEM;
 }

@@ -103,12 +103,13 @@ km_status km__best_shifts(const km__input *a, const km__input *b, double *cand,
 /* ---- morphs made from a morph (morph.c) and crossings (morph_avoid.c) */
 
 /* The morph base with its closed `to` started a further fraction dshift of
- * its length along (0: where it is), with automatic matches or none: its
- * inputs are copied, not computed again, and it is planned as base was.
- * Statuses as km_morph_create (err may be NULL). */
+ * its length along (0: where it is), with automatic matches or none, at
+ * frame tolerance tol (<= 0: base's): its inputs are copied, not computed
+ * again, and it is planned as base was. Statuses as km_morph_create (err
+ * may be NULL). */
 km_status km__morph_variant(const km_morph *base, double dshift,
-                            bool auto_matches, km__poll *poll, km_morph **out,
-                            km_error *err);
+                            bool auto_matches, double tol, km__poll *poll,
+                            km_morph **out, km_error *err);
 /* The curve of the frame at t, as km_morph_frame_until with poll. */
 km_status km__morph_frame(const km_morph *m, double t, km__poll *poll,
                           km_curve *out, km_error *err);

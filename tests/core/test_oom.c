@@ -198,8 +198,8 @@ static km_status morph_frames(const km_morph *m, const morph_case *c) {
   return st;
 }
 
-static oom_outcome run_morph(void *ctx, char *why) {
-  const morph_case *c = ctx;
+static oom_outcome run_morph_as(const morph_case *c, km_intersections mode,
+                                char *why) {
   km_morph_input a = {c->from, NULL}, b = {c->to, NULL};
   km_morph_options o;
   km_morph *m = NULL;
@@ -209,6 +209,7 @@ static oom_outcome run_morph(void *ctx, char *why) {
   o.matches = c->matches;
   o.nmatches = c->nmatches;
   o.auto_matches = c->auto_matches;
+  o.intersections = mode;
   o.tolerance = 1e-4;
   st = km_morph_create(&m, &a, &b, &o, NULL);
   if (st != KM_OK && m != NULL) {
@@ -219,6 +220,14 @@ static oom_outcome run_morph(void *ctx, char *why) {
   st = morph_frames(m, c);
   km_morph_free(m);
   return outcome_of(st, "km_morph_frame", why);
+}
+
+static oom_outcome run_morph(void *ctx, char *why) {
+  return run_morph_as(ctx, KM_INTERSECTIONS_ALLOW, why);
+}
+
+static oom_outcome run_morph_avoid(void *ctx, char *why) {
+  return run_morph_as(ctx, KM_INTERSECTIONS_AVOID, why);
 }
 
 static void morph_curvature_closed_survives_oom(void **state) {
@@ -235,6 +244,15 @@ static void morph_start_preview_survives_oom(void **state) {
   morph_case c = {&s->letter_u, &s->letter_s, KM_METHOD_CURVATURE, NULL, 0,
                   false,        false};
   oom_loop("morph start preview", run_morph, &c, false, OOM_MAX_RUNS);
+}
+
+/* A failed allocation while avoiding crossings (previews of other starts)
+ * fails the morph in the same way. */
+static void morph_avoid_survives_oom(void **state) {
+  shapes *s = *state;
+  morph_case c = {&s->letter_u, &s->letter_s, KM_METHOD_CURVATURE, NULL, 0,
+                  false,        false};
+  oom_loop("morph avoid", run_morph_avoid, &c, false, OOM_MAX_RUNS);
 }
 
 static void morph_curvature_closed_metrics_survives_oom(void **state) {
@@ -287,6 +305,7 @@ static const struct CMUnitTest tests[] = {
     cmocka_unit_test(morph_curvature_closed_survives_oom),
     cmocka_unit_test(morph_curvature_closed_metrics_survives_oom),
     cmocka_unit_test(morph_start_preview_survives_oom),
+    cmocka_unit_test(morph_avoid_survives_oom),
     cmocka_unit_test(morph_curvature_open_survives_oom),
     cmocka_unit_test(morph_linear_closed_survives_oom),
     cmocka_unit_test(morph_linear_open_survives_oom),

@@ -1,0 +1,192 @@
+/* bench_avoid.c - the cost of "intersections": "avoid" against "allow" on
+ * the glyph pairs of tests/fixtures/avoid/glyphs.json.
+ *
+ * Each pair is morphed into 41 frames both ways: km_morph_create plus 41
+ * km_morph_frame calls, curve only (the planned frames of an SVG answer)
+ * and with metrics (the JSON answer's default), best of runs repeated for
+ * at least MIN_SECONDS. The per-frame time (creation amortised over the 41
+ * frames) is summed over two groups of pairs: those whose previews do not
+ * cross (avoid checks and keeps the frames: its whole cost is the check)
+ * and those it searched. Glyph outlines are TrueType (M, L, Q, Z), built
+ * with km_path exactly.
+ *
+ * Usage: bench_avoid (run from the repository root).
+ */
+#include <cJSON.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "km/kmorph.h"
+
+#define FRAMES 41
+#define FIXTURE "tests/fixtures/avoid/glyphs.json"
+#define MIN_SECONDS 0.1
+
+static double now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static char *read_file(const char *path) {
+  FILE *f = fopen(path, "rb");
+  if (!f) return NULL;
+  fseek(f, 0, SEEK_END);
+  long n = ftell(f);
+  fseek(f, 0, SEEK_SET);
+  char *s = malloc((size_t)n + 1);
+  if (s && fread(s, 1, (size_t)n, f) != (size_t)n) {
+    free(s);
+    s = NULL;
+  }
+  if (s) s[n] = '\0';
+  fclose(f);
+  return s;
+}
+
+/* Absolute M, L, Q and Z path data (one subpath) into *c. */
+static int glyph_curve(const char *d, km_curve *c) {
+  km_path p;
+  km_path_init(&p);
+  km_error err;
+  km_status st = KM_OK;
+  double v[4];
+  while (*d && !st) {
+    while (*d == ' ') d++;
+    char op = *d;
+    if (!op) break;
+    d++;
+    int n = op == 'M' || op == 'L' ? 2 : op == 'Q' ? 4 : 0;
+    for (int i = 0; i < n; i++) v[i] = strtod(d, (char **)&d);
+    if (op == 'M')
+      st = km_path_move_to(&p, v[0], v[1], &err);
+    else if (op == 'L')
+      st = km_path_line_to(&p, v[0], v[1], &err);
+    else if (op == 'Q')
+      st = km_path_quad_to(&p, v[0], v[1], v[2], v[3], &err);
+    else if (op == 'Z')
+      st = km_path_close(&p, &err);
+    else
+      st = KM_EINVAL;
+  }
+  km_curve_init(c);
+  if (!st) st = km_path_to_curve(&p, 0.0, c, &err);
+  km_path_free(&p);
+  return st == KM_OK ? 0 : -1;
+}
+
+/* One morph of FRAMES frames: its time in seconds, or a negative number. */
+static double morph_once(const km_curve *a, const km_curve *b,
+                         km_intersections mode, bool metrics,
+                         km_morph_avoidance *rep) {
+  km_morph_options o;
+  km_morph_options_default(&o);
+  o.intersections = mode;
+  km_morph_input A = {a, NULL}, B = {b, NULL};
+  km_morph *m = NULL;
+  km_error err;
+  double t0 = now();
+  if (km_morph_create(&m, &A, &B, &o, &err) != KM_OK) return -1;
+  for (int i = 0; i < FRAMES; i++) {
+    km_curve f;
+    km_frame_metrics mt;
+    km_curve_init(&f);
+    km_status st = km_morph_frame(m, i / (double)(FRAMES - 1), &f,
+                                  metrics ? &mt : NULL, NULL, &err);
+    km_curve_free(&f);
+    if (st) {
+      km_morph_free(m);
+      return -1;
+    }
+  }
+  double t = now() - t0;
+  if (rep) km_morph_avoided(m, rep);
+  km_morph_free(m);
+  return t;
+}
+
+static double morph_best(const km_curve *a, const km_curve *b,
+                         km_intersections mode, bool metrics,
+                         km_morph_avoidance *rep) {
+  double best = INFINITY, end = now() + MIN_SECONDS;
+  for (int r = 0; r < 3 || now() < end; r++) {
+    double t = morph_once(a, b, mode, metrics, r == 0 ? rep : NULL);
+    if (t < 0) return -1;
+    best = fmin(best, t);
+  }
+  return best;
+}
+
+static const char *glyph_d(const cJSON *root, const char *id) {
+  const cJSON *g;
+  cJSON_ArrayForEach(g, cJSON_GetObjectItemCaseSensitive(root, "glyphs")) {
+    if (!strcmp(cJSON_GetObjectItemCaseSensitive(g, "id")->valuestring, id))
+      return cJSON_GetObjectItemCaseSensitive(g, "d")->valuestring;
+  }
+  return NULL;
+}
+
+int main(void) {
+  char *text = read_file(FIXTURE);
+  cJSON *root = text ? cJSON_Parse(text) : NULL;
+  free(text);
+  if (!root) {
+    fprintf(stderr, "cannot read %s\n", FIXTURE);
+    return 1;
+  }
+  /* [metrics][searched][allow, avoid]: summed per-frame microseconds */
+  double sum[2][2][2] = {{{0}}};
+  int count[2] = {0, 0};
+  long previews[2] = {0, 0};
+  const cJSON *p;
+  cJSON_ArrayForEach(p, cJSON_GetObjectItemCaseSensitive(root, "pairs")) {
+    const char *from = cJSON_GetObjectItemCaseSensitive(p, "from")->valuestring;
+    const char *to = cJSON_GetObjectItemCaseSensitive(p, "to")->valuestring;
+    const char *da = glyph_d(root, from), *db = glyph_d(root, to);
+    km_curve a, b;
+    if (!da || !db || glyph_curve(da, &a) || glyph_curve(db, &b)) {
+      fprintf(stderr, "%s -> %s: cannot build the glyphs\n", from, to);
+      cJSON_Delete(root);
+      return 1;
+    }
+    km_morph_avoidance rep;
+    memset(&rep, 0, sizeof rep);
+    double t[2][2];
+    for (int metrics = 0; metrics < 2; metrics++) {
+      t[metrics][0] = morph_best(&a, &b, KM_INTERSECTIONS_ALLOW, metrics, NULL);
+      t[metrics][1] = morph_best(&a, &b, KM_INTERSECTIONS_AVOID, metrics, &rep);
+    }
+    km_curve_free(&a);
+    km_curve_free(&b);
+    if (t[0][0] < 0 || t[0][1] < 0 || t[1][0] < 0 || t[1][1] < 0) {
+      fprintf(stderr, "%s -> %s: the morph failed\n", from, to);
+      cJSON_Delete(root);
+      return 1;
+    }
+    int s = rep.searched ? 1 : 0;
+    count[s]++;
+    previews[s] += (long)rep.previews;
+    for (int metrics = 0; metrics < 2; metrics++)
+      for (int k = 0; k < 2; k++)
+        sum[metrics][s][k] += 1e6 * t[metrics][k] / FRAMES;
+  }
+  cJSON_Delete(root);
+  printf("intersections avoid against allow, %d frames, per frame (creation "
+         "amortised), mean over pairs:\n",
+         FRAMES);
+  static const char *group[2] = {"previews do not cross (kept)",
+                                 "previews cross (searched)"};
+  for (int s = 0; s < 2; s++) {
+    if (count[s] == 0) continue;
+    printf("  %-30s %2d pairs, %5.1f previews: curve %6.1f us allow, %6.1f "
+           "us avoid (x%.2f); with metrics %6.1f us, %6.1f us (x%.2f)\n",
+           group[s], count[s], (double)previews[s] / count[s],
+           sum[0][s][0] / count[s], sum[0][s][1] / count[s],
+           sum[0][s][1] / sum[0][s][0], sum[1][s][0] / count[s],
+           sum[1][s][1] / count[s], sum[1][s][1] / sum[1][s][0]);
+  }
+  return 0;
+}
