@@ -6,6 +6,7 @@ import { Client, KmorphError, curveToPath, samplePoints } from "./kmorph.js";
 import { CURVES, PAIRS } from "./examples.js";
 import { splitSubpaths, slotColour, isShapeResult, framePath, frameMetrics, frameIsBad, resultBounds,
          slotPoints } from "./shapes.js";
+import { curvaturePlot } from "./plot.js";
 
 const km = new Client();
 const $ = (sel, root = document) => root.querySelector(sel);
@@ -53,7 +54,72 @@ function parseCurve(text) {
     throw new Error("a JSON curve needs type, signature, kappa or control_points");
   }
   if (!/^[Mm]/.test(s)) throw new Error("an SVG path must start with M (or paste a JSON curve)");
+  let subpaths;
+  try { subpaths = splitSubpaths(s); } catch (e) { throw new Error("SVG path: " + e.message); }
+  if (!subpaths.length) throw new Error("SVG path: it draws nothing (a moveto alone)");
+  if (subpaths.length > 1) {
+    const open = subpaths.findIndex((p) => !p.closed);
+    if (open >= 0) throw new Error(`SVG path: subpath ${open + 1} of ${subpaths.length} is not closed by Z (each contour of a compound shape must be)`);
+  }
   return { type: "svg", d: s };
+}
+
+/* A path whose end is this close to its start (relative to its size) is
+ * closed when sent; one within CLOSE_OFFER is offered a Z. */
+const CLOSE_AUTO = 1e-6, CLOSE_OFFER = 0.05;
+
+/** How far a single open SVG path ends from its start: {gap, size}, or
+ * null for closed, compound or other curves. */
+function openGap(curve) {
+  if (!curve || curve.type !== "svg") return null;
+  let subpaths;
+  try { subpaths = splitSubpaths(curve.d); } catch { return null; }
+  if (subpaths.length !== 1 || subpaths[0].closed) return null;
+  const { start, end, box } = subpaths[0];
+  return { gap: Math.hypot(end[0] - start[0], end[1] - start[1]), size: Math.hypot(box[2] - box[0], box[3] - box[1]) };
+}
+
+/** The curve as it is sent: an SVG path that returns to its start
+ * within rounding is closed with Z (its frames would explode open). */
+function sentCurve(curve) {
+  const g = openGap(curve);
+  return g && g.gap <= CLOSE_AUTO * g.size ? { ...curve, d: curve.d.trimEnd() + " Z" } : curve;
+}
+
+/** The note under a curve field about closing it, and the closed box. */
+function updateClosedNote(which) {
+  const curve = state.input[which], note = $("#note-" + which), box = $(`.draw-closed[data-which=${which}]`);
+  note.replaceChildren();
+  if (curve && curve.type === "svg") {
+    box.checked = /z\s*$/i.test(curve.d);
+    box.disabled = !!(state.display[which] && state.display[which].compound);
+  } else box.disabled = false;
+  const g = openGap(curve);
+  if (!g || g.gap > CLOSE_OFFER * g.size) return;
+  if (g.gap <= CLOSE_AUTO * g.size) {
+    note.textContent = "This path ends where it starts: it is sent closed (Z added).";
+    return;
+  }
+  note.append(`This path ends ${fmt(g.gap)} from its start and is open. `);
+  const btn = document.createElement("button");
+  btn.type = "button";
+  btn.className = "close-path";
+  btn.textContent = "Close it with Z";
+  btn.addEventListener("click", () => setClosed(which, true));
+  note.appendChild(btn);
+}
+
+/** Close (Z at the end) or open a single SVG path in its field. */
+function setClosed(which, closed) {
+  const ta = $("#curve-" + which), text = ta.value.trimEnd();
+  if (text.startsWith("{")) {
+    try {
+      const c = JSON.parse(text);
+      if (c.type === "points" || c.type === "bspline") { c.closed = closed; ta.value = JSON.stringify(c); }
+    } catch { /* the field's own error says what is wrong */ }
+  } else if (closed && !/z$/i.test(text)) ta.value = text + " Z";
+  else if (!closed) ta.value = text.replace(/\s*[zZ]$/, "");
+  updateCurve(which);
 }
 
 function curveText(curve) {
@@ -131,11 +197,18 @@ async function updateCurve(which) {
     state.input[which] = null;
     state.display[which] = null;
     setFieldError(which, e.message);
+    updateClosedNote(which);
     renderEditor();
     return;
   }
+  const changed = JSON.stringify(curve) !== JSON.stringify(state.input[which]);
   state.input[which] = curve;
-  state.contourMatches = null;
+  if (changed) forgetMatches();
+  if (changed && state.pairError) {
+    /* a fault of the pair is gone with either curve changed */
+    state.pairError = false;
+    setFieldError(which === "from" ? "to" : "from", "");
+  }
   try {
     const shown = await displayShape(curve);
     if (seq !== previewSeq[which]) return;
@@ -146,6 +219,7 @@ async function updateCurve(which) {
     state.display[which] = curve.type === "points" ? single(pointsPath(curve.points, curve.closed), !!curve.closed) : null;
     setFieldError(which, problemText(e));
   }
+  updateClosedNote(which);
   renderEditor();
 }
 
@@ -296,7 +370,7 @@ function toggleDraw(which) {
     state.drawing = null;
     btn.textContent = "Draw";
     $("#editor").classList.remove("drawing");
-    $("#editor-hint").textContent = "The two input curves.";
+    $("#editor-hint").textContent = EDITOR_HINT;
     updateCurve(which);
     return;
   }
@@ -310,11 +384,50 @@ function toggleDraw(which) {
   renderEditor();
 }
 
+const EDITOR_HINT = "The two input curves. Use Draw to click control points, or Pick pairs to match points.";
+
 function stopPicking() {
   state.picking = false;
   state.pending = null;
   $("#editor").classList.remove("picking");
   $("#pick-matches").textContent = "Pick pairs";
+  $("#editor-hint").textContent = EDITOR_HINT;
+}
+
+/** Picked pairs and contour colours name points of the curves they were
+ * made on: a changed curve drops them. */
+function forgetMatches() {
+  state.contourMatches = null;
+  if (!state.matches.length && state.pending == null) return;
+  state.matches = [];
+  state.pending = null;
+  if ($("#matches-mode").value === "pairs") $("#matches-mode").value = "none";
+}
+
+/* A pick within one sampling step of a curve's ends is at its seam (the
+ * start of a closed curve) or its end; sent SEAM_EPS inside, which the
+ * service takes as the end itself up to rounding. */
+const SEAM_PICK = 1 / 400 + 1e-9, SEAM_EPS = 1e-4;
+const atSeam = (f) => f <= SEAM_PICK || f >= 1 - SEAM_PICK;
+
+function curvesClosed() {
+  return ["from", "to"].every((w) => state.display[w] && state.display[w].closed);
+}
+
+/** The picked pairs as the service takes them: strictly inside (0, 1).
+ * On closed curves the two starts always correspond when pairs are
+ * given, so a pick of both starts needs no pair, and a start matched with
+ * an inner point is sent just after the seam or just before it, whichever
+ * leaves less of the partner's length to the sliver between the two. */
+function sendablePairs() {
+  const closed = curvesClosed(), out = [];
+  for (const [a, b] of state.matches) {
+    if (closed && atSeam(a) && atSeam(b)) continue;
+    const inside = (f, other) => (!atSeam(f) ? f : closed ? (other < 0.5 ? SEAM_EPS : 1 - SEAM_EPS)
+                                                          : (f < 0.5 ? SEAM_EPS : 1 - SEAM_EPS));
+    out.push([inside(a, b), inside(b, a)]);
+  }
+  return out.sort((p, q) => p[0] - q[0]);
 }
 
 function renderMatchList() {
@@ -322,7 +435,10 @@ function renderMatchList() {
   ul.replaceChildren();
   for (const [a, b] of state.matches) {
     const li = document.createElement("li");
-    li.textContent = `from ${a.toFixed(4)} ↔ to ${b.toFixed(4)} (arc-length fractions)`;
+    const where = (f) => f.toFixed(4) + (atSeam(f) ? (curvesClosed() ? " (start)" : f < 0.5 ? " (start)" : " (end)") : "");
+    li.textContent = curvesClosed() && atSeam(a) && atSeam(b)
+      ? "start ↔ start (the starts of closed curves correspond whenever pairs are picked)"
+      : `from ${where(a)} ↔ to ${where(b)} (arc-length fractions)`;
     ul.appendChild(li);
   }
 }
@@ -343,12 +459,15 @@ function optionsRequest() {
   }
   const mode = $("#matches-mode").value;
   if (mode === "auto") req.matches = "auto";
-  else if (mode === "pairs" && state.matches.length && !isCompound()) req.matches = state.matches;
+  else if (mode === "pairs" && !isCompound()) {
+    const pairs = sendablePairs();
+    if (pairs.length) req.matches = pairs;
+  }
   return req;
 }
 
 const FIELD_OF = [
-  [/^\/from(\/|$)/, "from"], [/^\/to(\/|$)/, "to"],
+  [/^\/from(\/|$)/, "from"], [/^\/to(\/|$)/, "to"], [/^\/closed$/, "curves"],
   [/^\/(frames|times|matches|closure|anchor|blend|tolerance|method|orient|degree)(\/|$)/, "options"],
 ];
 const INPUT_OF = { frames: "#frames", times: "#frames", matches: "#matches-mode", closure: "#closure",
@@ -357,6 +476,21 @@ const INPUT_OF = { frames: "#frames", times: "#frames", matches: "#matches-mode"
 function clearErrors() {
   for (const w of ["from", "to", "options", "general"]) setFieldError(w, "");
   for (const sel of Object.values(INPUT_OF)) $(sel).parentElement.classList.remove("has-error");
+}
+
+/** A JSON pointer of a request said in words ("/matches/1/0" -> "match
+ * 2, from fraction"). */
+function pointerWords(pointer) {
+  const parts = (pointer || "").split("/").slice(1);
+  if (!parts.length) return "the request";
+  const [key, i, j] = parts;
+  if (key === "matches" && i !== undefined)
+    return `picked pair ${Number(i) + 1}` + (j === "0" ? ", on the from curve" : j === "1" ? ", on the to curve" : "");
+  if (key === "contour_matches" && i !== undefined) return `contour pair ${Number(i) + 1}`;
+  const words = { frames: "frames", times: "times", closure: "closure", anchor: "anchor", blend: "blend",
+                  tolerance: "tolerance", method: "method", orient: "orientation", degree: "degree",
+                  closed: "open or closed curves", svg: "SVG layout" };
+  return words[key] || parts.join(" ");
 }
 
 /** Show a service problem next to the field(s) it points at. */
@@ -370,7 +504,13 @@ function showProblem(e, method) {
   for (const x of e.errors) {
     const hit = FIELD_OF.find(([re]) => re.test(x.pointer || ""));
     const where = hit ? hit[1] : "general";
-    (per[where] ||= []).push(`${x.message}${where === "general" || where === "options" ? ` (${x.pointer})` : ""}`);
+    if (where === "curves") {
+      /* an open curve against a closed one: the fault of both curves */
+      for (const w of ["from", "to"]) (per[w] ||= []).push(x.message);
+      state.pairError = true;
+      continue;
+    }
+    (per[where] ||= []).push(`${where === "general" || where === "options" ? `${pointerWords(x.pointer)}: ` : ""}${x.message}`);
     const key = (x.pointer || "").split("/")[1];
     if (where === "options" && INPUT_OF[key]) $(INPUT_OF[key]).parentElement.classList.add("has-error");
   }
@@ -391,7 +531,7 @@ async function runMorph() {
       return;
     }
   }
-  const base = { from: state.input.from, to: state.input.to, ...optionsRequest() };
+  const base = { from: sentCurve(state.input.from), to: sentCurve(state.input.to), ...optionsRequest() };
   const choice = $("#method").value;
   const methods = choice === "both" ? ["curvature", "linear"] : [choice];
   const asJob = $("#use-job").checked || (Number(base.frames) > JOB_FRAMES);
@@ -438,7 +578,11 @@ async function runMorph() {
     showProblem(o.error, failed.length < outcomes.length ? o.method : "");
   }
   const ok = outcomes.filter((o) => o.result);
-  if (!ok.length) { $("#status").textContent = "failed"; return; }
+  if (!ok.length) {
+    clearResults();
+    $("#status").textContent = "failed: see the messages by the fields";
+    return;
+  }
   const ms = Math.round(performance.now() - started);
   $("#status").textContent = `${ok.map((o) => `${o.method}: ${o.result.frames.length} frames`).join(", ")} in ${ms} ms` +
                              (asJob ? " (jobs)" : "");
@@ -446,6 +590,18 @@ async function runMorph() {
 }
 
 // ---------------------------------------------------------------- results
+
+/** Take the shown results away (they belong to another request). */
+function clearResults() {
+  stop();
+  state.results = [];
+  state.panels = [];
+  state.contourMatches = null;
+  $("#panels").replaceChildren();
+  $("#results").hidden = true;
+  renderContourList();
+  renderEditor();
+}
 
 function showResults(outcomes) {
   stop();
@@ -468,9 +624,6 @@ function showResults(outcomes) {
   state.contourMatches = shape ? outcomes[0].result.contour_matches_used || null : null;
   renderContourList();
   renderEditor();
-  /* The service draws compound morphs as a filmstrip only. */
-  for (const opt of $("#svg-layout").options) opt.disabled = shape && opt.value !== "filmstrip";
-  if (shape) $("#svg-layout").value = "filmstrip";
   const n = outcomes[0].result.frames.length;
   /* Slider steps land exactly on frames: k steps per frame interval. */
   const k = Math.max(1, Math.ceil(1000 / Math.max(1, n - 1)));
@@ -535,7 +688,9 @@ function buildPanel(o, viewBox) {
   $(".ghost.from", stage).setAttribute("d", paths[0]);
   $(".ghost.to", stage).setAttribute("d", paths[paths.length - 1]);
   const current = $(".current", stage);
-  current.classList.add("fillable");
+  /* only closed curves have an inside to fill */
+  const fillable = shape || result.frames.every((f) => f.curve.closed);
+  current.classList.toggle("fillable", fillable);
   /* A compound frame's contours outlined one by one in their pair's colour. */
   const slotPaths = shape ? result.frames[0].contours.map((_, k) =>
     svgEl("path", { class: "slot", "data-slot": k, style: `stroke: ${slotColour(k)}` }, stage)) : [];
@@ -552,7 +707,7 @@ function buildPanel(o, viewBox) {
       (f.metrics ? `, ${m.self_intersections} self-intersections` : "") +
       (shape && f.metrics ? `, ${m.mutual_intersections} crossings between contours` +
                             (m.nesting_ok ? "" : ", a hole outside its contour") : "");
-    svgEl("path", { d: paths[i], class: "fillable", "fill-rule": fillRuleAt(f.t) }, svg);
+    svgEl("path", { d: paths[i], class: fillable ? "fillable" : "", "fill-rule": fillRuleAt(f.t) }, svg);
     if (shape)
       f.contours.forEach((c, k) => c && svgEl("path", { d: curveToPath(c), class: "slot", "data-slot": k,
                                                         style: `stroke: ${slotColour(k)}` }, svg));
@@ -681,31 +836,39 @@ function setT(t) {
       if (p.thumbs.get(at.frame)) p.thumbs.get(at.frame).classList.add("current");
       p.current = at.frame;
     }
-    label = at.exact ? `frame #${at.frame} (of ${p.result.frames.length})`
-                     : `between frames (nearest ${at.frame}; metrics of that frame)`;
+    label = at.exact ? `frame ${at.frame} of ${p.result.frames.length - 1}`
+                     : `≈ frame ${at.frame} of ${p.result.frames.length - 1} (blend)`;
   }
   $("#frame-label").textContent = label;
+  $("#frame-label").title = label.includes("blend")
+    ? "Between frames the stage blends the two nearest frames; the numbers are the nearest frame's." : "";
 }
 
-/** Fetch the paper-style plot of kappa_t(s) for a subset of the frames. */
-async function loadPlot(panel) {
+/** The plot of kappa_t(s / L_t) for a subset of the frames, drawn here
+ * from the frames (see plot.js): single curves from the from colour to
+ * the to colour by t, compound shapes contour by contour in their pair's
+ * colour. */
+function loadPlot(panel) {
   const div = $(".plot", panel.root);
-  if (panel.shape) {
-    div.textContent = "The curvature plot is drawn for single curves; see each contour's metrics in the JSON download.";
-    return;
-  }
   const frames = panel.result.frames, n = frames.length, count = Math.min(n, PLOT_MAX);
-  const times = [...new Set(Array.from({ length: count }, (_, i) => frames[Math.round(i * (n - 1) / Math.max(1, count - 1))].t))];
-  const { include, metrics, frames: _f, ...rest } = panel.request;
+  const picks = [...new Set(Array.from({ length: count }, (_, i) => Math.round(i * (n - 1) / Math.max(1, count - 1))))];
+  const curves = [];
+  for (const i of picks) {
+    const f = frames[i];
+    if (panel.shape) f.contours.forEach((c, k) => c && curves.push({ curve: c, colour: slotColour(k), t: f.t }));
+    else curves.push({ curve: f.curve, colour: mixColour(f.t), t: f.t });
+  }
   try {
-    const svg = await km.morph({ ...rest, times, format: "svg", svg: { layout: "curvature_plot" } });
-    const img = document.createElement("img");
-    img.alt = `curvature of ${times.length} frames (${panel.method})`;
-    img.src = URL.createObjectURL(new Blob([svg], { type: "image/svg+xml" }));
-    div.replaceChildren(img);
+    div.replaceChildren(curvaturePlot(curves));
   } catch (e) {
     div.textContent = "no curvature plot: " + problemText(e);
   }
+}
+
+/** The colour of time t between the from and to colours. */
+function mixColour(t) {
+  const a = [0x1f, 0x6f, 0xd1], b = [0xd1, 0x57, 0x1f];
+  return `rgb(${a.map((x, i) => Math.round(x + t * (b[i] - x))).join(",")})`;
 }
 
 // --------------------------------------------------------------- playback
@@ -809,12 +972,8 @@ function init() {
     });
     $(`.draw[data-which=${which}]`).addEventListener("click", () => toggleDraw(which));
     $(`.draw-closed[data-which=${which}]`).addEventListener("change", (e) => {
-      const ta = $("#curve-" + which);
-      try {
-        const c = JSON.parse(ta.value);
-        if (c.type === "points") { c.closed = e.target.checked; ta.value = JSON.stringify(c); updateCurve(which); }
-      } catch { /* an SVG path closes with Z instead */ }
-      renderEditor();
+      if (state.drawing === which) { renderEditor(); return; }
+      setClosed(which, e.target.checked);
     });
   }
   $("#editor").addEventListener("click", onEditorClick);
@@ -831,6 +990,12 @@ function init() {
     $("#editor-hint").textContent = "Click a point on the from curve, then its partner on the to curve.";
   });
   $("#clear-matches").addEventListener("click", () => { state.matches = []; state.pending = null; renderEditor(); });
+  for (const sel of Object.values(INPUT_OF))
+    $(sel).addEventListener("input", () => {
+      $(sel).parentElement.classList.remove("has-error");
+      setFieldError("options", "");
+      setFieldError("general", "");
+    });
   $("#outline-only").addEventListener("change", (e) => document.body.classList.toggle("outlines", e.target.checked));
   $("#morph").addEventListener("click", runMorph);
   $("#cancel").addEventListener("click", () => state.controller && state.controller.abort());

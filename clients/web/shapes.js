@@ -46,15 +46,17 @@ export function pathCommands(d) {
 
 /** The subpaths of SVG path data that draw something, each as path data
  * of its own starting with an absolute moveto, with whether it is closed
- * by Z. Movetos that draw nothing are left out, as the service does. */
+ * by Z, its start and end points and the box of its command end points.
+ * Movetos that draw nothing are left out, as the service does. */
 export function splitSubpaths(d) {
   const subpaths = [];
   let x = 0, y = 0, sx = 0, sy = 0, current = null;
   const finish = () => {
-    if (current && current.draws) subpaths.push({ d: current.text.trim(), closed: current.closed });
+    if (current && current.draws)
+      subpaths.push({ d: current.text.trim(), closed: current.closed, start: [sx, sy], end: [x, y], box: current.box });
     current = null;
   };
-  const begin = () => { current = { text: `M${sx},${sy}`, draws: false, closed: false }; };
+  const begin = () => { current = { text: `M${sx},${sy}`, draws: false, closed: false, box: [sx, sy, sx, sy] }; };
   for (const [cmd, a] of pathCommands(d)) {
     const lower = cmd.toLowerCase(), rel = cmd === lower;
     if (lower === "m") {
@@ -76,6 +78,8 @@ export function splitSubpaths(d) {
       x = rel ? x + ex : ex;
       y = rel ? y + ey : ey;
     }
+    const b = current.box;
+    current.box = [Math.min(b[0], x), Math.min(b[1], y), Math.max(b[2], x), Math.max(b[3], y)];
   }
   finish();
   return subpaths;

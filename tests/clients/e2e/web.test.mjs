@@ -71,9 +71,13 @@ test("the spiral example morphed both ways shows exactly what the API returned",
   const between = await page.getAttribute("#panel-curvature .stage path.current", "d");
   assert.ok(!cur.frames.some((f) => f.curve.svg_d === between));
   await setScrub(page, 0.5);
-  await page.waitForFunction(() => [...document.querySelectorAll(".plot")].every((p) => p.querySelector("img") &&
-                                                                                     p.querySelector("img").complete),
+  await page.waitForFunction(() => [...document.querySelectorAll(".plot")].every((p) => p.querySelector("svg.kappa-plot")),
                              null, { timeout: 20000 });
+  /* the curvature blend's frames have max |kappa_t| = 4 |1 - 1.5 t|, largest
+   * (4) at t = 0: the plot's scale is that peak and 5% (the frames are
+   * cubic B-splines within the tolerance: their peak within 2.5%) */
+  const range = Number(await page.getAttribute("#panel-curvature .plot svg", "data-range"));
+  assert.ok(Math.abs(range / 1.05 - 4) < 0.1, String(range));
   const shot = path.join(ARTIFACTS, "spirals-t0.5.png");
   await page.screenshot({ path: shot, fullPage: true });
   assert.ok(fs.statSync(shot).size > 10000);
