@@ -227,7 +227,7 @@ run: deps build
 	else echo "kmorphd not built yet: CLI demo"; \
 	  $(CLI) signature < docs/examples/circle-signature.json; fi
 
-bench: deps bench-morph
+bench: deps bench-morph bench-shapes
 	@$(MAKE) --no-print-directory build/bench/bench_core build/bench/bench_avoid
 	build/bench/bench_core
 	build/bench/bench_avoid
@@ -245,6 +245,25 @@ bench-morph: deps
 	    > build/bench/flubber.txt || rm -f build/bench/flubber.txt; \
 	else echo "flubber could not be installed with npm: kmorph figures only"; fi
 	build/bench/bench_morph build/bench/flubber.txt
+
+# 60-frame morphs of compound shapes (bench/shape_pairs.json: glyphs with
+# holes, 4-contour icons), the CLI end to end and the core in-process,
+# beside flubber's interpolateAll / combine / separate on the same pairs.
+.PHONY: bench-shapes
+bench-shapes: deps build
+	@$(MAKE) --no-print-directory build/bench/bench_shapes
+	@rm -f build/bench/flubber-shapes.txt; \
+	if [ -d bench/flubber/node_modules/flubber ] || \
+	   (cd bench/flubber && npm ci --no-audit --no-fund >/dev/null 2>&1); then \
+	  (cd bench/flubber && node bench_flubber_shapes.js ../shape_pairs.json \
+	    ../../tests/fixtures/compound) > build/bench/flubber-shapes.txt || \
+	    rm -f build/bench/flubber-shapes.txt; \
+	else echo "flubber could not be installed with npm: kmorph figures only"; fi
+	build/bench/bench_shapes bench/shape_pairs.json $(CLI) build/bench/flubber-shapes.txt
+
+build/bench/bench_shapes: bench/bench_shapes.c $(LIBAPI) $(LIBCORE)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) $(API_INC) -Iapi/src $< -o $@ $(LIBAPI) $(LIBCORE) $(CJSON_LIBS) -lm $(LDFLAGS)
 
 build/bench/bench_morph: bench/bench_morph.c $(LIBCORE)
 	@mkdir -p $(@D)
