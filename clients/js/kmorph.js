@@ -546,9 +546,25 @@ function meanPoint(pts) {
   return [x / pts.length, y / pts.length];
 }
 
+/** The point a collapsed contour (null at frame i) shrinks into or grows
+ * from: the centre of its samples at the nearest frame where it is
+ * present, carried on to t_i along the centre's motion between that frame
+ * and the next one present beyond it (the service shrinks such a contour
+ * about a centre that moves smoothly, so this is exact to first order). */
+function collapsePoint(frames, pts, i) {
+  for (let d = 1; d < pts.length; d++)
+    for (const p of [i - d, i + d]) {
+      if (p < 0 || p >= pts.length || !pts[p]) continue;
+      const c = meanPoint(pts[p]), q = p + Math.sign(p - i);
+      if (q < 0 || q >= pts.length || !pts[q] || frames[q].t === frames[p].t) return c;
+      const c2 = meanPoint(pts[q]), f = (frames[i].t - frames[p].t) / (frames[p].t - frames[q].t);
+      return [c[0] + f * (c[0] - c2[0]), c[1] + f * (c[1] - c2[1])];
+    }
+  return [0, 0];
+}
+
 /** Where each slot's contour is at every frame: its samples, or for a
- * collapsed contour the point it shrinks into (or grows from), taken as
- * the centre of its samples at the nearest frame where it is present. */
+ * collapsed contour the point it shrinks into (or grows from). */
 function slotTracks(frames, samples) {
   const perFrame = frames.map((f) => frameContours(f).map((c) => (c ? samplePoints(c, samples) : null)));
   const slots = perFrame[0].length;
@@ -556,14 +572,7 @@ function slotTracks(frames, samples) {
   for (let k = 0; k < slots; k++) {
     const pts = perFrame.map((row) => row[k]);
     const closed = frames.map((f) => { const c = frameContours(f)[k]; return c ? !!c.closed : true; });
-    const points = pts.map((p, i) => {
-      if (p) return null;
-      for (let d = 1; d < pts.length; d++) {
-        if (i - d >= 0 && pts[i - d]) return meanPoint(pts[i - d]);
-        if (i + d < pts.length && pts[i + d]) return meanPoint(pts[i + d]);
-      }
-      return [0, 0];
-    });
+    const points = pts.map((p, i) => (p ? null : collapsePoint(frames, pts, i)));
     tracks.push({ pts, points, closed });
   }
   return tracks;

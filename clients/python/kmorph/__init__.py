@@ -607,10 +607,29 @@ def _mean(pts):
     return (sum(p[0] for p in pts) / len(pts), sum(p[1] for p in pts) / len(pts))
 
 
+def _collapse_point(frames, pts, i):
+    """The point a collapsed contour (None at frame i) shrinks into or
+    grows from: the centre of its samples at the nearest frame where it is
+    present, carried on to t_i along the centre's motion between that
+    frame and the next one present beyond it (the service shrinks such a
+    contour about a centre that moves smoothly: exact to first order)."""
+    for d in range(1, len(pts)):
+        for p in (i - d, i + d):
+            if p < 0 or p >= len(pts) or pts[p] is None:
+                continue
+            c = _mean(pts[p])
+            q = p + (1 if p > i else -1)
+            if q < 0 or q >= len(pts) or pts[q] is None or frames[q]["t"] == frames[p]["t"]:
+                return c
+            c2 = _mean(pts[q])
+            f = (frames[i]["t"] - frames[p]["t"]) / (frames[p]["t"] - frames[q]["t"])
+            return (c[0] + f * (c[0] - c2[0]), c[1] + f * (c[1] - c2[1]))
+    return (0.0, 0.0)
+
+
 def _slot_tracks(frames, samples):
     """Per slot: samples per frame (None where collapsed), the point a
-    collapsed contour shrinks into (the centre of its samples at the
-    nearest frame where it is present), and closedness per frame."""
+    collapsed contour shrinks into or grows from, closedness per frame."""
     per_frame = [[None if c is None else sample_points(c, samples) for c in frame_contours(f)]
                  for f in frames]
     tracks = []
@@ -618,19 +637,7 @@ def _slot_tracks(frames, samples):
         pts = [row[k] for row in per_frame]
         closed = [True if frame_contours(f)[k] is None else bool(frame_contours(f)[k].get("closed"))
                   for f in frames]
-        points = []
-        for i, p in enumerate(pts):
-            c = None
-            if p is None:
-                c = (0.0, 0.0)
-                for d in range(1, len(pts)):
-                    if i - d >= 0 and pts[i - d] is not None:
-                        c = _mean(pts[i - d])
-                        break
-                    if i + d < len(pts) and pts[i + d] is not None:
-                        c = _mean(pts[i + d])
-                        break
-            points.append(c)
+        points = [None if p is not None else _collapse_point(frames, pts, i) for i, p in enumerate(pts)]
         tracks.append((pts, points, closed))
     return tracks
 

@@ -178,6 +178,21 @@ class ShapeTest(unittest.TestCase):
         frame = subpaths(frame_contour_paths(res["frames"][2])[slot], 16)[0]
         self.assertLess(hausdorff(mid, frame, 0.2), 0.05)
 
+    def test_between_frames_the_vanishing_dot_of_i_follows_the_frames_into_its_point(self):
+        frm, to = SHAPES["dejavu-sans/i"]["d"], SHAPES["dejavu-sans/l"]["d"]
+        res = self.km.morph(morph_request(frm, to, frames=11, tolerance=0.001))
+        slot = [j for _, j in res["contour_matches_used"]].index(None)
+        truth = self.km.morph(morph_request(frm, to, times=[0.95, 0.99], tolerance=0.001,
+                                            contour_matches=res["contour_matches_used"]))
+        at = interpolator(res, samples=400, per_contour=True)
+        # The dot's centre moves on a smooth track: carried on from the
+        # frames at 0.8 and 0.9 it lands within 2e-4 of the em of the
+        # service's dot (at most 2.2 long here: 400 samples cut its corners
+        # by less than 0.003); the centre at 0.9 alone is 0.27 off.
+        for f in truth["frames"]:
+            h = hausdorff(subpaths(frame_contour_paths(f)[slot], 16)[0], subpaths(at(f["t"])[slot], 1)[0], 0.5)
+            self.assertLess(h, 0.02, "t = %g" % f["t"])
+
     def test_a_callers_contour_matches_are_honoured(self):
         frm, to = SHAPES["mdi/dice-3"]["d"], SHAPES["mdi/dice-5"]["d"]
         auto = self.km.morph(morph_request(frm, to, frames=2, tolerance=TOL["icon"]))
