@@ -253,6 +253,24 @@ t_shape_svg_fill() {
 }
 check "an SVG file keeps its fill rule (evenodd makes a hole) and its open subpaths are closed (mdi's lock morphs)" t_shape_svg_fill
 
+t_path_contours_jq() {
+  # The scripts' jq splitter over every icon as shipped and as closed: the
+  # service answers the same signatures as for the closed fixture d.
+  ( . "$bin/kmorph-lib.sh"
+    jq -r "$km_path_contours_jq"' .icons[] | [.id, .d, (.d | path_contours | join(" ")), (.d_source | path_contours | join(" "))] | @tsv' \
+      "$FIX/icons.json" >"$work/icons.tsv" ) || return 1
+  sig() { jq -cn --arg d "$1" '{curve: {type: "svg", d: $d}}' |
+            curl -sS -H 'Content-Type: application/json' --data-binary @- "$KMORPH_URL/v1/signature"; }
+  n=0
+  while IFS=$'\t' read -r id d closed shipped; do
+    want=$(sig "$d")
+    [ "$(sig "$closed")" = "$want" ] && [ "$(sig "$shipped")" = "$want" ] || { echo "$id differs"; return 1; }
+    n=$((n + 1))
+  done <"$work/icons.tsv"
+  [ "$n" -eq "$(jq '.icons | length' "$FIX/icons.json")" ]
+}
+check "the jq path splitter closes every fixture icon as shipped into the fixture's contours (same signatures)" t_path_contours_jq
+
 t_shape_job() {
   from=$(shape_d mdi/circle-double icons) to=$(shape_d mdi/target icons)
   "$bin/km-job" -q -i 0.05 -n 7 -p -t $ICON_TOL "$from" "$to" >"$work/job.lines" 2>"$work/job.err" || { cat "$work/job.err"; return 1; }

@@ -392,3 +392,17 @@ test("i -> l between frames: the vanishing dot follows the service's frames into
     assert.ok(h < 0.02, `t = ${f.t}: ${h}`);
   }
 });
+
+test("pathContours of every fixture glyph and icon (and each icon as shipped) gives the same signatures as its closed d", async () => {
+  let n = 0;
+  for (const x of byId.values()) {
+    const want = await km.signature(curve(x.d));
+    for (const d of x.d_source ? [x.d, x.d_source] : [x.d]) {
+      const parts = pathContours(d);
+      assert.equal(parts.length, want.signatures ? want.signatures.length : 1, x.id);
+      assert.deepEqual(await km.signature(curve(parts.join(" "))), want, x.id);
+      n++;
+    }
+  }
+  assert.equal(n, byId.size + [...byId.values()].filter((x) => x.d_source).length);
+});

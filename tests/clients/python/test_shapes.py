@@ -255,6 +255,14 @@ class ShapeTest(unittest.TestCase):
         b = self.km.morph(morph_request(icon["d"], to, frames=3, tolerance=TOL["icon"]))
         self.assertEqual(a, b)
 
+    def test_path_contours_of_every_fixture_give_the_signatures_of_its_closed_d(self):
+        for x in SHAPES.values():
+            want = self.km.signature(curve(x["d"]))
+            for d in [x["d"]] + ([x["d_source"]] if "d_source" in x else []):
+                parts = path_contours(d)
+                self.assertEqual(len(parts), len(want["signatures"]) if "signatures" in want else 1, x["id"])
+                self.assertEqual(self.km.signature(curve(" ".join(parts))), want, x["id"])
+
     def test_path_contours_keep_relative_subpaths_where_they_were(self):
         # The second square is placed by a relative moveto from the open
         # first one's last point (10, 30): corners (15, 35) and (25, 45).
