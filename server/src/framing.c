@@ -391,3 +391,7 @@ size_t srv_framing_ending(const srv_framing *f, char *out, size_t cap) {
                    lead, f->detail);
   return n > 0 && (size_t)n < cap ? (size_t)n : 0;
 }
+
+bool srv_framing_idle(const srv_framing *f) {
+  return f->state == FR_REQUEST_LINE && f->status == 0;
+}

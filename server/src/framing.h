@@ -88,6 +88,9 @@ void srv_framing_init(srv_framing *f);
  * b->safe then ends before the refused request. */
 void srv_framing_scan(srv_framing *f, srv_framing_buf *b);
 
+/* True between requests: no part of one is held or being counted. */
+bool srv_framing_idle(const srv_framing *f);
+
 /* After a refusal inside a chunked body: the bytes that end that body
  * for the server (a last chunk if need be, SRV_FRAMING_REFUSED_FIELD with
  * the detail, the empty line), written to out; returns their length, or

@@ -58,6 +58,9 @@ typedef struct conn {
   size_t out_len, out_sent;
   bool client_eof;   /* the client's FIN was read */
   bool pair_shut;    /* the pair was told end of input */
+  bool client_ready; /* the client may have bytes to read (an event
+                      * came and no short read since) */
+  bool pair_ready;   /* the same for the pair */
   bool pair_refuses; /* a write to the pair failed: the server closed;
                       * what it wrote before is still to be read */
   bool pair_hup;     /* the server closed its end while out was full */
@@ -212,16 +215,18 @@ static void queue_refusal(relay *r, conn *c) {
   gmtime_r(&now, &tm);
   strftime(date, sizeof date, "%a, %d %b %Y %H:%M:%S GMT", &tm);
   strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  int n = snprintf(c->out, OUT_CAP,
-                   "HTTP/1.1 %d %s\r\n"
-                   "Date: %s\r\n"
-                   "Content-Type: application/problem+json\r\n"
-                   "Connection: close\r\n"
-                   "Cache-Control: no-store\r\n"
-                   "X-Request-Id: %s\r\n"
-                   "Content-Length: %d\r\n"
-                   "\r\n%s",
-                   fr->status, reason, date, rid, bn, body);
+  if (c->out == NULL) c->out = malloc(OUT_CAP);
+  int n = c->out == NULL ? -1
+                         : snprintf(c->out, OUT_CAP,
+                                    "HTTP/1.1 %d %s\r\n"
+                                    "Date: %s\r\n"
+                                    "Content-Type: application/problem+json\r\n"
+                                    "Connection: close\r\n"
+                                    "Cache-Control: no-store\r\n"
+                                    "X-Request-Id: %s\r\n"
+                                    "Content-Length: %d\r\n"
+                                    "\r\n%s",
+                                    fr->status, reason, date, rid, bn, body);
   c->out_len = n > 0 && n < OUT_CAP ? (size_t)n : 0;
   c->out_sent = 0;
   c->answered = true;
@@ -255,9 +260,15 @@ static bool client_in(relay *r, conn *c, bool *moved) {
     c->in.safe -= c->sent;
     c->sent = 0;
   }
-  if (c->in.len == IN_CAP) return true;
-  ssize_t n =
-      recv(c->client, c->in.data + c->in.len, IN_CAP - c->in.len, MSG_DONTWAIT);
+  if (c->in.len == IN_CAP || !c->client_ready) return true;
+  if (c->in.data == NULL && (c->in.data = malloc(IN_CAP)) == NULL) {
+    conn_free(r, c);
+    return false;
+  }
+  size_t want = IN_CAP - c->in.len;
+  ssize_t n = recv(c->client, c->in.data + c->in.len, want, MSG_DONTWAIT);
+  /* A short read took all there was: the next waits for an event. */
+  if (n < 0 || (size_t)n < want) c->client_ready = false;
   if (n > 0) {
     c->in.len += (size_t)n;
     srv_framing_scan(&c->fr, &c->in);
@@ -317,13 +328,19 @@ static void pair_out(relay *r, conn *c, bool *moved) {
   }
 }
 
-/* The server to the front; its end of file closes the pair. */
-static void pair_in(relay *r, conn *c, bool *moved) {
-  if (c->pair < 0) return;
+/* The server to the front; its end of file closes the pair. Returns
+ * false if the connection is gone. */
+static bool pair_in(relay *r, conn *c, bool *moved) {
+  if (c->pair < 0) return true;
   if (c->out_sent == c->out_len) c->out_len = c->out_sent = 0;
-  if (c->out_len == OUT_CAP) return;
-  ssize_t n =
-      recv(c->pair, c->out + c->out_len, OUT_CAP - c->out_len, MSG_DONTWAIT);
+  if (c->out_len == OUT_CAP || !c->pair_ready) return true;
+  if (c->out == NULL && (c->out = malloc(OUT_CAP)) == NULL) {
+    conn_free(r, c);
+    return false;
+  }
+  size_t want = OUT_CAP - c->out_len;
+  ssize_t n = recv(c->pair, c->out + c->out_len, want, MSG_DONTWAIT);
+  if (n < 0 || (size_t)n < want) c->pair_ready = false;
   if (n > 0) {
     c->out_len += (size_t)n;
     *moved = true;
@@ -331,6 +348,7 @@ static void pair_in(relay *r, conn *c, bool *moved) {
     close_pair(r, c);
     *moved = true;
   }
+  return true;
 }
 
 /* The front to the client: returns false if the connection is gone. */
@@ -371,21 +389,43 @@ static bool finish(relay *r, conn *c) {
   return true;
 }
 
+/* Buffers are held only while bytes pass: an idle kept-alive connection
+ * (thousands may be open) holds none. */
+static void release_idle_buffers(conn *c) {
+  if (c->in.data != NULL && c->sent == c->in.len && srv_framing_idle(&c->fr)) {
+    free(c->in.data);
+    c->in.data = NULL;
+    c->in.len = c->in.pos = c->in.safe = c->sent = 0;
+  }
+  if (c->out != NULL && c->out_sent == c->out_len && c->in.data == NULL) {
+    free(c->out);
+    c->out = NULL;
+    c->out_len = c->out_sent = 0;
+  }
+}
+
 /* Move bytes until nothing moves, then wait for what is missing. */
 static void pump(relay *r, conn *c) {
   for (int round = 0; round < 8; round++) {
     bool moved = false;
     if (!client_in(r, c, &moved)) return;
     pair_out(r, c, &moved);
-    pair_in(r, c, &moved);
+    if (!pair_in(r, c, &moved)) return;
     if (!client_out(r, c, &moved)) return;
     if (!finish(r, c)) return;
     if (!moved) break;
   }
+  release_idle_buffers(c);
   arm(r, c);
 }
 
 static void on_conn_event(relay *r, conn *c, bool pair_end, uint32_t ev) {
+  if (ev & (EPOLLIN | EPOLLHUP | EPOLLERR)) {
+    if (pair_end)
+      c->pair_ready = true;
+    else
+      c->client_ready = true;
+  }
   if (!pair_end && (ev & (EPOLLERR | EPOLLHUP))) {
     /* A reset, or both directions shut: nothing more can be delivered. */
     conn_free(r, c);
@@ -436,11 +476,7 @@ static void adopt(relay *r, int fd, const struct sockaddr_storage *ss,
     return;
   }
   conn *c = calloc(1, sizeof *c);
-  char *in = c ? malloc(IN_CAP) : NULL;
-  char *out = in ? malloc(OUT_CAP) : NULL;
-  if (out == NULL) {
-    free(in);
-    free(c);
+  if (c == NULL) {
     close(fd);
     close(sv[0]);
     close(sv[1]);
@@ -450,8 +486,6 @@ static void adopt(relay *r, int fd, const struct sockaddr_storage *ss,
   setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
   c->client = fd;
   c->pair = sv[0];
-  c->in.data = in;
-  c->out = out;
   srv_framing_init(&c->fr);
   peer_text(ss, c->peer, sizeof c->peer);
   c->next = r->first;
