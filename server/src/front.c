@@ -252,7 +252,7 @@ static bool client_in(relay *r, conn *c, bool *moved) {
   }
   if (c->client_eof || c->fr.status != 0 || c->pair < 0 || c->pair_refuses)
     return true;
-  if (c->sent == c->in.len || (c->in.len == IN_CAP && c->sent > 0)) {
+  if (c->sent > 0 && (c->sent == c->in.len || c->in.len == IN_CAP)) {
     /* Move what is not yet written down to the buffer's start. */
     memmove(c->in.data, c->in.data + c->sent, c->in.len - c->sent);
     c->in.len -= c->sent;
