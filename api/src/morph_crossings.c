@@ -59,35 +59,34 @@ cJSON *api__intersections_json(api_ctx *ctx, const api_morph_plan *pl) {
   if (!pl->shapes && pl->morph) km_morph_avoided(pl->morph, &a);
   double tol = count_tolerance(pl);
   cJSON *o = cJSON_CreateObject(), *frames = cJSON_CreateArray();
-  if (o == NULL || frames == NULL) goto oom;
+  if (o == NULL || frames == NULL) {
+    cJSON_Delete(o);
+    cJSON_Delete(frames);
+    api__oom(ctx);
+    return NULL;
+  }
   size_t crossing = 0;
-  for (size_t i = 0; i < pl->nframes; i++)
+  bool ok = api__add_item(ctx, o, "crossing_frames", frames);
+  for (size_t i = 0; ok && i < pl->nframes; i++)
     if (frame_crossings(pl, &pl->frames[i], tol) > 0) {
-      cJSON *n = cJSON_CreateNumber((double)i);
-      if (n == NULL) goto oom;
+      cJSON *n = api__number((double)i);
+      if (n == NULL) {
+        ok = api__oom(ctx);
+        break;
+      }
       cJSON_AddItemToArray(frames, n);
       crossing++;
     }
   const char *why = crossing_reason(&a, !pl->shapes, crossing);
-  cJSON *reason = why ? cJSON_CreateString(why) : cJSON_CreateNull();
-  if (reason == NULL) goto oom;
-  cJSON_AddItemToObject(o, "crossing_frames", frames);
-  frames = NULL;
-  cJSON_AddItemToObject(o, "reason", reason);
-  cJSON *changed = cJSON_CreateBool(a.changed);
-  if (!api__add_item(ctx, o, "changed", changed) ||
-      !api__add_num(ctx, o, "previews", (double)a.previews) ||
-      !api__add_num(ctx, o, "preview_crossings_before",
-                    (double)a.crossings_before) ||
-      !api__add_num(ctx, o, "preview_crossings_after",
-                    (double)a.crossings_after)) {
-    cJSON_Delete(o);
-    return NULL;
-  }
-  return o;
-oom:
+  ok = ok && api__add_item(ctx, o, "reason",
+                           why ? cJSON_CreateString(why) : cJSON_CreateNull());
+  ok = ok && api__add_item(ctx, o, "changed", cJSON_CreateBool(a.changed)) &&
+       api__add_num(ctx, o, "previews", (double)a.previews) &&
+       api__add_num(ctx, o, "preview_crossings_before",
+                    (double)a.crossings_before) &&
+       api__add_num(ctx, o, "preview_crossings_after",
+                    (double)a.crossings_after);
+  if (ok) return o;
   cJSON_Delete(o);
-  cJSON_Delete(frames);
-  api__oom(ctx);
   return NULL;
 }
