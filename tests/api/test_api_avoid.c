@@ -379,7 +379,30 @@ static void a_crossing_input_is_the_reason(void **state) {
   cJSON_Delete(j);
 }
 
+/* Without the member a morph avoids: the 2 -> 5 of DejaVu Sans, which
+ * crosses under "allow", answers without a crossing frame and says so. */
+static void avoid_is_the_default(void **state) {
+  (void)state;
+  cJSON *root = fixture();
+  at_buf b = {0};
+  at_printf(&b,
+            "{\"from\":{\"type\":\"svg\",\"d\":\"%s\"},"
+            "\"to\":{\"type\":\"svg\",\"d\":\"%s\"},\"frames\":%d}",
+            glyph_d(root, "dejavu-sans/2"), glyph_d(root, "dejavu-sans/5"),
+            FRAMES);
+  cJSON *j = at_expect_json(MORPH, b.s);
+  free(b.s);
+  bool x[FRAMES];
+  assert_int_equal(crossing_frames(j, x), 0);
+  const cJSON *rep = member(j, "intersections");
+  assert_true(cJSON_IsTrue(member(rep, "changed")));
+  assert_int_equal(cJSON_GetArraySize(member(rep, "crossing_frames")), 0);
+  cJSON_Delete(j);
+  cJSON_Delete(root);
+}
+
 static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(avoid_is_the_default),
     cmocka_unit_test(avoid_removes_most_crossing_frames),
     cmocka_unit_test(frames_that_did_not_cross_are_kept),
     cmocka_unit_test(avoided_sequences_do_not_jump),
