@@ -7,6 +7,7 @@ import { CURVES, PAIRS } from "./examples.js";
 import { splitSubpaths, slotColour, isShapeResult, framePath, frameMetrics, frameIsBad, resultBounds,
          slotPoints } from "./shapes.js";
 import { curvaturePlot } from "./plot.js";
+import { parseEasing, ease, easeInverse, cssKeyframes, svgAnimate, dList, EASINGS } from "./motion.js";
 
 const km = new Client();
 const $ = (sel, root = document) => root.querySelector(sel);
@@ -524,6 +525,13 @@ function setBusy(busy) {
 }
 
 async function runMorph() {
+  try { await morphOnce(); } finally {
+    /* finished morphs, counted for whoever waits for the page */
+    document.body.dataset.morphs = String(Number(document.body.dataset.morphs || 0) + 1);
+  }
+}
+
+async function morphOnce() {
   clearErrors();
   for (const which of ["from", "to"]) {
     try { state.input[which] = parseCurve($("#curve-" + which).value); } catch (e) {
@@ -587,6 +595,7 @@ async function runMorph() {
   $("#status").textContent = `${ok.map((o) => `${o.method}: ${o.result.frames.length} frames`).join(", ")} in ${ms} ms` +
                              (asJob ? " (jobs)" : "");
   showResults(ok);
+  saveUrl();
 }
 
 // ---------------------------------------------------------------- results
@@ -712,7 +721,11 @@ function buildPanel(o, viewBox) {
       f.contours.forEach((c, k) => c && svgEl("path", { d: curveToPath(c), class: "slot", "data-slot": k,
                                                         style: `stroke: ${slotColour(k)}` }, svg));
     if (frameIsBad(m)) svg.classList.add("bad");
+    svg.setAttribute("tabindex", "0");
+    svg.setAttribute("role", "button");
+    svg.setAttribute("aria-label", `frame ${i}, t = ${fmt(f.t)}`);
     svg.addEventListener("click", () => { stop(); setT(f.t); });
+    svg.addEventListener("keydown", (e) => { if (e.key === "Enter") { stop(); setT(f.t); } });
     thumbs.set(i, svg);
   }
   /* Metrics of every frame; frames drawn wrong stand out. */
@@ -833,7 +846,13 @@ function setT(t) {
       if (p.rows[p.current]) p.rows[p.current].classList.remove("current");
       if (p.thumbs.get(p.current)) p.thumbs.get(p.current).classList.remove("current");
       if (p.rows[at.frame]) p.rows[at.frame].classList.add("current");
-      if (p.thumbs.get(at.frame)) p.thumbs.get(at.frame).classList.add("current");
+      const thumb = p.thumbs.get(at.frame);
+      if (thumb) {
+        thumb.classList.add("current");
+        /* the filmstrip follows the current frame */
+        const strip = thumb.parentElement, a = strip.getBoundingClientRect(), b = thumb.getBoundingClientRect();
+        if (b.left < a.left || b.right > a.right) strip.scrollLeft += b.left - a.left - (a.width - b.width) / 2;
+      }
       p.current = at.frame;
     }
     label = at.exact ? `frame ${at.frame} of ${p.result.frames.length - 1}`
@@ -873,22 +892,76 @@ function mixColour(t) {
 
 // --------------------------------------------------------------- playback
 
+/** The easing chosen on the page (linear when the text is not one). */
+function easing() {
+  const points = parseEasing($("#easing").value.trim());
+  $("#easing").parentElement.classList.toggle("has-error", !points);
+  return points || EASINGS.linear;
+}
+
+function duration() {
+  const v = Number($("#duration").value);
+  return v > 0 && v <= 600 ? v : 3;
+}
+
+/* Playback runs a phase through [0, 1] in the chosen duration; t is the
+ * eased phase. Once stops at the end; loop starts again; ping-pong runs
+ * back. */
 function play() {
   if (!state.panels.length) return;
+  const curve = easing();
   state.playing = true;
   $("#play").textContent = "Pause";
-  if (state.t >= 1) setT(0);
+  if (state.t >= 1 && $("#repeat").value !== "ping-pong") setT(0);
+  if (state.phase === undefined || Math.abs(ease(curve, state.phase) - state.t) > 1e-6) state.phase = easeInverse(curve, state.t);
+  if ($("#repeat").value !== "ping-pong" || !state.direction) state.direction = 1;
+  if (state.direction < 0 && state.phase <= 0) state.direction = 1;
+  if (state.direction > 0 && state.phase >= 1 && $("#repeat").value === "ping-pong") state.direction = -1;
   let last = performance.now();
   const step = (now) => {
     if (!state.playing) return;
-    const dt = (now - last) / 1000;
-    last = now;
-    const t = state.t + dt / 3;         /* a whole morph in 3 s */
-    setT(t >= 1 ? 1 : t);
-    if (t >= 1) { stop(); return; }
+    /* a frame's time stamp may precede the moment play was pressed */
+    const dt = Math.max(0, (now - last) / 1000);
+    last = Math.max(last, now);
+    let phase = state.phase + state.direction * dt / duration();
+    const repeat = $("#repeat").value;
+    if ((state.direction > 0 && phase >= 1) || (state.direction < 0 && phase <= 0)) {
+      if (repeat === "once") {
+        state.phase = Math.min(1, Math.max(0, phase));
+        setT(ease(curve, state.phase));
+        stop();
+        return;
+      }
+      if (repeat === "loop") phase = phase >= 1 ? phase - 1 : phase + 1;
+      else { state.direction = -state.direction; phase = phase >= 1 ? 2 - phase : -phase; }
+    }
+    state.phase = phase;
+    setT(ease(curve, phase));
     requestAnimationFrame(step);
   };
   requestAnimationFrame(step);
+}
+
+/** Go to the frame `by` frames before or after the current t. */
+function stepFrame(by) {
+  if (!state.panels.length) return;
+  stop();
+  const ts = state.panels[0].result.frames.map((f) => f.t);
+  let i;
+  if (by > 0) { i = ts.findIndex((t) => t > state.t + 1e-9); if (i < 0) i = ts.length - 1; }
+  else { i = ts.length - 1; while (i > 0 && ts[i] >= state.t - 1e-9) i--; }
+  setT(ts[i]);
+}
+
+function onKey(e) {
+  if (!state.panels.length || e.ctrlKey || e.metaKey || e.altKey) return;
+  const tag = (e.target.tagName || "").toLowerCase();
+  if (tag === "textarea" || (tag === "input" && !["range", "checkbox"].includes(e.target.type)) || tag === "select") return;
+  const keys = { " ": () => (state.playing ? stop() : play()), ArrowRight: () => stepFrame(1), ArrowLeft: () => stepFrame(-1),
+                 Home: () => { stop(); setT(0); }, End: () => { stop(); setT(1); } };
+  if (!keys[e.key]) return;
+  e.preventDefault();
+  keys[e.key]();
 }
 
 function stop() {
@@ -927,6 +1000,84 @@ async function downloadSvg() {
       showProblem(e, o.method);
     }
   }
+}
+
+// ----------------------------------------------------------------- export
+
+/* At most this many frames go into an export (evenly chosen). */
+const EXPORT_MAX = 61;
+
+function exportResult() {
+  const o = state.results.find((r) => r.method === "curvature") || state.results[0];
+  if (!o) return null;
+  const frames = o.result.frames, n = frames.length, count = Math.min(n, EXPORT_MAX);
+  const picks = [...new Set(Array.from({ length: count }, (_, i) => Math.round(i * (n - 1) / Math.max(1, count - 1))))];
+  return { ...o.result, frames: picks.map((i) => frames[i]) };
+}
+
+function showExport(kind) {
+  const result = exportResult();
+  if (!result) return;
+  const opts = { duration: duration(), easing: easing(), pingPong: $("#repeat").value === "ping-pong",
+                 fillRule: state.display.from ? state.display.from.fillRule : "nonzero" };
+  const once = $("#repeat").value === "once";
+  let text;
+  if (kind === "css") {
+    text = cssKeyframes(result, opts);
+    if (once) text = text.replace(" infinite", " 1 forwards");
+    text = "/* <svg viewBox=...><path class=\"kmorph\"/></svg> */\n" + text;
+  } else if (kind === "svg") {
+    text = svgAnimate(result, opts);
+    if (once) text = text.replace('repeatCount="indefinite"', 'repeatCount="1" fill="freeze"');
+  } else if (kind === "d") {
+    text = dList(result);
+  } else {
+    const req = state.results[0].request;
+    text = `import { Client, interpolator } from "./kmorph.js";\n` +
+           `const km = new Client({ baseUrl: ${JSON.stringify(location.origin)} });\n` +
+           `const result = await km.morph(${JSON.stringify({ ...req, method: result.method, metrics: false })});\n` +
+           `const at = interpolator(result);      // t in [0, 1] -> path d\n` +
+           `const [x1, y1, x2, y2] = ${JSON.stringify(opts.easing)}, ms = ${opts.duration * 1000};\n` +
+           `// ease(p) solves the cubic-bezier (x1, y1, x2, y2) for p; at(ease(p)) each frame:\n` +
+           `// requestAnimationFrame((now) => path.setAttribute("d", at(ease(((now - start) % ms) / ms))));\n`;
+  }
+  $("#export-text").value = text;
+  $("#export-text").dataset.kind = kind;
+  $("#export-status").textContent = `${kind === "d" ? "d list" : kind.toUpperCase()}: ${result.frames.length} frames, ${Math.round(text.length / 1024)} KiB`;
+}
+
+async function copyText(text, what) {
+  try {
+    await navigator.clipboard.writeText(text);
+    $("#export-status").textContent = `${what} copied`;
+  } catch {
+    $("#export-text").select();
+    $("#export-status").textContent = `${what}: select and copy it from the box (the browser did not allow copying)`;
+  }
+}
+
+/* The state kept in the URL's fragment: both curves' text and the options. */
+const URL_FIELDS = ["method", "frames", "matches-mode", "closure", "anchor", "blend", "tolerance", "repeat", "duration", "easing"];
+
+function saveUrl() {
+  const st = { from: $("#curve-from").value, to: $("#curve-to").value };
+  for (const id of URL_FIELDS) st[id] = $("#" + id).value;
+  history.replaceState(null, "", "#" + encodeURIComponent(JSON.stringify(st)));
+}
+
+/** Fill the page from the URL's fragment; false when it holds none. */
+function loadUrl() {
+  if (location.hash.length < 2) return false;
+  let st;
+  try { st = JSON.parse(decodeURIComponent(location.hash.slice(1))); } catch { return false; }
+  if (!st || typeof st.from !== "string" || typeof st.to !== "string") return false;
+  for (const id of URL_FIELDS) if (typeof st[id] === "string") $("#" + id).value = st[id];
+  for (const which of ["from", "to"]) {
+    $("#curve-" + which).value = st[which];
+    $(`select.pick[data-testid=pick-${which}]`).value = "";
+    updateCurve(which);
+  }
+  return true;
 }
 
 // ------------------------------------------------------------------ setup
@@ -1003,7 +1154,14 @@ function init() {
   $("#play").addEventListener("click", () => (state.playing ? stop() : play()));
   $("#download-json").addEventListener("click", downloadJson);
   $("#download-svg").addEventListener("click", downloadSvg);
-  chooseExample(PAIRS[0][0]);
+  $("#step-back").addEventListener("click", () => stepFrame(-1));
+  $("#step-on").addEventListener("click", () => stepFrame(1));
+  document.addEventListener("keydown", onKey);
+  for (const [id, kind] of [["#export-css", "css"], ["#export-svg", "svg"], ["#export-js", "js"], ["#export-d", "d"]])
+    $(id).addEventListener("click", () => showExport(kind));
+  $("#export-copy").addEventListener("click", () => copyText($("#export-text").value, "export"));
+  $("#share").addEventListener("click", () => { saveUrl(); copyText(location.href, "link"); });
+  if (!loadUrl()) chooseExample(PAIRS[0][0]);
   document.body.dataset.ready = "1";
 }
 

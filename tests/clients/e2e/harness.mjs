@@ -74,9 +74,11 @@ export async function waitForEditor(page) {
 
 /** Click Morph and wait until `count` panels show and the page is idle. */
 export async function morphAndWait(page, count) {
+  const before = Number(await page.evaluate(() => document.body.dataset.morphs || 0));
   await page.click("#morph");
-  await page.waitForFunction((n) => document.querySelectorAll("#panels .panel").length === n &&
-                                    !document.querySelector("#morph").disabled, count, { timeout: 60000 });
+  await page.waitForFunction(([n, k]) => Number(document.body.dataset.morphs || 0) > k &&
+                                         document.querySelectorAll("#panels .panel").length === n &&
+                                         !document.querySelector("#morph").disabled, [count, before], { timeout: 60000 });
   await Promise.all(page.kmPending);
 }
 
