@@ -592,39 +592,79 @@ static km_status plan_all(plan *pl, const theta_pieces *tp, int degree,
   return KM_OK;
 }
 
-/* The output pieces within 0.9 tol; a cubic's neighbours merged where the
- * bound allows and their end speeds settled (pieces split where that
- * breaks the bound). Should settling not end within a few rounds, the
- * cubic is planned Hermite in arc length throughout, as it always can. */
-static km_status plan_pieces(plan *pl, const theta_pieces *tp, int degree,
-                             double tol, const km_signature *sig,
-                             km_error *err) {
+/* The output pieces within 0.9 tol, arc-length Hermite throughout: a
+ * cubic's neighbours merged across breaks of kappa where the bound allows
+ * (a signature breaks at every knot of its curve). */
+static km_status plan_arc_length(plan *pl, const theta_pieces *tp, int degree,
+                                 double tol, const km_signature *sig,
+                                 km_error *err) {
+  pl->n = 0;
+  pl->arc_length_only = true;
   km_status st = plan_all(pl, tp, degree, 0.9 * tol, sig, err);
   if (st || degree != 3) return st;
+  merge_cubic(pl, tp, 0.9 * tol);
+  bool over;
+  return settle_speeds(pl, tp, 0.9 * tol, &over) ? km__stopped(err) : KM_OK;
+}
+
+/* The output pieces with arc-shaped cubics where they bound closer, their
+ * neighbours merged where the bound allows and their end speeds settled
+ * (pieces split where that breaks the bound). Should settling not end
+ * within a few rounds, KM_ENOCONVERGE. */
+static km_status plan_shaped(plan *pl, const theta_pieces *tp, double tol,
+                             const km_signature *sig, km_error *err) {
+  km_status st = plan_all(pl, tp, 3, 0.9 * tol, sig, err);
+  if (st) return st;
   if (merge_shape(pl, tp, 0.9 * tol)) return km__stopped(err);
   merge_cubic(pl, tp, 0.9 * tol);
-  for (int round = 0;; round++) {
+  for (int round = 0; round < 12; round++) {
     bool over;
     if (settle_speeds(pl, tp, 0.9 * tol, &over)) return km__stopped(err);
     if (!over) return KM_OK;
-    if (round == 12) {
-      pl->n = 0;
-      pl->arc_length_only = true;
-      st = plan_all(pl, tp, degree, 0.9 * tol, sig, err);
-      if (st) return st;
-      merge_cubic(pl, tp, 0.9 * tol);
-      continue;
-    }
     st = split_over(pl, tp, 0.9 * tol);
     if (st == KM_ECANCELLED) return km__stopped(err);
     if (st)
       return km__fail(err, st, KM_FIELD_TOLERANCE, -1, NAN,
                       st == KM_ELIMIT ? "the curve needs more than %zu pieces "
-                                        "of degree %d at this tolerance: "
+                                        "of degree 3 at this tolerance: "
                                         "loosen the tolerance"
                                       : "out of memory",
-                      pl->limit, degree);
+                      pl->limit);
   }
+  return KM_ENOCONVERGE;
+}
+
+/* The fewer pieces of the two plans for cubics: arc-shaped pieces cannot
+ * span breaks of kappa, so where a curve's breaks are dense (a frame's
+ * signature, a spline's) the merged arc-length plan may be the smaller. */
+static km_status plan_pieces(plan *pl, const theta_pieces *tp, int degree,
+                             double tol, const km_signature *sig,
+                             km_error *err) {
+  if (degree != 3) return plan_arc_length(pl, tp, degree, tol, sig, err);
+  plan alt = {NULL, 0, 0, pl->limit, pl->poll, true};
+  km_error alt_err;
+  km_status st = plan_shaped(pl, tp, tol, sig, err);
+  if (st == KM_ECANCELLED || st == KM_ENOMEM) {
+    km__free(alt.p);
+    return st;
+  }
+  km_status sa = plan_arc_length(&alt, tp, degree, tol, sig, &alt_err);
+  if (sa == KM_ECANCELLED || sa == KM_ENOMEM) {
+    km__free(alt.p);
+    if (err) *err = alt_err;
+    return sa;
+  }
+  if (sa == KM_OK && (st != KM_OK || alt.n < pl->n)) {
+    km__free(pl->p);
+    *pl = alt;
+    return KM_OK;
+  }
+  km__free(alt.p);
+  if (st == KM_ENOCONVERGE) {
+    if (err) *err = alt_err;
+    return sa;
+  }
+  return st;
 }
 
 /* pos[2 j], pos[2 j + 1]: the position at the start of output piece j
