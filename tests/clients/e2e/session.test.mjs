@@ -150,6 +150,22 @@ test("the URL holds the curves and options: a shared link opens the same morph",
   await page.close();
 });
 
+test("the numbers say their units and meaning", async () => {
+  const { page, errors } = await openPage(env);
+  await page.selectOption("#example", "circle-star");
+  await waitForEditor(page);
+  await page.fill("#frames", "3");
+  await morphAndWait(page, 2);
+  const title = (sel) => page.$eval(`#panel-curvature ${sel}`, (b) => b.parentElement.title);
+  assert.match(await title(".m-kappa"), /1 \/ units/);
+  assert.match(await title(".m-energy"), /∫ κ² ds/);
+  assert.match(await title(".m-gap"), /before the closure/);
+  assert.match(await page.textContent("#panel-curvature .m-gap", { timeout: 1000 }).then(() =>
+    page.$eval("#panel-curvature .m-gap", (b) => b.parentElement.textContent)), /before closing/);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
 test("dark mode follows prefers-color-scheme", async () => {
   const { page, errors } = await openPage(env);
   const luminance = () => page.$eval("body", (b) => {
