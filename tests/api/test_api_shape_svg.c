@@ -202,6 +202,39 @@ static double drawing_size(const path *p) {
   return hypot(hi[0] - lo[0], hi[1] - lo[1]);
 }
 
+/* Twice the signed area of the closed polyline q of n points. */
+static double area2(const double *q, size_t n) {
+  double a = 0;
+  for (size_t i = 0; i < n; i++) {
+    const double *u = q + 2 * i, *v = q + 2 * ((i + 1) % n);
+    a += u[0] * v[1] - v[0] * u[1];
+  }
+  return a;
+}
+
+/* The innermost other subpath of p that holds every point of subpath k's
+ * polyline (its parent in the nesting), or -1 for none. */
+static int parent_subpath(const path *p, size_t k) {
+  size_t nk, nh;
+  double *qk = subpath_polyline(p, k, &nk), best = INFINITY;
+  int parent = -1;
+  for (size_t h = 0; h < p->nsub; h++) {
+    if (h == k) continue;
+    double *qh = subpath_polyline(p, h, &nh);
+    bool all = nh > 2;
+    for (size_t i = 0; all && i < nk; i++)
+      all = winding(qh, nh, qk + 2 * i) != 0;
+    double a = fabs(area2(qh, nh));
+    if (all && a < best) {
+      best = a;
+      parent = (int)h;
+    }
+    free(qh);
+  }
+  free(qk);
+  return parent;
+}
+
 /* ---- animate_d ---- */
 
 static const cJSON *member(const cJSON *o, const char *key) {
@@ -267,9 +300,10 @@ static void animate_d_keeps_one_structure(void **state) {
 }
 
 /* At the end where a contour is absent its subpath is one point, inside
- * the contour it collapses into (O -> C: the C; i -> l: the l; the icon:
- * one of the rings left), and the live frames next to that end close in
- * on that point. */
+ * its parent's partner (O -> C: the C; the icons: the ring or the die
+ * that held it at the other end) or, for a top-level contour, inside a
+ * paired one (i -> l: the l), and the live frames next to that end close
+ * in on that point. */
 static void collapsed_contour_is_a_point_inside_its_host(void **state) {
   (void)state;
   const int nframes = 21;
@@ -293,7 +327,23 @@ static void collapsed_contour_is_a_point_inside_its_host(void **state) {
       double size = drawing_size(&pe);
       /* one point: every number of the subpath the same */
       assert_true(spread_about(&pe, (size_t)slot, x) <= 1e-9 * size);
-      /* inside a contour of a paired slot of that frame */
+      /* inside its parent's partner: the slot whose contour holds it at
+       * the end where it is live (found here on that end's value) */
+      path pl;
+      path_parse(cJSON_GetArrayItem(ad, nframes - 1 - end)->valuestring, &pl);
+      int parent = parent_subpath(&pl, (size_t)slot);
+      path_free(&pl);
+      if (parent >= 0) {
+        size_t n;
+        double *q = subpath_polyline(&pe, (size_t)parent, &n);
+        if (winding(q, n, x) == 0)
+          print_error("%s -> %s: slot %d collapses to (%g, %g), outside its "
+                      "parent's slot %d\n",
+                      CASES[c].from, CASES[c].to, slot, x[0], x[1], parent);
+        assert_int_not_equal(winding(q, n, x), 0);
+        free(q);
+      }
+      /* a top-level one inside a contour of a paired slot of that frame */
       bool inside = false;
       for (size_t k = 0; k < pe.nsub; k++) {
         const cJSON *pr = cJSON_GetArrayItem(used, (int)k);
