@@ -590,7 +590,8 @@ function slotTracks(frames, samples) {
  * where its length is zero. `perContour: true` returns, instead of one
  * string, an array of one string per slot (null where omitted). Option
  * `exact: true` returns the frame's own path when t is a frame's t. */
-export function interpolator(result, { samples = 200, exact = false, collapsed = "point", perContour = false } = {}) {
+export function interpolator(result, { samples = 200, exact = false, collapsed = "point", perContour = false,
+                                        string = true } = {}) {
   const frames = result.frames;
   if (!frames.length) throw new RangeError("the morph result has no frames");
   if (collapsed !== "point" && collapsed !== "omit") throw new RangeError('collapsed is "point" or "omit"');
@@ -598,14 +599,19 @@ export function interpolator(result, { samples = 200, exact = false, collapsed =
   const tracks = slotTracks(frames, samples);
   const paths = exact ? frames.map((f) => (perContour ? frameContourPaths(f) : framePath(f))) : null;
   const degenerate = (c) => Array.from({ length: samples }, () => c);
-  const join = (list) => (perContour ? list : list.filter((d) => d !== null).join(""));
+  const compound = isCompound(result);
+  /* string: false gives the blended points: one [[x, y]...] array for a
+   * single curve, one per slot (null where omitted) for a shape. */
+  const join = string
+    ? (list) => (perContour ? list : list.filter((d) => d !== null).join(""))
+    : (list) => (compound || perContour ? list : list[0]);
   return (t) => {
     t = Math.min(Math.max(+t, ts[0]), ts[ts.length - 1]);
     let i = 0;
     while (i < ts.length - 2 && t > ts[i + 1]) i++;
     const j = frames.length === 1 ? i : i + 1;
     const span = ts[j] - ts[i], f = span > 0 ? (t - ts[i]) / span : 0;
-    if (exact) {
+    if (exact && string) {
       if (Math.abs(t - ts[i]) < 1e-12) return paths[i];
       if (Math.abs(t - ts[j]) < 1e-12) return paths[j];
     }
@@ -616,9 +622,42 @@ export function interpolator(result, { samples = 200, exact = false, collapsed =
       }
       const pa = a || degenerate(points[i]), pb = b || degenerate(points[j]);
       const mixed = pa.map((q, n) => [q[0] + f * (pb[n][0] - q[0]), q[1] + f * (pb[n][1] - q[1])]);
-      return pointsToPath(mixed, f < 0.5 ? closed[i] : closed[j]);
+      return string ? pointsToPath(mixed, f < 0.5 ? closed[i] : closed[j]) : mixed;
     }));
   };
+}
+
+/** Options of interpolate() that shape the interpolator, not the request. */
+const INTERPOLATOR_OPTIONS = ["samples", "exact", "collapsed", "perContour", "string"];
+
+/** The flubber-style entry point: one morph of `from` into `to` (anything
+ * curve() takes) computed once on the service, then a function t -> d for
+ * any t in [0, 1] (see interpolator). Options: client (a Client; default
+ * one on $KMORPH_URL or the page's origin), signal, the interpolator's
+ * samples, exact, collapsed, perContour and string (false: point arrays
+ * instead of path data), and anything else as morph request fields
+ * (frames, method, contourMatches...; frames defaults to 11). */
+export async function interpolate(from, to, options = {}) {
+  const { client, signal, ...rest } = options;
+  const shaping = {}, fields = {};
+  for (const [key, value] of Object.entries(rest))
+    (INTERPOLATOR_OPTIONS.includes(key) ? shaping : fields)[key] = value;
+  if (fields.frames === undefined && fields.times === undefined) fields.frames = 11;
+  const result = await (client || dc()).morph(morphRequest(from, to, fields), { signal });
+  return interpolator(result, shaping);
+}
+
+/** interpolate() for lists of pairs froms[i] -> tos[i] (equal lengths),
+ * the morphs made one after another: an array of interpolators, or with
+ * `single: true` one function t -> the paths of all pairs joined. */
+export async function interpolateAll(froms, tos, options = {}) {
+  if (!Array.isArray(froms) || !Array.isArray(tos) || froms.length !== tos.length || froms.length === 0)
+    throw new TypeError("interpolateAll needs two non-empty arrays of equal length");
+  const { single = false, ...rest } = options;
+  const each = [];
+  for (let i = 0; i < froms.length; i++) each.push(await interpolate(froms[i], tos[i], rest));
+  if (!single) return each;
+  return (t) => (rest.string === false ? each.map((at) => at(t)) : each.map((at) => at(t)).join(""));
 }
 
 /** Bounding box [minX, minY, maxX, maxY] of the frames' control polygons

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # run.sh - the client suites against live kmorphd daemons (each suite
 # starts its own on a free loopback port): the curl scripts, the JS module
-# (node --test), the Python module (unittest) and, when Chromium and
+# (node --test, its npm package packed and installed), the Python module (unittest) and, when Chromium and
 # playwright-core are there, the web page end to end. Appends
 # "tests/clients/<suite> <passed> <failed>" lines to the results file that
 # tests/summarise.sh totals.
