@@ -58,7 +58,7 @@ UNIT_BIN  := $(UNIT_SRC:%.c=$(BUILD)/%)
 APIT_BIN  := $(APIT_SRC:%.c=$(BUILD)/%)
 SUPPORT_SRC := $(wildcard tests/support/*.c)
 
-.PHONY: all deps check-deps check build run test test-unit test-asan test-server test-clients check-layers format-check \
+.PHONY: all deps check-deps check build run test test-compound test-unit test-asan test-server test-clients check-layers format-check \
         bench bench-http fuzz fuzz-svg clean format examples \
         test-fuzz test-hardening bench-load bench-hostile
 
@@ -207,6 +207,13 @@ test: deps
 	@echo "== hardening: bad-input barrage, daemon under ASan, leaks, load, faults"
 	@$(MAKE) --no-print-directory test-hardening || true
 	@tests/summarise.sh
+
+# Compound morphs of every fixture pair at all 41 frames (make test: 21),
+# with the per-pair figures in build/compound-morphs.txt.
+test-compound: build
+	@cd tests/fixtures/compound && KMORPH=$(CURDIR)/$(CLI) \
+	  KM_COMPOUND_REPORT=$(CURDIR)/build/compound-morphs.txt \
+	  /usr/bin/python3 -m unittest -v test_compound_morphs
 
 # The daemon over real HTTP (loopback, ephemeral ports); appends its counts
 # to build/test-results.txt like the other suites.

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # checks.sh - the tree's own checks beside the test suites: every C file
 # laid out as .clang-format says (clang-format 14, Debian 12's), and the
-# compound-shape fixtures consistent with what they claim to be. Appends
+# compound-shape fixtures consistent with what they claim to be, and the
+# compound morphs of every fixture pair checked against them. Appends
 # "checks/<name> <passed> <failed>" to the results file summarise.sh
 # totals.
 set -u
@@ -27,14 +28,24 @@ else
   status=1
 fi
 
-# 2. The compound-shape fixtures (tests/fixtures/compound).
-out=$(cd tests/fixtures/compound && "$PY" -m unittest test_fixtures 2>&1)
-rc=$?
-ran=$(printf '%s\n' "$out" | sed -n 's/^Ran \([0-9]*\) test.*/\1/p' | tail -n 1)
-bad=$(printf '%s\n' "$out" | grep -cE '^(FAIL|ERROR): ')
-ran=${ran:-0}
-[ "$rc" -ne 0 ] && [ "$bad" -eq 0 ] && bad=1
-printf '%s\n' "$out" | grep -E '^(FAIL|ERROR):|^Ran|^OK|^FAILED'
-echo "checks/compound-fixtures $((ran - bad)) $bad" >>"$results"
-[ "$bad" -eq 0 ] || status=1
+# 2. The compound-shape fixtures (tests/fixtures/compound), and 3. the
+# compound morphs of every fixture pair (needs build/kmorph; 21 frames
+# here, all 41 in make test-compound).
+unittest_module() { # name module [VAR=value ...]
+  local name=$1 module=$2
+  shift 2
+  out=$(cd tests/fixtures/compound && env "$@" "$PY" -m unittest "$module" 2>&1)
+  rc=$?
+  ran=$(printf '%s\n' "$out" | sed -n 's/^Ran \([0-9]*\) test.*/\1/p' | tail -n 1)
+  bad=$(printf '%s\n' "$out" | sed -n 's/^\(FAIL\|ERROR\): \([a-z_0-9]*\).*/\2/p' | sort -u | wc -l)
+  ran=${ran:-0}
+  [ "$rc" -ne 0 ] && [ "$bad" -eq 0 ] && bad=1
+  printf '%s\n' "$out" | grep -E '^(FAIL|ERROR):|^Ran|^OK|^FAILED|^  all pairs'
+  echo "checks/$name $((ran - bad)) $bad" >>"$results"
+  [ "$bad" -eq 0 ] || status=1
+}
+unittest_module compound-fixtures test_fixtures
+unittest_module compound-morphs test_compound_morphs \
+  KMORPH="$PWD/build/kmorph" KM_COMPOUND_FRAMES="${KM_COMPOUND_FRAMES:-21}" \
+  KM_COMPOUND_REPORT="$PWD/build/compound-morphs.txt"
 exit $status

@@ -66,6 +66,65 @@ static km_status contour_at(const km_shape_morph *m, size_t k, double t,
   return KM_OK;
 }
 
+void km__ref_sample(const km_curve *c, double *out) {
+  double t0, t1;
+  km_curve_domain(c, &t0, &t1);
+  for (int i = 0; i < KM__REF_POINTS; i++) {
+    double d[1][2];
+    km_curve_eval(c, t0 + (t1 - t0) * i / KM__REF_POINTS, 0, d);
+    out[2 * i] = d[0][0];
+    out[2 * i + 1] = d[0][1];
+  }
+}
+
+/* The similarity x -> g + z (x - h) (z complex: rotation and scale) that
+ * maps the points X onto the points Y best in least squares, applied to
+ * c (in place). */
+static void similar_map(const double *X, const double *Y, double c[2]) {
+  double hx = 0, hy = 0, gx = 0, gy = 0;
+  for (int i = 0; i < KM__REF_POINTS; i++) {
+    hx += X[2 * i];
+    hy += X[2 * i + 1];
+    gx += Y[2 * i];
+    gy += Y[2 * i + 1];
+  }
+  hx /= KM__REF_POINTS;
+  hy /= KM__REF_POINTS;
+  gx /= KM__REF_POINTS;
+  gy /= KM__REF_POINTS;
+  double re = 0, im = 0, nn = 0;
+  for (int i = 0; i < KM__REF_POINTS; i++) {
+    double ax = X[2 * i] - hx, ay = X[2 * i + 1] - hy;
+    double bx = Y[2 * i] - gx, by = Y[2 * i + 1] - gy;
+    re += bx * ax + by * ay; /* (b) conj(a) */
+    im += by * ax - bx * ay;
+    nn += ax * ax + ay * ay;
+  }
+  double zr = nn > 0 ? re / nn : 1.0, zi = nn > 0 ? im / nn : 0.0;
+  double dx = c[0] - hx, dy = c[1] - hy;
+  c[0] = gx + zr * dx - zi * dy;
+  c[1] = gy + zi * dx + zr * dy;
+}
+
+bool km__follow_parent(const km_shape_morph *m, size_t k, long parent,
+                       const km_curve *parent_now, double t, double out[2]) {
+  long pf = m->parent_from[k], pt = m->parent_to[k];
+  if (parent < 0 || !m->has_ref[parent]) return false;
+  if (m->pairs[k].from >= 0 && pf != parent) return false;
+  if (m->pairs[k].to >= 0 && pt != parent) return false;
+  double now[2 * KM__REF_POINTS], c0[2], c1[2];
+  km__ref_sample(parent_now, now);
+  const double *an = m->anchor + 4 * k;
+  const double *r = m->ref + 4 * (size_t)parent * KM__REF_POINTS;
+  memcpy(c0, an, sizeof c0);
+  memcpy(c1, an + 2, sizeof c1);
+  similar_map(r, now, c0);
+  similar_map(r + 2 * KM__REF_POINTS, now, c1);
+  out[0] = (1 - t) * c0[0] + t * c1[0];
+  out[1] = (1 - t) * c0[1] + t * c1[1];
+  return true;
+}
+
 static bool all_inside(const double *P, size_t np, const double *Q, size_t nq,
                        const double d[2]) {
   for (size_t i = 0; i < np; i++) {
@@ -125,18 +184,127 @@ static int frame_depth(const km_shape_frame *f, size_t k) {
   return d;
 }
 
-/* Nesting adjustment parents first, then the metrics. */
-static km_status finish(km_shape_frame *f, double **fl, size_t *np,
-                        km__poll *poll) {
+static void translate(km_shape_frame *f, size_t k, double **fl, size_t *np,
+                      const double d[2]) {
+  const double zero[2] = {0, 0};
+  move_curve(&f->contours[k], zero, 1.0, d);
+  for (size_t i = 0; i < np[k]; i++) {
+    fl[k][2 * i] += d[0];
+    fl[k][2 * i + 1] += d[1];
+  }
+}
+
+/* Slot k follows its parent's motion (km__follow_parent) where it has one
+ * paired parent: the parts move as one shape, turning with it. */
+static void follow(const km_shape_morph *m, km_shape_frame *f, size_t k,
+                   double t, double **fl, size_t *np) {
+  double at[2], a, g[2];
+  long p = f->parent[k];
+  if (!km__follow_parent(m, k, p, &f->contours[p], t, at)) return;
+  km__curve_area(&f->contours[k], &a, g);
+  double d[2] = {at[0] - g[0], at[1] - g[1]};
+  translate(f, k, fl, np, d);
+}
+
+/* The schedule's scale of slot k at t as a fraction of its nominal size
+ * (1 when not scheduled). */
+static double scheduled_ratio(const km_shape_morph *m, size_t k, double t) {
+  double s = m->kind[k] == KM__VANISH ? 1.0 - t : t;
+  if (!m->scheduled || !(s > 0)) return 1.0;
+  const double *S = m->sched + (KM__SCHED + 1) * k;
+  double x = t * KM__SCHED;
+  int j = (int)floor(x);
+  if (j >= KM__SCHED) j = KM__SCHED - 1;
+  double u = x - j, v = (1 - u) * S[j] + u * S[j + 1];
+  return fmin(1.0, v / s);
+}
+
+static void scale_about(km_shape_frame *f, size_t k, double **fl, size_t *np,
+                        const double g[2], double r) {
+  const double zero[2] = {0, 0};
+  move_curve(&f->contours[k], g, r, zero);
+  for (size_t i = 0; i < np[k]; i++) {
+    fl[k][2 * i] = g[0] + r * (fl[k][2 * i] - g[0]);
+    fl[k][2 * i + 1] = g[1] + r * (fl[k][2 * i + 1] - g[1]);
+  }
+  km_frame_metrics *mt = &f->metrics[k];
+  mt->length *= r;
+  mt->closure_gap *= r;
+  if (r > 0) {
+    mt->max_abs_kappa /= r;
+    mt->bending_energy /= r;
+  }
+}
+
+/* An unpaired slot takes its scheduled size; where it does not fit in
+ * its parent its centroid moves to the nearest point inside the parent
+ * when it lies outside, and (only while the schedule is measured) it
+ * shrinks about that to the largest fraction (to 1/1024) that fits: it
+ * vanishes sooner rather than cross. *ratio: its size as a fraction of
+ * its nominal. */
+static km_status shrink_to_fit(const km_shape_morph *m, double t,
+                               km_shape_frame *f, size_t k, double **fl,
+                               size_t *np, double *ratio) {
+  size_t p = (size_t)f->parent[k];
+  const double zero[2] = {0, 0};
+  if (m->kind[k] == KM__PAIRED) return KM_OK;
+  double a, g[2], cap = scheduled_ratio(m, k, t);
+  km__curve_area(&f->contours[k], &a, g);
+  if (cap < 1.0) scale_about(f, k, fl, np, g, cap);
+  *ratio = cap;
+  if (all_inside(fl[k], np[k], fl[p], np[p], zero)) return KM_OK;
+  if (km__poly_winding(fl[p], np[p], g) == 0) {
+    /* its centre first to the nearest point well inside the parent */
+    double q[2];
+    km__poly_interior_point(fl[p], np[p], g, q);
+    if (km__poly_winding(fl[p], np[p], q) == 0) return KM_OK;
+    double d[2] = {q[0] - g[0], q[1] - g[1]};
+    translate(f, k, fl, np, d);
+    g[0] = q[0];
+    g[1] = q[1];
+  }
+  /* a scheduled size is kept even where it does not fit: shrinking more
+   * here and less at the next frame would make it grow */
+  if (m->scheduled) return KM_OK;
+  double lo = 0.0, hi = 1.0, *cur = fl[k];
+  double *buf = km__malloc(2 * np[k] * sizeof *buf);
+  if (!buf) return KM_ENOMEM;
+  for (int it = 0; it < 10; it++) {
+    double mid = 0.5 * (lo + hi);
+    for (size_t i = 0; i < np[k]; i++) {
+      buf[2 * i] = g[0] + mid * (cur[2 * i] - g[0]);
+      buf[2 * i + 1] = g[1] + mid * (cur[2 * i + 1] - g[1]);
+    }
+    if (all_inside(buf, np[k], fl[p], np[p], zero))
+      lo = mid;
+    else
+      hi = mid;
+  }
+  km__free(buf);
+  scale_about(f, k, fl, np, g, lo);
+  *ratio = cap * lo;
+  return KM_OK;
+}
+
+/* Placement and nesting adjustment parents first, then the metrics. */
+static km_status finish(const km_shape_morph *m, double t, km_shape_frame *f,
+                        double **fl, size_t *np, km__poll *poll,
+                        double *ratio) {
   int maxd = 0;
   for (size_t k = 0; k < f->ncontours; k++)
     if (frame_depth(f, k) > maxd) maxd = frame_depth(f, k);
   const double zero[2] = {0, 0};
   for (int d = 1; d <= maxd; d++)
-    for (size_t k = 0; k < f->ncontours; k++)
-      if (f->present[k] && f->parent[k] >= 0 && f->present[f->parent[k]] &&
-          frame_depth(f, k) == d && adjust(f, k, fl, np))
-        f->adjusted++;
+    for (size_t k = 0; k < f->ncontours; k++) {
+      if (!f->present[k] || f->parent[k] < 0 || !f->present[f->parent[k]] ||
+          frame_depth(f, k) != d)
+        continue;
+      follow(m, f, k, t, fl, np);
+      double r = 1.0;
+      if (shrink_to_fit(m, t, f, k, fl, np, &r) != KM_OK) return KM_ENOMEM;
+      if (ratio) ratio[k] = r;
+      if (adjust(f, k, fl, np)) f->adjusted++;
+    }
   f->nesting_ok = true;
   for (size_t k = 0; k < f->ncontours; k++)
     if (f->present[k] && f->parent[k] >= 0 && f->present[f->parent[k]] &&
@@ -163,9 +331,9 @@ static km_status frame_alloc(km_shape_frame *f, size_t n) {
                                                               : KM_ENOMEM;
 }
 
-km_status km_shape_morph_frame_until(const km_shape_morph *m, double t,
-                                     const km_stop *stop, km_shape_frame *out,
-                                     km_error *err) {
+static km_status frame_at(const km_shape_morph *m, double t,
+                          const km_stop *stop, km_shape_frame *out,
+                          double *ratio, km_error *err) {
   if (!m || !out)
     return km__fail(err, KM_EINVAL, KM_FIELD_NONE, -1, NAN, "no morph");
   if (!(t >= 0.0 && t <= 1.0))
@@ -191,7 +359,11 @@ km_status km_shape_morph_frame_until(const km_shape_morph *m, double t,
         km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, "out of memory");
     }
   }
-  if (st == KM_OK) st = finish(&f, fl, np, &poll);
+  if (st == KM_OK) {
+    st = finish(m, t, &f, fl, np, &poll, ratio);
+    if (st == KM_ENOMEM)
+      km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, "out of memory");
+  }
   if (st == KM_ECANCELLED) km__stopped(err);
   if (st != KM_OK) goto cleanup;
   *out = f;
@@ -200,6 +372,22 @@ cleanup:
   for (size_t k = 0; fl && k < n; k++) km__free(fl[k]);
   km__free(fl);
   km__free(np);
+  km_shape_frame_free(&f);
+  return st;
+}
+
+km_status km_shape_morph_frame_until(const km_shape_morph *m, double t,
+                                     const km_stop *stop, km_shape_frame *out,
+                                     km_error *err) {
+  return frame_at(m, t, stop, out, NULL, err);
+}
+
+km_status km__shape_frame_ratios(const km_shape_morph *m, double t,
+                                 const km_stop *stop, double *ratio,
+                                 km_error *err) {
+  km_shape_frame f;
+  km_shape_frame_init(&f);
+  km_status st = frame_at(m, t, stop, &f, ratio, err);
   km_shape_frame_free(&f);
   return st;
 }

@@ -39,6 +39,14 @@ void km__poly_interior_point(const double *P, size_t np, const double x[2],
 /* The compound morph (shape_morph.c), read by its frames (shape_frame.c). */
 typedef enum km__pair_kind { KM__PAIRED, KM__VANISH, KM__APPEAR } km__pair_kind;
 
+/* Points a parent's frames are sampled at, equal steps of the parameter
+ * (the arc length of a curvature frame), to follow the parent's motion. */
+#define KM__REF_POINTS 64
+
+/* Times an unpaired contour's size is measured at to keep its shrinking
+ * monotone (shape_morph.c): t = j / KM__SCHED. */
+#define KM__SCHED 32
+
 struct km_shape_morph {
   size_t npairs;
   km_shape_pair *pairs;
@@ -47,6 +55,35 @@ struct km_shape_morph {
   double *centre; /* 2 per pair: the unpaired contour's centroid */
   double *point;  /* 2 per pair: where it vanishes or appears */
   long *parent_from, *parent_to; /* parent slots on each side, -1 none */
+  double *anchor; /* 4 per pair: where its centroid is at t = 0 and t = 1
+                     (an unpaired contour's point on its missing side) */
+  double *ref;    /* 4 KM__REF_POINTS per pair: a paired parent's frames
+                     at t = 0 and t = 1 sampled (has_ref), else unset */
+  bool *has_ref;
+  double *sched; /* KM__SCHED + 1 per pair: the largest scale (of its full
+                     size) an unpaired contour has at t = j / KM__SCHED,
+                     falling toward its missing side; used when scheduled */
+  bool scheduled;
 };
+
+/* The scale each unpaired slot of the frame at t takes to fit in its
+ * parent, as a fraction of its nominal (1 - t or t), into ratio[npairs]
+ * (1 for the others), without the schedule (shape_frame.c). KM_OK or the
+ * statuses of km_shape_morph_frame_until. */
+km_status km__shape_frame_ratios(const km_shape_morph *m, double t,
+                                 const km_stop *stop, double *ratio,
+                                 km_error *err);
+
+/* Where slot k's centroid goes in frame f at t: the anchors at t = 0
+ * and t = 1 carried by the similarities that best map its parent's
+ * frames at t = 0 and t = 1 onto the parent's frame at t, blended
+ * (1 - t, t). false (out unset) when slot k has no such parent: none, or
+ * different ones at the two ends, or one not paired (shape_frame.c). */
+bool km__follow_parent(const km_shape_morph *m, size_t k, long parent,
+                       const km_curve *parent_now, double t, double out[2]);
+
+/* P sampled at KM__REF_POINTS equal parameter steps into out (2 doubles
+ * a point). */
+void km__ref_sample(const km_curve *c, double *out);
 
 #endif

@@ -41,6 +41,10 @@ void km_shape_morph_free(km_shape_morph *m) {
   km__free(m->point);
   km__free(m->parent_from);
   km__free(m->parent_to);
+  km__free(m->anchor);
+  km__free(m->ref);
+  km__free(m->has_ref);
+  km__free(m->sched);
   km__free(m);
 }
 
@@ -180,8 +184,12 @@ static km_status morph_alloc(km_shape_morph *m, size_t n) {
   m->point = km__calloc(2 * n, sizeof *m->point);
   m->parent_from = km__calloc(n, sizeof *m->parent_from);
   m->parent_to = km__calloc(n, sizeof *m->parent_to);
+  m->anchor = km__calloc(4 * n, sizeof *m->anchor);
+  m->ref = km__calloc(4 * KM__REF_POINTS * n, sizeof *m->ref);
+  m->has_ref = km__calloc(n, sizeof *m->has_ref);
+  m->sched = km__calloc((KM__SCHED + 1) * n, sizeof *m->sched);
   return m->morphs && m->kind && m->centre && m->point && m->parent_from &&
-                 m->parent_to
+                 m->parent_to && m->anchor && m->ref && m->has_ref && m->sched
              ? KM_OK
              : KM_ENOMEM;
 }
@@ -226,6 +234,89 @@ static void plan_slots(km_shape_morph *m, const km_shape *a,
         place_point(m, k, a, b);
 }
 
+/* Anchors of every slot, and the sampled end frames of every paired slot
+ * that is some slot's parent. */
+static km_status take_refs(km_shape_morph *m, const km_shape *a,
+                           const km_shape *b, const km_stop *stop,
+                           km_error *err) {
+  for (size_t k = 0; k < m->npairs; k++) {
+    double *an = m->anchor + 4 * k;
+    long i = m->pairs[k].from, j = m->pairs[k].to;
+    const double *c0 = i >= 0 ? a->centroid + 2 * i : m->point + 2 * k;
+    const double *c1 = j >= 0 ? b->centroid + 2 * j : m->point + 2 * k;
+    memcpy(an, c0, 2 * sizeof(double));
+    memcpy(an + 2, c1, 2 * sizeof(double));
+    long p = m->parent_from[k] >= 0 ? m->parent_from[k] : m->parent_to[k];
+    if (p >= 0 && m->kind[p] == KM__PAIRED) m->has_ref[p] = true;
+  }
+  for (size_t k = 0; k < m->npairs; k++) {
+    if (!m->has_ref[k]) continue;
+    for (int e = 0; e < 2; e++) {
+      km_curve c;
+      km_frame_metrics mt;
+      km_curve_init(&c);
+      km_status st = km_morph_frame_until(m->morphs[k], (double)e, stop, &c,
+                                          &mt, NULL, err);
+      if (st != KM_OK) {
+        if (err && st != KM_ECANCELLED) err->index = (long)k;
+        return st;
+      }
+      km__ref_sample(&c, m->ref + (4 * k + 2 * e) * KM__REF_POINTS);
+      km_curve_free(&c);
+    }
+  }
+  return KM_OK;
+}
+
+/* The schedule of unpaired contours inside a parent: the scale that fits
+ * at each t = j / KM__SCHED, then the running minimum from the side where
+ * the contour is whole, so its size only falls toward its missing side
+ * (frames between take the linear interpolation). */
+static km_status take_schedule(km_shape_morph *m, const km_stop *stop,
+                               km_error *err) {
+  size_t n = m->npairs;
+  bool any = false;
+  for (size_t k = 0; k < n; k++)
+    any = any || (m->kind[k] != KM__PAIRED &&
+                  (m->parent_from[k] >= 0 || m->parent_to[k] >= 0));
+  if (!any) return KM_OK;
+  double *ratio = km__malloc(n * sizeof *ratio);
+  if (!ratio)
+    return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, "out of memory");
+  km_status st = KM_OK;
+  for (int j = 0; st == KM_OK && j <= KM__SCHED; j++) {
+    double t = (double)j / KM__SCHED;
+    for (size_t k = 0; k < n; k++) ratio[k] = 1.0;
+    if (j > 0 && j < KM__SCHED)
+      st = km__shape_frame_ratios(m, t, stop, ratio, err);
+    for (size_t k = 0; k < n; k++) {
+      double s = m->kind[k] == KM__VANISH   ? 1.0 - t
+                 : m->kind[k] == KM__APPEAR ? t
+                                            : 1.0;
+      m->sched[(KM__SCHED + 1) * k + (size_t)j] = s * ratio[k];
+    }
+  }
+  km__free(ratio);
+  if (st != KM_OK) return st;
+  for (size_t k = 0; k < n; k++) {
+    double *S = m->sched + (KM__SCHED + 1) * k;
+    /* each time takes the smaller of its own fit and the next's toward
+     * the missing side, so an interval's interpolation stays below the
+     * fit at both its ends (and between them where the fit is monotone);
+     * the whole end keeps its full size, and the last time before the
+     * point its own fit */
+    if (m->kind[k] == KM__VANISH) {
+      for (int j = 1; j + 1 < KM__SCHED; j++) S[j] = fmin(S[j], S[j + 1]);
+      for (int j = 1; j <= KM__SCHED; j++) S[j] = fmin(S[j], S[j - 1]);
+    } else if (m->kind[k] == KM__APPEAR) {
+      for (int j = KM__SCHED - 1; j > 1; j--) S[j] = fmin(S[j], S[j - 1]);
+      for (int j = KM__SCHED - 1; j >= 0; j--) S[j] = fmin(S[j], S[j + 1]);
+    }
+  }
+  m->scheduled = true;
+  return KM_OK;
+}
+
 km_status km_shape_morph_create(km_shape_morph **out, const km_shape *from,
                                 const km_shape *to,
                                 const km_shape_morph_options *opt,
@@ -250,6 +341,8 @@ km_status km_shape_morph_create(km_shape_morph **out, const km_shape *from,
   mo.stop = stop;
   for (size_t k = 0; st == KM_OK && k < m->npairs; k++)
     st = morph_pair(m, k, from, to, &mo, err);
+  if (st == KM_OK) st = take_refs(m, from, to, stop, err);
+  if (st == KM_OK) st = take_schedule(m, stop, err);
   if (st != KM_OK) goto cleanup;
   *out = m;
   m = NULL;

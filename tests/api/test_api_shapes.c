@@ -363,6 +363,106 @@ static void what_shapes_do_not_take_is_named(void **state) {
       "/contour_matches");
 }
 
+/* A figure eight of turning number 0 (its right lobe larger, so it
+ * encloses area), centred at (10, 0) clear of the squares. */
+#define EIGHT_D                                                                \
+  "M 10 0 C 11 2, 13 2, 13 0 C 13 -2, 11 -2, 10 0 C 9 1, 8 1, 8 0 "            \
+  "C 8 -1, 9 -1, 10 0 Z"
+#define EIGHT_WIDE_D                                                           \
+  "M 10 0 C 11 3, 14 3, 14 0 C 14 -3, 11 -3, 10 0 C 9 1, 8 1, 8 0 "            \
+  "C 8 -1, 9 -1, 10 0 Z"
+#define SQUARE4_D "M 0 0 L 4 0 L 4 4 L 0 4 Z"
+#define SQUARE5_D "M 0 0 L 5 0 L 5 5 L 0 5 Z"
+
+static void empty_subpaths_are_named(void **state) {
+  (void)state;
+  /* a subpath that draws nothing, in SVG path data and as a contour */
+  const char *d = SQUARE4_D " M 5 5 Z";
+  char body[512], want[32];
+  snprintf(body, sizeof body,
+           "{\"from\":{\"type\":\"svg\",\"d\":\"%s\"},\"to\":" RING "}", d);
+  cJSON *j = at_expect_problem(MORPH, body, 422, "/from/d");
+  snprintf(want, sizeof want, "offset %zu", (size_t)(strrchr(d, 'Z') - d));
+  assert_non_null(strstr(member(j, "detail")->valuestring, want));
+  cJSON_Delete(j);
+  at_problem(MORPH,
+             "{\"to\":" RING ",\"from\":{\"type\":\"shape\",\"contours\":[" SQ(
+                 0) ",{\"type\":\"svg\",\"d\":\"M 5 5 Z\"}]}}",
+             422, "/from/contours/1/d");
+  at_problem(MORPH,
+             "{\"from\":" RING ",\"to\":{\"type\":\"shape\",\"contours\":[" SQ(
+                 0) ",{\"type\":\"points\",\"points\":[[5,5],[5,5],[5,5]],"
+                    "\"closed\":true}]}}",
+             422, "/to/contours/1/points");
+}
+
+/* Turning number 0 against contours that all turn once: no pairing
+ * avoids the mismatch, and an unpaired contour would morph to a circle
+ * (turning once) as well. */
+static void a_contour_no_pairing_can_morph_is_named(void **state) {
+  (void)state;
+  cJSON *j = at_expect_problem(
+      MORPH,
+      "{\"from\":{\"type\":\"svg\",\"d\":\"" SQUARE4_D " " EIGHT_D "\"},"
+      "\"to\":{\"type\":\"svg\",\"d\":\"" SQUARE5_D " M 20 0 L 21 0 L 21 1 "
+      "Z\"}}",
+      422, "/from/d");
+  assert_string_equal(member(j, "type")->valuestring,
+                      "/problems/not-morphable");
+  const char *msg = member(j, "detail")->valuestring;
+  assert_non_null(strstr(msg, "subpath 1"));
+  assert_non_null(strstr(msg, "offset 26"));
+  assert_non_null(strstr(msg, "turn"));
+  cJSON_Delete(j);
+  /* the same with the other side having fewer contours */
+  at_problem(MORPH,
+             "{\"from\":{\"type\":\"shape\",\"contours\":[{\"type\":\"svg\","
+             "\"d\":\"" SQUARE4_D "\"},{\"type\":\"svg\",\"d\":\"" EIGHT_D
+             "\"}]},\"to\":{\"type\":\"svg\",\"d\":\"" SQUARE5_D "\"}}",
+             422, "/from/contours/1");
+}
+
+/* metrics member `name` of contour k of frame i */
+static double contour_metric(const cJSON *frames, int i, int k,
+                             const char *name) {
+  const cJSON *m = member(cJSON_GetArrayItem(frames, i), "metrics");
+  return member(cJSON_GetArrayItem(member(m, "contours"), k), name)
+      ->valuedouble;
+}
+
+static double frame_metric(const cJSON *frames, int i, const char *name) {
+  const cJSON *m = member(cJSON_GetArrayItem(frames, i), "metrics");
+  return member(m, name)->valuedouble;
+}
+
+/* A contour crossing itself (the figure eight: one crossing, at its
+ * centre) and two contours crossing each other (squares overlapping at a
+ * corner: their edges cross twice) are morphed, their crossings counted
+ * at both ends. */
+static void crossing_contours_morph_and_show_their_crossings(void **state) {
+  (void)state;
+  cJSON *j = at_expect_json(
+      MORPH, "{\"from\":{\"type\":\"svg\",\"d\":\"" SQUARE4_D " " EIGHT_D
+             "\"},\"to\":{\"type\":\"svg\",\"d\":\"" SQUARE5_D " " EIGHT_WIDE_D
+             "\"},\"frames\":3,\"metrics\":true}");
+  const cJSON *frames = member(j, "frames");
+  for (int i = 0; i < 3; i += 2) {
+    assert_int_equal(contour_metric(frames, i, 1, "self_intersections"), 1);
+    assert_int_equal(contour_metric(frames, i, 0, "self_intersections"), 0);
+    assert_int_equal(frame_metric(frames, i, "mutual_intersections"), 0);
+  }
+  cJSON_Delete(j);
+  j = at_expect_json(MORPH, "{\"from\":{\"type\":\"svg\",\"d\":\"" SQUARE4_D
+                            " M 2.3 1.7 L 6.3 1.7 L 6.3 5.7 L 2.3 5.7 Z\"},"
+                            "\"to\":{\"type\":\"svg\",\"d\":\"" SQUARE5_D
+                            " M 3.1 2.9 L 7.1 2.9 L 7.1 6.9 L 3.1 6.9 Z\"},"
+                            "\"frames\":3,\"metrics\":true}");
+  frames = member(j, "frames");
+  for (int i = 0; i < 3; i += 2)
+    assert_int_equal(frame_metric(frames, i, "mutual_intersections"), 2);
+  cJSON_Delete(j);
+}
+
 /* ---- SVG documents ---- */
 
 /* The paths of an SVG document: their count, and each one's subpaths
@@ -596,6 +696,9 @@ static const struct CMUnitTest tests[] = {
     cmocka_unit_test(bad_contours_are_named),
     cmocka_unit_test(subpath_offsets_are_given),
     cmocka_unit_test(contours_past_the_limit_are_refused),
+    cmocka_unit_test(empty_subpaths_are_named),
+    cmocka_unit_test(a_contour_no_pairing_can_morph_is_named),
+    cmocka_unit_test(crossing_contours_morph_and_show_their_crossings),
     cmocka_unit_test(what_shapes_do_not_take_is_named),
     cmocka_unit_test(svg_filmstrip_fills_every_frame),
     cmocka_unit_test(svg_of_o_to_c_within_its_bound),

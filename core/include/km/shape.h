@@ -258,11 +258,18 @@ bool km_shape_morph_collapse_point(const km_shape_morph *m, size_t slot,
 /* Frame at t in [0, 1] into *out (owned by the caller, km_shape_frame
  * _free; taken as empty). Each pair's curve is km_morph_frame_until's at t
  * (the engine's fit placement onto the pair's linear blend); a vanishing
- * or appearing contour is scaled about its centroid and moved on the
- * straight line between its centroid and its point. A contour found
- * outside its parent's frame is then translated toward the parent's
- * centroid, by the smallest fraction (bisection to 1/1024) that puts it
- * inside; out->adjusted counts them. t = 0 and t = 1 give the inputs
+ * or appearing contour is scaled about its centroid. A contour with one
+ * paired parent at both ends (or at its one end) then follows the
+ * parent: its centroid goes where the similarities best mapping the
+ * parent's end frames onto the parent's frame at t carry its centroids at
+ * t = 0 and 1 (an unpaired one's point on its missing side), blended
+ * (1 - t, t), so the parts move and turn as one shape. An unpaired contour
+ * inside a parent takes the largest size that fits in the parent, measured
+ * when the morph is made at t = j / 32 and kept monotone (it never grows
+ * toward its missing side), its centre moved inside the parent if it lies
+ * outside. A contour still outside its parent is then translated toward
+ * the parent's inside by the smallest fraction (bisection to 1/1024) that
+ * puts it inside; out->adjusted counts them. t = 0 and t = 1 give the inputs
  * within the morph tolerance. Returns KM_OK, or:
  *   KM_ERANGE     t outside [0, 1] or NaN (KM_FIELD_TIMES, param t);
  *   km_morph_frame_until's statuses (err->index the pair);
