@@ -46,7 +46,8 @@ printf '%s\n' "$out" | grep -E '^(not )?ok |^# (tests|pass|fail)|Error|expected|
 record js $(node_counts "$out" "$rc")
 
 echo "-- clients/python"
-out=$(timeout "$limit" "$PY" -m unittest -v tests/clients/python/test_kmorph.py tests/clients/python/test_shapes.py 2>&1); rc=$?
+out=$(timeout "$limit" "$PY" -m unittest -v tests/clients/python/test_kmorph.py tests/clients/python/test_shapes.py \
+  tests/clients/python/test_package.py 2>&1); rc=$?
 printf '%s\n' "$out" | grep -E ' \.\.\. |^(FAIL|ERROR):|^Ran |^OK|^FAILED|Error|assert' | head -n 200
 ran=$(printf '%s\n' "$out" | sed -n 's/^Ran \([0-9]*\) tests\{0,1\}.*/\1/p' | tail -n 1)
 bad=$(printf '%s\n' "$out" | grep -cE '^(FAIL|ERROR): ')

@@ -29,6 +29,8 @@ after the job was cancelled on the service too.
 
 Also a command line: ``python3 -m kmorph --help``.
 """
+from __future__ import annotations
+
 import bisect
 import dataclasses
 import json
@@ -39,8 +41,15 @@ import time
 import urllib.error
 import urllib.parse
 import urllib.request
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+
+__version__ = "1.0.0"
+
+JSON = Dict[str, Any]
+Point = Tuple[float, float]
 
 __all__ = [
+    "__version__",
     "Client", "KmorphError", "JobCancelled", "ContourError", "DEFAULT_URL",
     "curve", "shape", "path_contours", "morph_request",
     "eval_curve", "curve_to_path", "sample_points", "frame_paths",
@@ -67,7 +76,7 @@ class KmorphError(Exception):
         self.retry_after = retry_after
         super().__init__(self.detail or self.title or "kmorph request failed")
 
-    def message_for(self, pointer):
+    def message_for(self, pointer: str) -> Optional[str]:
         """The message of the first error at `pointer` or below it, or None."""
         for e in self.errors:
             ptr = e.get("pointer", "")
@@ -75,7 +84,7 @@ class KmorphError(Exception):
                 return e.get("message")
         return None
 
-    def contour_errors(self):
+    def contour_errors(self) -> List["ContourError"]:
         """The errors that name one contour of a compound shape, as
         ContourError: from a pointer /from/contours/K/..., or from an SVG
         `d` whose subpath K is at fault (with its character offset)."""
@@ -130,7 +139,7 @@ class Client:
 
     # ----------------------------------------------------------- HTTP
 
-    def request(self, method, path, body=None, accept=None):
+    def request(self, method: str, path: str, body: Any = None, accept: Optional[str] = None) -> Any:
         """One exchange; returns (status, headers, parsed body) where the
         body is a dict/list for JSON answers, str for others, None for
         204. Raises KmorphError for status >= 400 and network errors."""
@@ -159,7 +168,7 @@ class Client:
 
     # ------------------------------------------------------ endpoints
 
-    def signature(self, curve, tolerance=None, samples=None):
+    def signature(self, curve: JSON, tolerance: Optional[float] = None, samples: Optional[int] = None) -> JSON:
         """POST /v1/signature: {"signature": ..., "samples"?: [[s, kappa]]}."""
         req = {"curve": curve}
         if tolerance is not None:
@@ -168,7 +177,8 @@ class Client:
             req["samples"] = samples
         return self.request("POST", "/v1/signature", req)[2]
 
-    def reconstruct(self, signature, tolerance=None, degree=None, include=None):
+    def reconstruct(self, signature: JSON, tolerance: Optional[float] = None, degree: Optional[int] = None,
+                    include: Optional[Sequence[str]] = None) -> JSON:
         """POST /v1/reconstruct: {"curve": ..., "error_bound": e}."""
         req = {"signature": signature}
         if tolerance is not None:
@@ -179,32 +189,33 @@ class Client:
             req["include"] = list(include)
         return self.request("POST", "/v1/reconstruct", req)[2]
 
-    def morph(self, request):
+    def morph(self, request: JSON) -> Union[JSON, str]:
         """POST /v1/morph: the morph result (a dict), or SVG text when
         request["format"] is "svg"."""
         accept = "image/svg+xml, application/problem+json" if request.get("format") == "svg" else None
         return self.request("POST", "/v1/morph", request, accept)[2]
 
-    def submit_job(self, request):
+    def submit_job(self, request: JSON) -> JSON:
         """POST /v1/jobs: the job status, with "location" from the header."""
         _, headers, body = self.request("POST", "/v1/jobs", request)
         body["location"] = _header(headers, "Location") or body["links"]["self"]
         return body
 
-    def job(self, job_id):
+    def job(self, job_id: str) -> JSON:
         """GET /v1/jobs/{id}: state, progress, frames_done, frames_total."""
         return self.request("GET", "/v1/jobs/" + urllib.parse.quote(job_id))[2]
 
-    def job_result(self, job_id):
+    def job_result(self, job_id: str) -> Union[JSON, str]:
         """GET /v1/jobs/{id}/result: the result of a done job."""
         return self.request("GET", "/v1/jobs/%s/result" % urllib.parse.quote(job_id),
                             accept="application/json, image/svg+xml, application/problem+json")[2]
 
-    def cancel_job(self, job_id):
+    def cancel_job(self, job_id: str) -> None:
         """DELETE /v1/jobs/{id}: cancel a live job, forget a finished one."""
         self.request("DELETE", "/v1/jobs/" + urllib.parse.quote(job_id))
 
-    def morph_job(self, request, on_progress=None, cancel=None, timeout=None):
+    def morph_job(self, request: JSON, on_progress: Optional[Callable[[JSON], None]] = None,
+                  cancel: Any = None, timeout: Optional[float] = None) -> Union[JSON, str]:
         """Submit, poll (calling on_progress(status) with each status),
         fetch the result. `cancel` is a threading.Event (or anything with
         is_set()): once set, the job is cancelled on the service and
@@ -262,10 +273,10 @@ class Client:
         except KmorphError:
             pass
 
-    def health(self):
+    def health(self) -> Any:
         return self.request("GET", "/healthz")[2]
 
-    def ready(self):
+    def ready(self) -> Any:
         return self.request("GET", "/readyz")[2]
 
 
@@ -299,7 +310,7 @@ def _parse(headers, raw):
 
 # ----------------------------------------------------------- requests
 
-def curve(value):
+def curve(value: Any) -> JSON:
     """A Curve for a request: an SVG path d string becomes {"type": "svg",
     "d": ...} (a compound shape when it has several subpaths), a list or
     tuple a shape of those contours, a dict is taken as it is."""
@@ -355,7 +366,7 @@ def _path_commands(d):
     return out
 
 
-def path_contours(d, close=True):
+def path_contours(d: str, close: bool = True) -> List[str]:
     """The subpaths of SVG path data, each as a d of its own that starts
     with an absolute moveto (so relative data after it keeps its meaning)
     and, with `close` (the default), ends with Z: SVG fills an open
@@ -402,7 +413,7 @@ def _num_text(v):
     return repr(int(v)) if v == int(v) and abs(v) < 1e15 else repr(v)
 
 
-def shape(contours, fill_rule=None):
+def shape(contours: Any, fill_rule: Optional[str] = None) -> JSON:
     """A compound shape {"type": "shape", "contours": [...]}: contours are
     closed curve dicts or d strings of one closed subpath each, or the
     whole shape is one d string, split by path_contours (and closed);
@@ -419,7 +430,7 @@ def shape(contours, fill_rule=None):
     return out
 
 
-def morph_request(from_curve, to_curve, **options):
+def morph_request(from_curve: Any, to_curve: Any, **options: Any) -> JSON:
     """A morph request from two curves (anything curve() takes) and the
     request's other members by their API names (frames, tolerance,
     contour_matches, include, ...); None values are left out."""
@@ -475,7 +486,7 @@ def _basis_ders(U, k, p, u):
     return N, D
 
 
-def eval_curve(curve, u, span=None):
+def eval_curve(curve: JSON, u: float, span: Optional[int] = None) -> Tuple[Point, Point]:
     """((x, y), (dx/du, dy/du)) of an output curve at parameter u, on knot
     span `span` if given (one-sided values at knots)."""
     p, P, U = curve["degree"], curve["control_points"], curve["knots"]
@@ -509,7 +520,7 @@ def _num(v):
     return s[:-2] if s.endswith(".0") else s
 
 
-def curve_to_path(curve, pieces=8):
+def curve_to_path(curve: JSON, pieces: int = 8) -> str:
     """SVG path data of a curve as cubic Béziers: exact for non-rational
     curves of degree <= 3, else `pieces` Hermite cubics per knot span."""
     m = 1 if curve["degree"] <= 3 and not curve.get("weights") else pieces
@@ -528,7 +539,7 @@ def curve_to_path(curve, pieces=8):
     return "".join(out) + ("Z" if curve.get("closed") else "")
 
 
-def sample_points(curve, n=200, per_span=24):
+def sample_points(curve: JSON, n: int = 200, per_span: int = 24) -> List[Point]:
     """n points at equal fractions of the curve's arc length."""
     dense = []
     for k, a, b in _spans(curve):
@@ -556,7 +567,7 @@ def _points_to_path(pts, closed):
     return d + ("Z" if closed else "")
 
 
-def is_compound(result_or_frame):
+def is_compound(result_or_frame: JSON) -> bool:
     """Whether a morph result (or frame) is of compound shapes: frames with
     "contours" in place of "curve"."""
     f = result_or_frame
@@ -565,7 +576,7 @@ def is_compound(result_or_frame):
     return isinstance(f, dict) and isinstance(f.get("contours"), list)
 
 
-def contour_pairs(result):
+def contour_pairs(result: JSON) -> List[JSON]:
     """The slots of a morph as [(slot, from, to)]: which contour of `from`
     went to which of `to` (from None: it appears; to None: it vanishes).
     A single-curve morph has the one slot (0, 0, 0)."""
@@ -575,19 +586,19 @@ def contour_pairs(result):
     return [(k, i, j) for k, (i, j) in enumerate(used)]
 
 
-def frame_contours(frame):
+def frame_contours(frame: JSON) -> List[Optional[JSON]]:
     """A frame's curves, one per slot: the CurveOut dict, or None where
     the contour is a point at this t. A single-curve frame gives [curve]."""
     return frame["contours"] if isinstance(frame.get("contours"), list) else [frame["curve"]]
 
 
-def frame_contour_paths(frame, pieces=8):
+def frame_contour_paths(frame: JSON, pieces: int = 8) -> List[Optional[str]]:
     """SVG path data per slot of a frame (None for a collapsed contour)."""
     return [None if c is None else (c.get("svg_d") or curve_to_path(c, pieces))
             for c in frame_contours(frame)]
 
 
-def frame_path(frame, pieces=8):
+def frame_path(frame: JSON, pieces: int = 8) -> str:
     """A frame's whole SVG path data: the service's svg_d when the request
     included it, else converted here; for shapes one closed subpath per
     present contour, in slot order, to fill with the shape's fill rule."""
@@ -598,7 +609,7 @@ def frame_path(frame, pieces=8):
     return frame["curve"].get("svg_d") or curve_to_path(frame["curve"], pieces)
 
 
-def frame_paths(result, pieces=8):
+def frame_paths(result: JSON, pieces: int = 8) -> List[str]:
     """One SVG d string per frame (see frame_path)."""
     return [frame_path(f, pieces) for f in result["frames"]]
 
@@ -642,7 +653,8 @@ def _slot_tracks(frames, samples):
     return tracks
 
 
-def interpolator(result, samples=200, collapsed="point", per_contour=False):
+def interpolator(result: JSON, samples: int = 200, collapsed: str = "point",
+                 per_contour: bool = False) -> Callable[[float], Any]:
     """A function t -> d for t in [0, 1]: each frame's curve (each contour
     of a shape) resampled at equal arc-length fractions, blended linearly
     between neighbouring frames; every string has one structure. A
@@ -682,7 +694,7 @@ def interpolator(result, samples=200, collapsed="point", per_contour=False):
     return at
 
 
-def bounds(result):
+def bounds(result: JSON) -> Tuple[float, float, float, float]:
     """(min_x, min_y, max_x, max_y) of every frame's control polygon (every
     contour of a shape), which holds the curves."""
     pts = [p for f in result["frames"] for c in frame_contours(f) if c is not None

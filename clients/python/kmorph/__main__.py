@@ -14,7 +14,7 @@ import json
 import sys
 import xml.etree.ElementTree as ET
 
-from . import (Client, JobCancelled, KmorphError, DEFAULT_URL, contour_pairs, frame_path, is_compound,
+from . import (__version__, Client, JobCancelled, KmorphError, DEFAULT_URL, contour_pairs, frame_path, is_compound,
                path_contours, shape)
 
 
@@ -214,6 +214,7 @@ def _morph_options(p):
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="python3 -m kmorph",
                                  description="Morph planar curves with a kmorph service.")
+    ap.add_argument("-V", "--version", action="version", version="kmorph " + __version__)
     ap.add_argument("-u", "--url", help="the service (default $KMORPH_URL or %s)" % DEFAULT_URL)
     sub = ap.add_subparsers(dest="cmd", required=True)
     p = sub.add_parser("signature", help="curvature signature of a curve")
