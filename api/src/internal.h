@@ -298,6 +298,14 @@ typedef struct api_include {
 } api_include;
 bool api__parse_include(api_ctx *ctx, const cJSON *root, bool allow_animate,
                         api_include *inc);
+/* The optional "precision": "exact" (default: shortest round-trip
+ * numbers) or "tolerance" (control points on a decimal grid of at most a
+ * tenth of the tolerance, json_write.h). */
+typedef enum api_precision {
+  API_PRECISION_EXACT,
+  API_PRECISION_TOLERANCE
+} api_precision;
+bool api__parse_precision(api_ctx *ctx, const cJSON *root, api_precision *out);
 
 /* ---- writers. A writer that meets a non-finite number records a 422
  * no-convergence error (the core produced something it cannot stand

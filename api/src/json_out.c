@@ -273,36 +273,102 @@ bool api__json_nums(api_ctx *ctx, api_svg_buf *b, const double *v, size_t n,
   return true;
 }
 
+bool api__parse_precision(api_ctx *ctx, const cJSON *root, api_precision *out) {
+  static const char *const names[] = {"exact", "tolerance"};
+  int which = API_PRECISION_EXACT;
+  if (!api__member_enum(ctx, root, "", "precision", names, 2, &which, NULL))
+    return false;
+  *out = (api_precision)which;
+  return true;
+}
+
+api_grid api__tolerance_grid(double tol) {
+  api_grid g = {true, api__grid_decimals(0.1 * tol)};
+  return g;
+}
+
+/* n points on grid g as [[x,y],...]; rounded receives the points as they
+ * read back, *moved the largest distance one moved. */
+static bool json_points_grid(api_ctx *ctx, api_svg_buf *b, const double *v,
+                             size_t n, const api_grid *g, double *rounded,
+                             double *moved) {
+  if (n > SIZE_MAX / (4 * API_NUM_PRINT_MAX)) return api__oom(ctx);
+  char *at = api__svg_buf_room(b, 2 + n * 2 * (API_NUM_PRINT_MAX + 2));
+  if (at == NULL) return true;
+  char *p = at;
+  *p++ = '[';
+  for (size_t i = 0; i < n; i++) {
+    if (!isfinite(v[2 * i]) || !isfinite(v[2 * i + 1])) {
+      *at = '\0';
+      return nonfinite(ctx, "coordinate");
+    }
+    if (i > 0) *p++ = ',';
+    *p++ = '[';
+    p += api__num_print_grid(p, v[2 * i], g->decimals, &rounded[2 * i]);
+    *p++ = ',';
+    p += api__num_print_grid(p, v[2 * i + 1], g->decimals, &rounded[2 * i + 1]);
+    *p++ = ']';
+    double d =
+        hypot(rounded[2 * i] - v[2 * i], rounded[2 * i + 1] - v[2 * i + 1]);
+    if (d > *moved) *moved = d;
+  }
+  *p++ = ']';
+  *p = '\0';
+  b->len += (size_t)(p - at);
+  return true;
+}
+
 bool api__json_curve(api_ctx *ctx, api_svg_buf *b, const km_curve *c,
-                     bool svg_d, double tol) {
-  double length;
+                     bool svg_d, double tol, const api_grid *grid,
+                     double *moved) {
+  double length, largest = 0.0;
+  km_curve printed = *c;
+  double *rounded = NULL;
+  bool ok = false;
   API_JSON_LIT(b, "{\"degree\":");
   if (!api__json_num(ctx, b, c->degree, "degree")) return false;
   API_JSON_LIT(b, ",\"knots\":");
   if (!api__json_nums(ctx, b, c->knots, c->n + (size_t)c->degree + 1, 1))
     return false;
   API_JSON_LIT(b, ",\"control_points\":");
-  if (!api__json_nums(ctx, b, c->cp, c->n, 2)) return false;
+  if (grid != NULL && grid->on) {
+    if ((rounded = km__malloc((c->n > 0 ? 2 * c->n : 1) * sizeof *rounded)) ==
+        NULL)
+      return api__oom(ctx);
+    if (!json_points_grid(ctx, b, c->cp, c->n, grid, rounded, &largest))
+      goto done;
+    printed.cp = rounded;
+  } else if (!api__json_nums(ctx, b, c->cp, c->n, 2)) {
+    return false;
+  }
   if (c->w != NULL) {
     API_JSON_LIT(b, ",\"weights\":");
-    if (!api__json_nums(ctx, b, c->w, c->n, 1)) return false;
+    if (!api__json_nums(ctx, b, c->w, c->n, 1)) goto done;
   }
   if (c->closed)
     API_JSON_LIT(b, ",\"closed\":true,\"length\":");
   else
     API_JSON_LIT(b, ",\"closed\":false,\"length\":");
-  length = km_curve_length(c);
-  if (!api__json_num(ctx, b, length, "length")) return false;
+  /* the length of the curve as printed, which the contract promises */
+  length = km_curve_length(&printed);
+  if (!api__json_num(ctx, b, length, "length")) goto done;
   if (svg_d) {
     /* Default tolerance as everywhere: 1e-5 of the curve's length. */
     char *d = api_svg_path_d(c, tol > 0 ? tol : 1e-5 * length, NULL);
-    if (d == NULL) return api__oom(ctx);
+    if (d == NULL) {
+      api__oom(ctx);
+      goto done;
+    }
     API_JSON_LIT(b, ",\"svg_d\":");
     api__json_string(b, d);
     km__free(d);
   }
   API_JSON_LIT(b, "}");
-  return true;
+  if (moved != NULL) *moved = largest;
+  ok = true;
+done:
+  km__free(rounded);
+  return ok;
 }
 
 bool api__json_tree(api_ctx *ctx, api_svg_buf *b, cJSON *item) {

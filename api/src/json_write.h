@@ -27,9 +27,29 @@ void api__json_string(api_svg_buf *b, const char *s);
 /* n values (stride 1) or n points (stride 2, [x,y] each) as an array. */
 bool api__json_nums(api_ctx *ctx, api_svg_buf *b, const double *v, size_t n,
                     size_t stride);
-/* A curve as the contract's Curve (output) object, as api__curve_json. */
+/* How control points are printed: exactly (shortest round trip), or on
+ * the decimal grid 10^-decimals ("precision": "tolerance"). */
+typedef struct api_grid {
+  bool on;
+  int decimals;
+} api_grid;
+
+/* The grid of "precision": "tolerance" for a tolerance tol (> 0): the
+ * coarsest 10^-d at most tol / 10. A point so rounded moves by at most
+ * sqrt(2)/2 of it (both coordinates by half a step), 0.071 tol, and so
+ * does the curve: a B-spline point is a convex combination of its control
+ * points, with or without (positive, unrounded) weights. */
+api_grid api__tolerance_grid(double tol);
+
+/* A curve as the contract's Curve (output) object, as api__curve_json,
+ * its control points on grid (NULL: exact) with the length of the curve
+ * so printed. *moved (may be NULL) receives the largest distance a
+ * control point moved by printing (0 when exact). Knots, weights and
+ * length are always exact: rounding a knot or a weight moves the curve
+ * by more than its share. */
 bool api__json_curve(api_ctx *ctx, api_svg_buf *b, const km_curve *c,
-                     bool svg_d, double tol);
+                     bool svg_d, double tol, const api_grid *grid,
+                     double *moved);
 /* A cJSON tree (consumed) printed into the buffer, for the parts of an
  * answer still built as trees. NULL item: false (the builder has recorded
  * its error). */

@@ -51,6 +51,7 @@ struct api_morph_plan {
   size_t nframes;
   api_frame_slot *frames;
   bool metrics;
+  api_precision precision;
   bool svg;
   bool want_sig;
   api_include inc;

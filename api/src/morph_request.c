@@ -302,6 +302,7 @@ static bool parse_options(api_ctx *ctx, const cJSON *root, api_morph_plan *pl) {
                        &degree, NULL) ||
       !api__member_bool(ctx, root, "", "metrics", false, &pl->metrics, NULL) ||
       !api__parse_include(ctx, root, true, &pl->inc) ||
+      !api__parse_precision(ctx, root, &pl->precision) ||
       !api__parse_tolerance(ctx, root, &pl->tol))
     return false;
   if (degree != 3 && degree != 5)

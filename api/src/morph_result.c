@@ -95,13 +95,14 @@ static bool animate_write(api_ctx *ctx, api_svg_buf *b,
 
 /* One frame's object: its t, its curve, its metrics when asked for. */
 static bool frame_write(api_ctx *ctx, api_svg_buf *b, const api_morph_plan *pl,
-                        const api_frame_slot *f) {
+                        const api_frame_slot *f, const api_grid *grid) {
   if (pl->shapes)
     return api__json_tree(ctx, b, api__shape_frame_json(ctx, pl, f));
   API_JSON_LIT(b, "{\"t\":");
   if (!api__json_num(ctx, b, f->t, "t")) return false;
   API_JSON_LIT(b, ",\"curve\":");
-  if (!api__json_curve(ctx, b, &f->curve, pl->inc.svg_d, pl->tol)) return false;
+  if (!api__json_curve(ctx, b, &f->curve, pl->inc.svg_d, pl->tol, grid, NULL))
+    return false;
   if (pl->metrics) {
     API_JSON_LIT(b, ",\"metrics\":");
     if (!metrics_write(ctx, b, &f->metrics)) return false;
@@ -130,13 +131,16 @@ static bool matches_used_write(api_ctx *ctx, api_svg_buf *b,
 static api_status result_json(api_ctx *ctx, api_morph_plan *pl,
                               api_response *out) {
   api_svg_buf b;
+  api_grid grid = {false, 0};
+  if (pl->precision == API_PRECISION_TOLERANCE)
+    grid = api__tolerance_grid(pl->tol);
   api__svg_buf_init(&b);
   API_JSON_LIT(&b, "{\"method\":");
   api__json_string(&b, api__morph_method_names[pl->opt.method]);
   API_JSON_LIT(&b, ",\"frames\":[");
   for (size_t i = 0; i < pl->nframes; i++) {
     if (i > 0) API_JSON_LIT(&b, ",");
-    if (!frame_write(ctx, &b, pl, &pl->frames[i])) goto fail;
+    if (!frame_write(ctx, &b, pl, &pl->frames[i], &grid)) goto fail;
   }
   if (pl->shapes) {
     API_JSON_LIT(&b, "],\"contour_matches_used\":");

@@ -411,3 +411,40 @@ size_t api__num_print_within(char *out, double x, double budget, double *got) {
   *got = x;
   return layout(out, negative, d, 2, 0, 16);
 }
+
+/* ---- on a decimal grid ---------------------------------------------- */
+
+static const double exact_pow10[23] = {
+    1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+    1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
+size_t api__num_print_grid(char *out, double v, int decimals, double *got) {
+  if (decimals > 22 || decimals < -22) {
+    *got = v;
+    return api__num_print(out, v);
+  }
+  double scaled =
+      decimals >= 0 ? v * exact_pow10[decimals] : v / exact_pow10[-decimals];
+  if (!(fabs(scaled) < 0x1p53)) {
+    *got = v;
+    return api__num_print(out, v);
+  }
+  double n = nearbyint(scaled);
+  if (n == 0) {
+    out[0] = '0';
+    out[1] = '\0';
+    *got = 0.0;
+    return 1;
+  }
+  uint64_t digits = (uint64_t)fabs(n);
+  *got = decimals >= 0 ? n / exact_pow10[decimals] : n * exact_pow10[-decimals];
+  return layout(out, n < 0, normalised(digits, -decimals), 0, 15, 21);
+}
+
+int api__grid_decimals(double step) {
+  int d = (int)ceil(-log10(step));
+  /* log10 may be off by an ulp at a power of ten: settle it exactly */
+  while (d < 400 && pow(10.0, -d) > step) d++;
+  while (d > -400 && pow(10.0, -(d - 1)) <= step) d--;
+  return d;
+}

@@ -54,4 +54,17 @@ size_t api__decimal_print(char *out, bool negative, api_decimal d);
  * length (at most 26). */
 size_t api__num_print_within(char *out, double x, double budget, double *got);
 
+/* v rounded to the decimal grid 10^-decimals, by integer arithmetic: the
+ * nearest integer N to v * 10^decimals printed as N * 10^-decimals in
+ * api__num_print's layout ("0" for N = 0, the sign of a zero dropped).
+ * Where the grid is finer than v's own precision (|v| 10^decimals >=
+ * 2^53) or |decimals| > 22, v is printed exactly (api__num_print). *got
+ * receives the double the text reads back as; |*got - v| <= 10^-decimals
+ * / 2 + 2^-52 |v|. v must be finite. Returns the length (at most 24). */
+size_t api__num_print_grid(char *out, double v, int decimals, double *got);
+
+/* The decimals of the coarsest grid 10^-decimals that is at most step
+ * (> 0, finite): the grid "precision": "tolerance" prints on. */
+int api__grid_decimals(double step);
+
 #endif

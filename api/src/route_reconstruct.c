@@ -5,12 +5,14 @@
 #include <math.h>
 
 #include "internal.h"
+#include "json_write.h"
 
 /* The members of a reconstruct request besides its signature. */
 typedef struct options {
   double tol; /* 0: none given */
   long degree;
   api_include inc;
+  api_precision precision;
 } options;
 
 static bool read_options(api_ctx *ctx, const cJSON *root, options *o) {
@@ -19,7 +21,8 @@ static bool read_options(api_ctx *ctx, const cJSON *root, options *o) {
   if (!api__parse_tolerance(ctx, root, &o->tol) ||
       !api__member_int(ctx, root, "", "degree", false, -1000000, 1000000,
                        &o->degree, NULL) ||
-      !api__parse_include(ctx, root, false, &o->inc))
+      !api__parse_include(ctx, root, false, &o->inc) ||
+      !api__parse_precision(ctx, root, &o->precision))
     return false;
   if (o->degree != 3 && o->degree != 5)
     return api__invalid(ctx, "/degree", "must be 3 or 5");
@@ -36,8 +39,12 @@ static bool reconstruct(api_ctx *ctx, const api_request *req, const options *o,
   km_stop stop_buf;
   size_t predicted;
   /* the answer's curve is held to the limit on curves, as inputs are */
+  /* on the tolerance's grid the printing may move the curve by 0.071 of
+   * the tolerance (json_write.h): the fit leaves it a tenth */
+  double tol = o->tol > 0 ? o->tol : 1e-5 * sig->length;
+  if (o->precision == API_PRECISION_TOLERANCE) tol *= 0.9;
   km_status st = km_reconstruct_until(
-      sig, (int)o->degree, o->tol, ctx->cfg->max_control_points,
+      sig, (int)o->degree, tol, ctx->cfg->max_control_points,
       api__km_stop(req, &stop_buf), curve, bound, &err);
   if (st == KM_ECANCELLED) return api__stopped(ctx);
   if (st != KM_OK)
@@ -55,53 +62,61 @@ static bool reconstruct(api_ctx *ctx, const api_request *req, const options *o,
                     predicted, curve->n, ctx->cfg->max_output_bytes);
 }
 
-/* {"curve": ..., "error_bound": ...}; svg_d printed to the request's
- * tolerance, else 1e-5 of the length. */
-static cJSON *answer_json(api_ctx *ctx, const options *o, double length,
-                          const km_curve *curve, double bound) {
-  cJSON *res = cJSON_CreateObject(), *jc;
-  if (res == NULL) {
-    api__oom(ctx);
-    return NULL;
-  }
-  if ((jc = api__curve_json(ctx, curve, o->inc.svg_d,
-                            o->tol > 0 ? o->tol : 1e-5 * length)) == NULL)
-    goto fail;
-  if (!api__add_item(ctx, res, "curve", jc) ||
-      !api__add_num(ctx, res, "error_bound", bound))
-    goto fail;
-  return res;
-fail:
-  cJSON_Delete(res);
-  return NULL;
+/* {"curve": ..., "error_bound": ...}, written straight into a buffer;
+ * svg_d printed to the request's tolerance, else 1e-5 of the length. The
+ * bound includes what printing on the tolerance's grid moved the curve. */
+static bool answer_write(api_ctx *ctx, api_svg_buf *b, const options *o,
+                         double length, const km_curve *curve, double bound) {
+  double tol = o->tol > 0 ? o->tol : 1e-5 * length, moved = 0.0;
+  api_grid grid = {false, 0};
+  if (o->precision == API_PRECISION_TOLERANCE) grid = api__tolerance_grid(tol);
+  API_JSON_LIT(b, "{\"curve\":");
+  if (!api__json_curve(ctx, b, curve, o->inc.svg_d, tol, &grid, &moved))
+    return false;
+  API_JSON_LIT(b, ",\"error_bound\":");
+  if (!api__json_num(ctx, b, bound + moved, "error_bound")) return false;
+  API_JSON_LIT(b, "}");
+  return api__json_done(ctx, b);
 }
 
 api_status api__route_reconstruct(api_ctx *ctx, const api_request *req,
                                   api_response *out) {
   cJSON *root = api__parse_body(ctx, req->body, req->length);
-  cJSON *res = NULL;
+  api_svg_buf b;
+  bool written = false;
   const cJSON *js;
   options o;
   km_signature sig;
   km_curve curve;
-  double bound = 0;
+  double bound = 0, length;
 
   km_signature_init(&sig);
   km_curve_init(&curve);
+  api__svg_buf_init(&b);
   if (root == NULL || !read_options(ctx, root, &o) ||
       (js = api__require(ctx, root, "", "signature")) == NULL ||
       !api__parse_signature(ctx, js, "/signature", &sig) ||
       !reconstruct(ctx, req, &o, &sig, &curve, &bound))
     goto done;
-  res = answer_json(ctx, &o, sig.length, &curve, bound);
+  /* the request's tree freed before the answer is written: the two never
+   * take memory at once */
+  cJSON_Delete(root);
+  root = NULL;
+  length = sig.length;
+  km_signature_free(&sig);
+  written = answer_write(ctx, &b, &o, length, &curve, bound);
 done:
-  /* freed before the answer is printed: the two never take memory at once */
   cJSON_Delete(root);
   km_signature_free(&sig);
   km_curve_free(&curve);
-  if (res == NULL) {
+  if (!written) {
+    api__svg_buf_free(&b);
     api__ctx_problem(ctx, out, req->request_id);
     return out->status;
   }
-  return api__respond_json(ctx, res, 200, out, req->request_id);
+  out->status = 200;
+  out->content_type = API_CT_JSON;
+  out->length = b.len;
+  out->body = api__svg_buf_take(&b);
+  return 200;
 }
