@@ -4,10 +4,15 @@
 #
 # KMORPH_URL   the service (default http://127.0.0.1:8080)
 # KMORPH_CURL  extra curl options, e.g. "--max-time 30"
+# KMORPH_RETRIES  how many times a 429 or 503 answer is retried (default 3),
+#              each after its Retry-After (default 1 s, at most
+#              KMORPH_RETRY_MAX seconds, default 10)
 
 KMORPH_URL=${KMORPH_URL:-http://127.0.0.1:8080}
 KMORPH_URL=${KMORPH_URL%/}
 km_prog=$(basename "$0")
+km_version=1.0.0
+case "${1:-}" in --version | -V) echo "$km_prog $km_version"; exit 0 ;; esac
 
 km_die() { echo "$km_prog: $*" >&2; exit 1; }
 km_usage_error() { echo "$km_prog: $*" >&2; echo "try '$km_prog -h'" >&2; exit 2; }
@@ -129,9 +134,20 @@ km_call() {
   local args=(-sS -X "$method" -o "$km_body" -D "$km_headers" -w '%{http_code}'
               -H "Accept: $accept, application/problem+json")
   [ -n "$data" ] && args+=(-H "Content-Type: application/json" --data-binary "@$data")
-  # shellcheck disable=SC2086
-  km_status=$(curl "${args[@]}" ${KMORPH_CURL:-} "$KMORPH_URL$path" 2>"$km_tmp/err") ||
-    km_die "cannot reach $KMORPH_URL: $(tail -n 1 "$km_tmp/err")"
+  local tries=${KMORPH_RETRIES:-3} wait_max=${KMORPH_RETRY_MAX:-10} wait
+  for (( ; ; tries-- )); do
+    # shellcheck disable=SC2086
+    km_status=$(curl "${args[@]}" ${KMORPH_CURL:-} "$KMORPH_URL$path" 2>"$km_tmp/err") ||
+      km_die "cannot reach $KMORPH_URL: $(tail -n 1 "$km_tmp/err")"
+    # An overloaded service (429, 503) refused the request without doing
+    # it, so asking again after the delay it names is safe, even a POST.
+    { [ "$km_status" = 429 ] || [ "$km_status" = 503 ]; } && [ "$tries" -gt 0 ] || break
+    wait=$(km_header Retry-After)
+    [[ "$wait" =~ ^[0-9]+$ ]] || wait=1
+    [ "$wait" -gt "$wait_max" ] && wait=$wait_max
+    echo "$km_prog: $km_status, retrying in ${wait}s" >&2
+    sleep "$wait"
+  done
   if [ "$km_status" -ge 400 ]; then
     if jq -e 'type == "object" and has("status")' "$km_body" >/dev/null 2>&1; then
       jq -r --arg p "$km_prog" '"\($p): \(.status) \(.title): \(.detail // "")",

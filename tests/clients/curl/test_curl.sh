@@ -290,5 +290,62 @@ t_shape_invalid() {
 }
 check "a bad contour exits 1 naming /from/contours/1, a bad subpath its offset; -p with -l is a usage error" t_shape_invalid
 
+t_version() {
+  want=$(sed -n '/^info:/,/^[^ ]/s/^  version: *"\{0,1\}\([^" ]*\).*/\1/p' "$km_root/api/openapi.yaml")
+  [ -n "$want" ] || { echo "no info.version in openapi.yaml"; return 1; }
+  for s in km-signature km-reconstruct km-morph km-job km-job-status km-job-cancel km-health; do
+    [ "$("$bin/$s" --version)" = "$s $want" ] || { echo "$s --version: $("$bin/$s" --version)"; return 1; }
+  done
+}
+check "every script's --version is the API's info.version" t_version
+
+# A stand-in service that answers 503 (Retry-After: 1), then 429
+# (Retry-After: 1), then 200: the scripts must wait and try again, and
+# give up with the problem once KMORPH_RETRIES is spent.
+t_retry() {
+  cat >"$work/busy.py" <<'PY'
+import http.server, json, sys, time
+answers = [(503, "1"), (429, "1")]
+seen = []
+class H(http.server.BaseHTTPRequestHandler):
+    def log_message(self, *a): pass
+    def do_GET(self):
+        seen.append(time.monotonic())
+        if answers:
+            code, after = answers.pop(0)
+            body = json.dumps({"type": "/problems/busy", "title": "Busy", "status": code}).encode()
+            self.send_response(code); self.send_header("Retry-After", after)
+            self.send_header("Content-Type", "application/problem+json")
+        else:
+            body = json.dumps({"status": "ok"}).encode()
+            self.send_response(200); self.send_header("Content-Type", "application/json")
+        self.send_header("Content-Length", str(len(body))); self.end_headers(); self.wfile.write(body)
+s = http.server.HTTPServer(("127.0.0.1", 0), H)
+print(s.server_address[1], flush=True)
+s.timeout = 20
+deadline = time.monotonic() + 30
+while time.monotonic() < deadline and len(seen) < int(sys.argv[1]):
+    s.handle_request()
+PY
+  timeout 40 python3 "$work/busy.py" 4 >"$work/port1" & busy=$!
+  for _ in $(seq 100); do [ -s "$work/port1" ] && break; sleep 0.1; done
+  port=$(cat "$work/port1")
+  start=$(date +%s.%N)
+  out=$(KMORPH_URL=http://127.0.0.1:$port "$bin/km-health" 2>"$work/retry.err") || { cat "$work/retry.err"; return 1; }
+  took=$(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN { print b - a }')
+  wait "$busy"
+  [ "$out" = "ok ok" ] || { echo "got: $out"; return 1; }
+  [ "$(grep -c 'retrying in 1s' "$work/retry.err")" -eq 2 ] || { cat "$work/retry.err"; return 1; }
+  awk -v t="$took" 'BEGIN { exit !(t >= 2 && t < 20) }' || { echo "took $took s"; return 1; }
+  timeout 40 python3 "$work/busy.py" 2 >"$work/port2" & busy=$!
+  for _ in $(seq 100); do [ -s "$work/port2" ] && break; sleep 0.1; done
+  port=$(cat "$work/port2")
+  KMORPH_RETRIES=1 KMORPH_URL=http://127.0.0.1:$port "$bin/km-health" 2>"$work/retry2.err"; rc=$?
+  wait "$busy"
+  [ "$rc" -eq 1 ] || { echo "rc $rc"; return 1; }
+  grep -q "429 Busy" "$work/retry2.err" || { cat "$work/retry2.err"; return 1; }
+}
+check "429 and 503 are retried after Retry-After, a bounded number of times" t_retry
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
