@@ -35,9 +35,17 @@ CJSON_CFLAGS := -I/usr/include/cjson
 CJSON_LIBS   := -lcjson
 MHD_LIBS     := -lmicrohttpd
 
+# The one version of the tree (VERSION): the core's generated km/version.h
+# and, as -D flags, the CLI's and the daemon's --version and build_info.
+KM_VERSION := $(shell cat VERSION)
+KM_VERSION_PARTS := $(subst ., ,$(KM_VERSION))
+GEN_INC := $(BUILD)/gen/include
+VERSION_H := $(GEN_INC)/km/version.h
+VERSION_DEF := -DKMORPH_VERSION='"$(KM_VERSION)"'
+
 # Layers: each is a static library; a wrong-way include does not compile
 # because the include path of a layer names only the layers below it.
-CORE_INC := -Icore/include
+CORE_INC := -Icore/include -I$(GEN_INC)
 API_INC  := -Iapi/include $(CORE_INC) $(CJSON_CFLAGS)
 SRV_INC  := -Iapi/include
 
@@ -103,17 +111,22 @@ check:
 	@awk '{p += $$2; f += $$3} END {printf "check: %d tests passed, %d failed\n", p, f}' \
 	  $(BUILD)/check-results.txt
 
-$(BUILD)/core/%.o: core/%.c | check-deps
+$(VERSION_H): packaging/version.h.in VERSION
+	@mkdir -p $(@D)
+	sed -e 's/@VERSION@/$(KM_VERSION)/' -e 's/@MAJOR@/$(word 1,$(KM_VERSION_PARTS))/' \
+	  -e 's/@MINOR@/$(word 2,$(KM_VERSION_PARTS))/' -e 's/@PATCH@/$(word 3,$(KM_VERSION_PARTS))/' $< > $@
+
+$(BUILD)/core/%.o: core/%.c | check-deps $(VERSION_H)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) $(CORE_INC) -MMD -MP -c $< -o $@
 
-$(BUILD)/api/%.o: api/%.c | check-deps
+$(BUILD)/api/%.o: api/%.c | check-deps $(VERSION_H)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) $(API_INC) -MMD -MP -c $< -o $@
 
 $(BUILD)/server/%.o: server/%.c | check-deps
 	@mkdir -p $(@D)
-	$(CC) $(CFLAGS) $(SRV_INC) -MMD -MP -c $< -o $@
+	$(CC) $(CFLAGS) $(SRV_INC) $(VERSION_DEF) -MMD -MP -c $< -o $@
 
 $(LIBCORE): $(CORE_OBJ)
 	@mkdir -p $(@D)
@@ -123,9 +136,11 @@ $(LIBAPI): $(API_OBJ)
 	@mkdir -p $(@D)
 	rm -f $@ && ar rcs $@ $^
 
-$(CLI): cli/kmorph.c $(LIBAPI) $(LIBCORE) | check-deps
+$(CLI): cli/kmorph.c $(LIBAPI) $(LIBCORE) VERSION | check-deps
 	@mkdir -p $(@D)
-	$(CC) $(CFLAGS) $(SRV_INC) $< -o $@ $(LIBAPI) $(LIBCORE) $(CJSON_LIBS) -lm $(LDFLAGS)
+	$(CC) $(CFLAGS) $(SRV_INC) $(VERSION_DEF) $< -o $@ $(LIBAPI) $(LIBCORE) $(CJSON_LIBS) -lm $(LDFLAGS)
+
+$(BUILD)/server/src/config.o $(BUILD)/server/src/metrics.o: VERSION
 
 $(DAEMON): $(SRV_OBJ) $(LIBAPI) $(LIBCORE)
 	@mkdir -p $(@D)
@@ -148,11 +163,11 @@ HOOK_API_OBJ  := $(API_SRC:%.c=$(BUILD)/hooked/%.o)
 HOOK_LIBCORE  := $(BUILD)/hooked/libkmorph.a
 HOOK_LIBAPI   := $(BUILD)/hooked/libkmapi.a
 
-$(BUILD)/hooked/core/%.o: core/%.c | check-deps
+$(BUILD)/hooked/core/%.o: core/%.c | check-deps $(VERSION_H)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) -DKM_ALLOC_HOOKED $(CORE_INC) -MMD -MP -c $< -o $@
 
-$(BUILD)/hooked/api/%.o: api/%.c | check-deps
+$(BUILD)/hooked/api/%.o: api/%.c | check-deps $(VERSION_H)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) -DKM_ALLOC_HOOKED $(API_INC) -MMD -MP -c $< -o $@
 
@@ -335,7 +350,7 @@ FUZZ_OBJ := $(CORE_SRC:%.c=build/fuzz/obj/%.o) $(API_SRC:%.c=build/fuzz/obj/%.o)
 # time of the curves target's slowest inputs (the api layer's, against
 # field names and limits, are).
 build/fuzz/obj/core/%.o: FUZZ_TRACE := -fno-sanitize-coverage=trace-cmp
-build/fuzz/obj/%.o: %.c tests/fuzz/coverage-ignore.txt
+build/fuzz/obj/%.o: %.c tests/fuzz/coverage-ignore.txt | $(VERSION_H)
 	@mkdir -p $(@D)
 	clang $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link $(FUZZ_TRACE) -MMD -MP -c $< -o $@
 -include $(FUZZ_OBJ:.o=.d)

@@ -13,6 +13,12 @@
 
 #include "kmapi/api.h"
 
+/* The build passes the tree's VERSION; a stray compile without it still
+ * says something true. */
+#ifndef KMORPH_VERSION
+#define KMORPH_VERSION "unknown"
+#endif
+
 static void usage(FILE *to) {
   fputs("usage: kmorph signature|reconstruct|morph [--pretty] [--svg] "
         "< request.json\n"
@@ -23,6 +29,7 @@ static void usage(FILE *to) {
         "  --pretty   indent JSON output\n"
         "  --svg      ask for SVG (as the header Accept: image/svg+xml)\n"
         "  --help     this text\n"
+        "  --version  the version, then exit\n"
         "\n"
         "Exit status: 0 on success, 1 when the answer is a problem\n"
         "(application/problem+json on stdout), 2 on a usage error.\n",
@@ -125,6 +132,9 @@ int main(int argc, char **argv) {
   for (int i = 1; i < argc; i++) {
     if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
       usage(stdout);
+      return 0;
+    } else if (strcmp(argv[i], "--version") == 0) {
+      printf("kmorph %s\n", KMORPH_VERSION);
       return 0;
     } else if (strcmp(argv[i], "--pretty") == 0) {
       pretty = true;

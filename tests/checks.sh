@@ -48,4 +48,28 @@ unittest_module compound-fixtures test_fixtures
 unittest_module compound-morphs test_compound_morphs \
   KMORPH="$PWD/build/kmorph" KM_COMPOUND_FRAMES="${KM_COMPOUND_FRAMES:-21}" \
   KM_COMPOUND_REPORT="$PWD/build/compound-morphs.txt"
+# 4. One version (VERSION): the contract's info.version, the generated
+# km/version.h and both binaries' --version say the same.
+version=$(cat VERSION)
+header=build/gen/include/km/version.h
+want=$(printf '%s' "$version" | awk -F. '{ printf "%d %d %d", $1, $2, $3 }')
+got=$(awk '$1 == "#define" && $2 ~ /^KM_VERSION_(MAJOR|MINOR|PATCH)$/ { printf "%s ", $3 }' \
+  "$header" 2>/dev/null | sed 's/ $//')
+api_version=$(awk '/^info:/ { i = 1; next } i && /^[^ ]/ { i = 0 } i && $1 == "version:" { print $2; exit }' \
+  api/openapi.yaml)
+bad=0
+for pair in "openapi.yaml info.version|$api_version" \
+            "km/version.h numbers|$got|$want" \
+            "kmorph --version|$(build/kmorph --version 2>&1)|kmorph $version" \
+            "kmorphd --version|$(build/kmorphd --version 2>&1 | cut -d' ' -f1-2)|kmorphd $version"; do
+  IFS='|' read -r what have expect <<<"$pair"
+  expect=${expect:-$version}
+  if [ "$have" != "$expect" ]; then
+    echo "FAIL version: $what is '$have', VERSION says '$expect'"
+    bad=$((bad + 1))
+  fi
+done
+[ "$bad" -eq 0 ] && echo "ok   version: $version in the contract, km/version.h and both binaries"
+echo "checks/version $((4 - bad)) $bad" >>"$results"
+[ "$bad" -eq 0 ] || status=1
 exit $status

@@ -14,6 +14,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The build passes the tree's VERSION; a stray compile without it still
+ * says something true. */
+#ifndef KMORPH_VERSION
+#define KMORPH_VERSION "unknown"
+#endif
+
 typedef enum { OPT_STR, OPT_UINT, OPT_SIZE, OPT_SECONDS, OPT_BOOL } opt_kind;
 
 typedef struct opt_def {
@@ -222,7 +228,7 @@ int srv_config_load(srv_config *cfg, int argc, char **argv, FILE *out,
       return 1;
     }
     if (strcmp(arg, "--version") == 0) {
-      fprintf(out, "kmorphd 1.0 (API v1)\n");
+      fprintf(out, "kmorphd %s (API v1)\n", KMORPH_VERSION);
       return 1;
     }
     if (strncmp(arg, "--", 2) != 0) {

@@ -13,6 +13,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The build passes the tree's VERSION; a stray compile without it still
+ * says something true. */
+#ifndef KMORPH_VERSION
+#define KMORPH_VERSION "unknown"
+#endif
+
 static const char *const ROUTE_NAMES[SRV_R_COUNT] = {
     "index",      "healthz",     "readyz", "metrics", "openapi",
     "signature",  "reconstruct", "morph",  "jobs",    "job",
@@ -218,6 +224,11 @@ char *srv_metrics_render(srv_metrics *m, const srv_gauges *g, size_t *len) {
   if (b.p == NULL) return NULL;
   b.p[0] = '\0';
   pthread_mutex_lock(&m->mu);
+  put(&b,
+      "# HELP kmorph_build_info The daemon's version (always 1).\n"
+      "# TYPE kmorph_build_info gauge\n"
+      "kmorph_build_info{version=\"%s\"} 1\n",
+      KMORPH_VERSION);
   put_requests(&b, m);
   put_durations(&b, m);
   put_rejections(&b, m);

@@ -65,4 +65,5 @@
 #include "km/signature.h"
 #include "km/status.h"
 #include "km/stop.h"
+#include "km/version.h"
 #endif
