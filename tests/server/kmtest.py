@@ -60,6 +60,23 @@ def heavy_morph_body(frames):
             "frames": frames, "metrics": True}
 
 
+def ring_morph_body(frames):
+    """A morph whose every frame is a compound shape (a ring of circles to
+    a ring of squares): several milliseconds a frame, for tests that need
+    a computation still running, where a single curve's frames are now
+    tens of microseconds."""
+    def circle(r):
+        return "M %g 0 A %g %g 0 1 1 %g 0 A %g %g 0 1 1 %g 0 Z" % (
+            r, r, r, -r, r, r, r)
+
+    def square(h):
+        return "M %g %g L %g %g L %g %g L %g %g Z" % (
+            -h, -h, h, -h, h, h, -h, h)
+    return {"from": {"type": "svg", "d": circle(10.0) + " " + circle(5.0)},
+            "to": {"type": "svg", "d": square(15.0) + " " + square(7.0)},
+            "frames": frames, "metrics": True}
+
+
 # ------------------------------------------------------------ jobs, metrics
 
 def run_job(daemon, body, timeout=15):

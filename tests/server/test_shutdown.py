@@ -16,7 +16,7 @@ import time
 import unittest
 
 from kmtest import (HOST, ContractCase, Daemon, Reply, heavy_morph_body,
-                    wait_for)
+                    ring_morph_body, wait_for)
 
 
 class GracefulShutdown(ContractCase):
@@ -42,7 +42,7 @@ class GracefulShutdown(ContractCase):
 
             def client():
                 out["r"] = d.request("POST", "/v1/morph",
-                                     body=heavy_morph_body(400), timeout=30)
+                                     body=ring_morph_body(400), timeout=30)
 
             t = threading.Thread(target=client)
             t.start()
