@@ -119,7 +119,9 @@ km_status km__avoid_crossings(km_morph **mp, km__poll *poll) {
   if (bx == 0) goto done;
   rep.searched = true;
   bool auto_m = base->opt.auto_matches && base->opt.nmatches == 0;
-  double shift[SEAMS], cost[SEAMS];
+  /* [0] is the morph's own start; km__sector_shifts writes SEAMS - 1
+   * starts after it and the own start's cost after those */
+  double shift[SEAMS + 1], cost[SEAMS + 1];
   size_t nshift = 0;
   if (base->closed && base->opt.nmatches == 0 &&
       km__sector_shifts(&base->in[0], &base->in[1], SEAMS, shift + 1, cost + 1,
