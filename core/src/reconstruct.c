@@ -604,7 +604,9 @@ static km_status plan_arc_length(plan *pl, const theta_pieces *tp, int degree,
   if (st || degree != 3) return st;
   merge_cubic(pl, tp, 0.9 * tol);
   bool over;
-  return settle_speeds(pl, tp, 0.9 * tol, &over) ? km__stopped(err) : KM_OK;
+  if (settle_speeds(pl, tp, 0.9 * tol, &over)) return km__stopped(err);
+  /* a piece whose settled speeds break the bound has none: not a plan */
+  return over ? KM_ENOCONVERGE : KM_OK;
 }
 
 /* The output pieces with arc-shaped cubics where they bound closer, their
