@@ -522,7 +522,7 @@ static km_status settle_speeds(plan *pl, const theta_pieces *tp, double tol,
 
 /* Pieces whose settled bound exceeds tol planned again in two halves. */
 static km_status split_over(plan *pl, const theta_pieces *tp, double tol) {
-  plan next = {NULL, 0, 0, pl->limit, pl->poll, false};
+  plan next = {NULL, 0, 0, pl->limit, pl->poll, pl->arc_length_only};
   km_status st = KM_OK;
   for (size_t j = 0; j < pl->n && !st; j++) {
     out_piece op = pl->p[j];
@@ -592,38 +592,16 @@ static km_status plan_all(plan *pl, const theta_pieces *tp, int degree,
   return KM_OK;
 }
 
-/* The output pieces within 0.9 tol, arc-length Hermite throughout: a
- * cubic's neighbours merged across breaks of kappa where the bound allows
- * (a signature breaks at every knot of its curve). */
-static km_status plan_arc_length(plan *pl, const theta_pieces *tp, int degree,
-                                 double tol, const km_signature *sig,
-                                 km_error *err) {
-  pl->n = 0;
-  pl->arc_length_only = true;
-  km_status st = plan_all(pl, tp, degree, 0.9 * tol, sig, err);
-  if (st || degree != 3) return st;
-  merge_cubic(pl, tp, 0.9 * tol);
-  bool over;
-  if (settle_speeds(pl, tp, 0.9 * tol, &over)) return km__stopped(err);
-  /* a piece whose settled speeds break the bound has none: not a plan */
-  return over ? KM_ENOCONVERGE : KM_OK;
-}
-
-/* The output pieces with arc-shaped cubics where they bound closer, their
- * neighbours merged where the bound allows and their end speeds settled
- * (pieces split where that breaks the bound). Should settling not end
- * within a few rounds, KM_ENOCONVERGE. */
-static km_status plan_shaped(plan *pl, const theta_pieces *tp, double tol,
-                             const km_signature *sig, km_error *err) {
-  km_status st = plan_all(pl, tp, 3, 0.9 * tol, sig, err);
-  if (st) return st;
-  if (merge_shape(pl, tp, 0.9 * tol)) return km__stopped(err);
-  merge_cubic(pl, tp, 0.9 * tol);
+/* The plan's end speeds settled, pieces that then break the bound split
+ * in two and settled again, for a few rounds; KM_ENOCONVERGE should that
+ * not end. */
+static km_status settle_plan(plan *pl, const theta_pieces *tp, double tol,
+                             km_error *err) {
   for (int round = 0; round < 12; round++) {
     bool over;
-    if (settle_speeds(pl, tp, 0.9 * tol, &over)) return km__stopped(err);
+    if (settle_speeds(pl, tp, tol, &over)) return km__stopped(err);
     if (!over) return KM_OK;
-    st = split_over(pl, tp, 0.9 * tol);
+    km_status st = split_over(pl, tp, tol);
     if (st == KM_ECANCELLED) return km__stopped(err);
     if (st)
       return km__fail(err, st, KM_FIELD_TOLERANCE, -1, NAN,
@@ -634,6 +612,32 @@ static km_status plan_shaped(plan *pl, const theta_pieces *tp, double tol,
                       pl->limit);
   }
   return KM_ENOCONVERGE;
+}
+
+/* The output pieces within 0.9 tol, arc-length Hermite throughout: a
+ * cubic's neighbours merged across breaks of kappa where the bound allows
+ * (a signature breaks at every knot of its curve), then their speeds
+ * settled. */
+static km_status plan_arc_length(plan *pl, const theta_pieces *tp, int degree,
+                                 double tol, const km_signature *sig,
+                                 km_error *err) {
+  pl->n = 0;
+  pl->arc_length_only = true;
+  km_status st = plan_all(pl, tp, degree, 0.9 * tol, sig, err);
+  if (st || degree != 3) return st;
+  merge_cubic(pl, tp, 0.9 * tol);
+  return settle_plan(pl, tp, 0.9 * tol, err);
+}
+
+/* The output pieces with arc-shaped cubics where they bound closer, their
+ * neighbours merged where the bound allows and their end speeds settled. */
+static km_status plan_shaped(plan *pl, const theta_pieces *tp, double tol,
+                             const km_signature *sig, km_error *err) {
+  km_status st = plan_all(pl, tp, 3, 0.9 * tol, sig, err);
+  if (st) return st;
+  if (merge_shape(pl, tp, 0.9 * tol)) return km__stopped(err);
+  merge_cubic(pl, tp, 0.9 * tol);
+  return settle_plan(pl, tp, 0.9 * tol, err);
 }
 
 /* The fewer pieces of the two plans for cubics: arc-shaped pieces cannot
