@@ -23,7 +23,8 @@ PACKAGES := gcc make pkg-config libcmocka-dev libcjson-dev libmicrohttpd-dev \
             clang clang-format libclang-rt-14-dev curl jq valgrind libxml2-utils \
             librsvg2-bin nodejs npm wrk python3 python3-yaml python3-jsonschema \
             chromium python3-fonttools fonts-dejavu-core fonts-liberation2 \
-            python3-venv python3-wheel
+            python3-venv python3-wheel redis-server redis-tools nginx-light \
+            libhiredis-dev
 
 # The library headers a build needs, each as header:Debian package; a
 # build starts by checking them (check-deps) so that a machine without them
