@@ -2,6 +2,8 @@
  * framing.h). */
 #include "framing.h"
 
+#include "http_syntax.h"
+
 #include <stdio.h>
 #include <string.h>
 #include <strings.h>
@@ -38,12 +40,6 @@ static void refuse(srv_framing *f, int status, const char *fmt,
   f->refused_in = f->state;
   f->state = FR_REFUSED;
   snprintf(f->detail, sizeof f->detail, fmt, shown);
-}
-
-static bool is_tchar(unsigned char c) {
-  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
-         (c >= '0' && c <= '9') ||
-         (c != '\0' && strchr("!#$%&'*+-.^_`|~", c) != NULL);
 }
 
 static bool is_ows(char c) {
@@ -114,12 +110,7 @@ static void request_line(srv_framing *f, const char *p, size_t n) {
  * own, so only digits pass. */
 static void content_length(srv_framing *f, const char *v, size_t n) {
   unsigned long long x = 0;
-  bool ok = n > 0 && n <= 19;
-  for (size_t i = 0; ok && i < n; i++) {
-    ok = v[i] >= '0' && v[i] <= '9';
-    x = x * 10 + (unsigned)(v[i] - '0');
-  }
-  if (!ok)
+  if (!srv_http_decimal(v, n, &x))
     refuse(f, 400,
            "the Content-Length header is not a decimal number (digits "
            "only, at most 19)%s",
@@ -136,19 +127,9 @@ static void content_length(srv_framing *f, const char *v, size_t n) {
  * the same list is refused below rather than read two ways. */
 static void transfer_coding(srv_framing *f, const char *v, size_t n) {
   if (!(n == 7 && strncasecmp(v, "chunked", 7) == 0)) f->exact_chunked = false;
-  size_t i = 0;
-  while (i < n) {
-    while (i < n && (is_ows(v[i]) || v[i] == ',')) i++;
-    size_t b = i;
-    while (i < n && v[i] != ',') i++;
-    size_t e = i;
-    while (e > b && is_ows(v[e - 1])) e--;
-    if (e == b) continue;
-    f->codings++;
-    bool chunked = e - b == 7 && strncasecmp(v + b, "chunked", 7) == 0;
-    if (!chunked && f->coding[0] == '\0')
-      snprintf(f->coding, sizeof f->coding, "%.*s", (int)(e - b), v + b);
-  }
+  char other[sizeof f->coding];
+  f->codings += srv_http_codings(v, n, other, sizeof other);
+  if (f->coding[0] == '\0') memcpy(f->coding, other, sizeof other);
 }
 
 /* One field line of a head or a trailer section (not the empty one). */
@@ -176,7 +157,7 @@ static void field_line(srv_framing *f, const char *p, size_t n, bool head) {
     return;
   }
   for (size_t i = 0; i < name_len; i++)
-    if (!is_tchar((unsigned char)p[i])) {
+    if (!srv_http_tchar((unsigned char)p[i])) {
       refuse(f, 400,
              "the header field name \"%s\" is not a token (whitespace "
              "before the colon?)",

@@ -13,6 +13,8 @@
  */
 #include "http_guard.h"
 
+#include "http_syntax.h"
+
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -37,16 +39,10 @@ void srv_http_target_scan(srv_http_target *t, const char *uri) {
 
 /* ----------------------------------------------------------------- fields */
 
-static bool is_tchar(unsigned char c) {
-  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
-         (c >= '0' && c <= '9') ||
-         (c != '\0' && strchr("!#$%&'*+-.^_`|~", c) != NULL);
-}
-
 void srv_http_log_token(char *out, size_t n, const char *s) {
   size_t k = 0;
   for (; s != NULL && s[k] != '\0' && k + 1 < n; k++)
-    out[k] = is_tchar((unsigned char)s[k]) ? s[k] : '?';
+    out[k] = srv_http_tchar((unsigned char)s[k]) ? s[k] : '?';
   out[k] = '\0';
 }
 
@@ -94,31 +90,17 @@ static bool in_block(const scan *s, const char *p) {
 
 /* One transfer-coding list (RFC 9110 5.6.1: elements, OWS around commas). */
 static void codings(scan *s, const char *v, size_t n) {
-  size_t i = 0;
-  while (i < n) {
-    while (i < n && (v[i] == ' ' || v[i] == '\t' || v[i] == ',')) i++;
-    size_t b = i;
-    while (i < n && v[i] != ',') i++;
-    size_t e = i;
-    while (e > b && (v[e - 1] == ' ' || v[e - 1] == '\t')) e--;
-    if (e == b) continue;
-    s->codings++;
-    bool chunked = e - b == 7 && strncasecmp(v + b, "chunked", 7) == 0;
-    if (!chunked && !s->other_coding) {
-      s->other_coding = true;
-      snprintf(s->coding, sizeof s->coding, "%.*s", (int)(e - b), v + b);
-    }
+  char other[sizeof s->coding];
+  s->codings += srv_http_codings(v, n, other, sizeof other);
+  if (other[0] != '\0' && !s->other_coding) {
+    s->other_coding = true;
+    memcpy(s->coding, other, sizeof other);
   }
 }
 
 static void content_length(scan *s, const char *v, size_t n) {
   unsigned long long x = 0;
-  bool ok = n > 0 && n <= 19;
-  for (size_t i = 0; ok && i < n; i++) {
-    ok = v[i] >= '0' && v[i] <= '9';
-    x = x * 10 + (unsigned)(v[i] - '0');
-  }
-  if (!ok)
+  if (!srv_http_decimal(v, n, &x))
     refuse(s, 400, "the Content-Length header is not a decimal number%s", "",
            0);
   else if (s->lengths > 0 && x != s->length)
@@ -156,7 +138,7 @@ static enum MHD_Result field(void *cls, enum MHD_ValueKind kind,
     return MHD_NO;
   }
   for (size_t i = 0; i < name_len; i++)
-    if (!is_tchar((unsigned char)name[i])) {
+    if (!srv_http_tchar((unsigned char)name[i])) {
       refuse(s, 400,
              "the header field name \"%s\" is not a token "
              "(whitespace before the colon?)",
