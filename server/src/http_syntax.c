@@ -22,7 +22,9 @@ bool srv_http_decimal(const char *v, size_t n, unsigned long long *out) {
   return true;
 }
 
-static bool is_ows(char c) { return c == ' ' || c == '\t'; }
+static bool is_ows(char c) {
+  return c == ' ' || c == '\t';
+}
 
 unsigned srv_http_codings(const char *v, size_t n, char *other, size_t cap) {
   unsigned count = 0;
