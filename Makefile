@@ -58,6 +58,16 @@ API_OBJ  := $(API_SRC:%.c=$(BUILD)/%.o)
 SRV_OBJ  := $(SRV_SRC:%.c=$(BUILD)/%.o)
 
 LIBCORE := $(BUILD)/libkmorph.a
+# The shared core: ABI version MAJOR of VERSION in its SONAME, every
+# object position-independent and only the KM_API functions exported
+# (km/export.h); the static library is built from the same objects.
+SO_MAJOR := $(word 1,$(KM_VERSION_PARTS))
+SONAME   := libkmorph.so.$(SO_MAJOR)
+LIBSO    := $(BUILD)/libkmorph.so.$(KM_VERSION)
+CORE_PIC := -fPIC -fvisibility=hidden -fno-semantic-interposition
+# -z defs: the library names every library it needs (libm); sanitizer
+# builds leave their runtime's symbols to the executable.
+SO_DEFS  := $(if $(SANFLAGS),,-Wl,-z,defs)
 LIBAPI  := $(BUILD)/libkmapi.a
 CLI     := $(BUILD)/kmorph
 DAEMON  := $(BUILD)/kmorphd
@@ -70,7 +80,8 @@ SUPPORT_SRC := $(wildcard tests/support/*.c)
 
 .PHONY: all deps check-deps check build run test test-compound test-unit test-asan test-server test-clients check-layers format-check \
         bench bench-http fuzz fuzz-svg clean format examples \
-        test-fuzz test-hardening bench-load bench-hostile
+        test-fuzz test-hardening bench-load bench-hostile install uninstall \
+        test-packaging
 
 all: build
 
@@ -86,7 +97,7 @@ deps:
 	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $$missing >/dev/null; \
 	fi
 
-build: $(LIBCORE) $(LIBAPI) $(CLI) $(if $(SRV_SRC),$(DAEMON))
+build: $(LIBCORE) $(LIBSO) $(LIBAPI) $(CLI) $(if $(SRV_SRC),$(DAEMON))
 
 # Each header is preprocessed alone, so the compiler's own search path
 # decides, as it will for the real sources.
@@ -119,7 +130,7 @@ $(VERSION_H): packaging/version.h.in VERSION
 
 $(BUILD)/core/%.o: core/%.c | check-deps $(VERSION_H)
 	@mkdir -p $(@D)
-	$(CC) $(CFLAGS) $(CORE_INC) -MMD -MP -c $< -o $@
+	$(CC) $(CFLAGS) $(CORE_PIC) $(CORE_INC) -MMD -MP -c $< -o $@
 
 $(BUILD)/api/%.o: api/%.c | check-deps $(VERSION_H)
 	@mkdir -p $(@D)
@@ -132,6 +143,12 @@ $(BUILD)/server/%.o: server/%.c | check-deps
 $(LIBCORE): $(CORE_OBJ)
 	@mkdir -p $(@D)
 	rm -f $@ && ar rcs $@ $^
+
+$(LIBSO): $(CORE_OBJ)
+	@mkdir -p $(@D)
+	$(CC) -shared -Wl,-soname,$(SONAME) $(SO_DEFS) -o $@ $^ -lm $(LDFLAGS)
+	ln -sf $(@F) $(@D)/$(SONAME)
+	ln -sf $(SONAME) $(@D)/libkmorph.so
 
 $(LIBAPI): $(API_OBJ)
 	@mkdir -p $(@D)
@@ -223,6 +240,8 @@ test: deps
 	@$(MAKE) --no-print-directory test-fuzz || true
 	@echo "== hardening: bad-input barrage, daemon under ASan, leaks, load, faults"
 	@$(MAKE) --no-print-directory test-hardening || true
+	@echo "== packaging: make install into a temporary DESTDIR, used from there"
+	@$(MAKE) --no-print-directory test-packaging || true
 	@tests/summarise.sh
 
 # Compound morphs of every fixture pair at all 41 frames (make test: 21),
@@ -379,6 +398,92 @@ bench-load: build
 # Peak RSS and time of kmorphd under hostile clients (bench/hostile.py).
 bench-hostile: build
 	@python3 bench/hostile.py --daemon $(DAEMON)
+
+# ------------------------------------------------------------ install
+# make install [PREFIX=/usr/local] [DESTDIR=staging]: the shared and
+# static core, its km/ headers and kmorph.pc, the CLI and the daemon, the
+# web page (the installed daemon's default web root, found beside its
+# executable), the man pages, the systemd unit and its environment file.
+# The configured paths are written into kmorph.pc, the unit and the man
+# page; DESTDIR is only where the files go. make uninstall removes them.
+PREFIX     ?= /usr/local
+BINDIR     ?= $(PREFIX)/bin
+SBINDIR    ?= $(PREFIX)/sbin
+LIBDIR     ?= $(PREFIX)/lib
+INCLUDEDIR ?= $(PREFIX)/include
+DATADIR    ?= $(PREFIX)/share
+MANDIR     ?= $(DATADIR)/man
+UNITDIR    ?= $(PREFIX)/lib/systemd/system
+SYSCONFDIR ?= /etc
+INSTALL    ?= install
+
+# alloc.h is left out: its hook is a seam of the test build only.
+KM_HEADERS := $(filter-out core/include/km/alloc.h,$(wildcard core/include/km/*.h))
+WEB_FILES  := $(wildcard clients/web/*)
+PKG_GEN    := $(BUILD)/packaging
+PKG_SUBST  := sed -e 's|@VERSION@|$(KM_VERSION)|g' -e 's|@PREFIX@|$(PREFIX)|g' \
+  -e 's|@LIBDIR@|$(LIBDIR)|g' -e 's|@INCLUDEDIR@|$(INCLUDEDIR)|g' \
+  -e 's|@SBINDIR@|$(SBINDIR)|g' -e 's|@DATADIR@|$(DATADIR)|g' \
+  -e 's|@SYSCONFDIR@|$(SYSCONFDIR)|g'
+PKG_FILES  := $(PKG_GEN)/kmorph.pc $(PKG_GEN)/kmorph.1 $(PKG_GEN)/kmorphd.8 \
+              $(PKG_GEN)/kmorphd.service $(PKG_GEN)/kmorphd.env
+
+# The paths are baked in: a different PREFIX rewrites them.
+$(PKG_GEN)/paths: FORCE
+	@mkdir -p $(@D)
+	@echo '$(KM_VERSION) $(PREFIX) $(LIBDIR) $(INCLUDEDIR) $(SBINDIR) $(DATADIR) $(SYSCONFDIR)' > $@.new
+	@cmp -s $@.new $@ && rm -f $@.new || mv $@.new $@
+.PHONY: FORCE
+FORCE:
+
+$(PKG_GEN)/%: packaging/%.in $(PKG_GEN)/paths
+	$(PKG_SUBST) $< > $@
+$(PKG_GEN)/kmorph.1 $(PKG_GEN)/kmorphd.env: $(PKG_GEN)/%: packaging/% $(PKG_GEN)/paths
+	$(PKG_SUBST) $< > $@
+$(PKG_GEN)/kmorphd.8: packaging/kmorphd.8.in packaging/man-options.awk $(DAEMON) $(PKG_GEN)/paths
+	$(DAEMON) --help | awk -v web_root_default='$(DATADIR)/kmorph/web when installed, else clients/web' \
+	  -f packaging/man-options.awk > $@.options
+	$(PKG_SUBST) $< | sed -e '/^@OPTIONS@$$/{r $@.options' -e 'd}' > $@
+	rm -f $@.options
+
+install: build $(PKG_FILES)
+	$(INSTALL) -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(SBINDIR) $(DESTDIR)$(LIBDIR)/pkgconfig \
+	  $(DESTDIR)$(INCLUDEDIR)/km $(DESTDIR)$(DATADIR)/kmorph/web \
+	  $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(MANDIR)/man8 $(DESTDIR)$(UNITDIR)
+	$(INSTALL) -m 755 $(CLI) $(DESTDIR)$(BINDIR)/kmorph
+	$(INSTALL) -m 755 $(DAEMON) $(DESTDIR)$(SBINDIR)/kmorphd
+	$(INSTALL) -m 755 $(LIBSO) $(DESTDIR)$(LIBDIR)/
+	ln -sf $(notdir $(LIBSO)) $(DESTDIR)$(LIBDIR)/$(SONAME)
+	ln -sf $(SONAME) $(DESTDIR)$(LIBDIR)/libkmorph.so
+	$(INSTALL) -m 644 $(LIBCORE) $(DESTDIR)$(LIBDIR)/libkmorph.a
+	$(INSTALL) -m 644 $(KM_HEADERS) $(VERSION_H) $(DESTDIR)$(INCLUDEDIR)/km/
+	$(INSTALL) -m 644 $(PKG_GEN)/kmorph.pc $(DESTDIR)$(LIBDIR)/pkgconfig/
+	$(INSTALL) -m 644 $(WEB_FILES) $(DESTDIR)$(DATADIR)/kmorph/web/
+	$(INSTALL) -m 644 $(PKG_GEN)/kmorphd.env $(DESTDIR)$(DATADIR)/kmorph/
+	$(INSTALL) -m 644 $(PKG_GEN)/kmorph.1 $(DESTDIR)$(MANDIR)/man1/
+	$(INSTALL) -m 644 $(PKG_GEN)/kmorphd.8 $(DESTDIR)$(MANDIR)/man8/
+	$(INSTALL) -m 644 $(PKG_GEN)/kmorphd.service $(DESTDIR)$(UNITDIR)/
+
+# Only what install wrote: the folders are left when something else put
+# files there, and a site's @SYSCONFDIR@/kmorph/kmorphd.env is its own.
+uninstall:
+	rm -f $(DESTDIR)$(BINDIR)/kmorph $(DESTDIR)$(SBINDIR)/kmorphd \
+	  $(DESTDIR)$(LIBDIR)/$(notdir $(LIBSO)) $(DESTDIR)$(LIBDIR)/$(SONAME) \
+	  $(DESTDIR)$(LIBDIR)/libkmorph.so $(DESTDIR)$(LIBDIR)/libkmorph.a \
+	  $(DESTDIR)$(LIBDIR)/pkgconfig/kmorph.pc \
+	  $(addprefix $(DESTDIR)$(INCLUDEDIR)/km/,$(notdir $(KM_HEADERS) $(VERSION_H))) \
+	  $(addprefix $(DESTDIR)$(DATADIR)/kmorph/web/,$(notdir $(WEB_FILES))) \
+	  $(DESTDIR)$(DATADIR)/kmorph/kmorphd.env \
+	  $(DESTDIR)$(MANDIR)/man1/kmorph.1 $(DESTDIR)$(MANDIR)/man8/kmorphd.8 \
+	  $(DESTDIR)$(UNITDIR)/kmorphd.service
+	-rmdir $(DESTDIR)$(INCLUDEDIR)/km $(DESTDIR)$(DATADIR)/kmorph/web \
+	  $(DESTDIR)$(DATADIR)/kmorph 2>/dev/null
+
+# make install into a temporary DESTDIR, then the installed library built
+# against with pkg-config, the installed daemon serving the installed
+# page, the man pages and the unit checked (tests/packaging/run.sh).
+test-packaging: build
+	@tests/packaging/run.sh
 
 clean:
 	rm -rf build

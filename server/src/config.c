@@ -6,6 +6,7 @@
  * body limit of 0) with a message rather than clamping silently.
  */
 #include "config.h"
+#include "web_root.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -139,7 +140,7 @@ void srv_config_default(srv_config *cfg) {
   cfg->shutdown_grace = 10;
   cfg->retry_after = 1;
   snprintf(cfg->cors_origins, sizeof cfg->cors_origins, "*");
-  snprintf(cfg->web_root, sizeof cfg->web_root, "clients/web");
+  srv_default_web_root(cfg->web_root, sizeof cfg->web_root);
   cfg->access_log = true;
 }
 
@@ -170,8 +171,11 @@ void srv_config_usage(FILE *out) {
     print_default(out, o, &d);
     fprintf(out, ")\n");
   }
-  fprintf(out, "\n  --help                                    this text\n"
-               "  --version                                 version\n");
+  fprintf(out,
+          "\n  --help                                    this text\n"
+          "  --version                                 version\n"
+          "  --healthcheck URL                         GET URL once, exit 0 "
+          "on 200 (no server)\n");
   fprintf(out, "\nSignals: SIGTERM, SIGINT drain and stop; SIGHUP reopens "
                "--log-file;\nSIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM are logged "
                "and ignored.\n");

@@ -26,6 +26,7 @@
 #include <unistd.h>
 
 #include "config.h"
+#include "healthcheck.h"
 #include "log.h"
 #include "server.h"
 
@@ -141,6 +142,8 @@ static int fit_connections_to_fds(srv_config *cfg, srv_log *log) {
 }
 
 int main(int argc, char **argv) {
+  if (argc >= 2 && srv_healthcheck_requested(argv[1]))
+    return srv_healthcheck_main(argc, argv, stderr);
   srv_config cfg;
   srv_config_default(&cfg);
   int rc = srv_config_load(&cfg, argc, argv, stdout, stderr);

@@ -26,6 +26,8 @@
 #ifndef KM_CURVE_H
 #define KM_CURVE_H
 
+#include "km/export.h"
+
 #include <stdbool.h>
 #include <stddef.h>
 
@@ -43,10 +45,10 @@ typedef struct km_curve {
 
 /* Make *c empty (all zero), so that km_curve_free may follow whatever
  * happens. c may be NULL. Allocates nothing. */
-void km_curve_init(km_curve *c);
+KM_API void km_curve_init(km_curve *c);
 
 /* Free what *c owns and leave it empty. c may be NULL or empty. */
-void km_curve_free(km_curve *c);
+KM_API void km_curve_free(km_curve *c);
 
 /* Build a curve from borrowed arrays, deep-copied, validating everything.
  *   out     (out) the new curve, owned by the caller (km_curve_free).
@@ -75,17 +77,17 @@ void km_curve_free(km_curve *c);
  *                  KM_MAX_COORDINATE] (KM_FIELD_WEIGHTS);
  *   KM_ECLOSED     closed but the end points differ (KM_FIELD_CLOSED);
  *   KM_ENOMEM. */
-km_status km_curve_create(km_curve *out, int degree, size_t n,
-                          const double *knots, const double *cp,
-                          const double *w, bool closed, km_error *err);
+KM_API km_status km_curve_create(km_curve *out, int degree, size_t n,
+                                 const double *knots, const double *cp,
+                                 const double *w, bool closed, km_error *err);
 
 /* Deep copy of c into out (owned by the caller), closed flag included.
  * Returns KM_OK or KM_ENOMEM; an empty c (nothing to copy) also gives
  * KM_ENOMEM. */
-km_status km_curve_copy(km_curve *out, const km_curve *c, km_error *err);
+KM_API km_status km_curve_copy(km_curve *out, const km_curve *c, km_error *err);
 
 /* Parameter domain [knots[degree], knots[n]] into *t0 and *t1 (out). */
-void km_curve_domain(const km_curve *c, double *t0, double *t1);
+KM_API void km_curve_domain(const km_curve *c, double *t0, double *t1);
 
 /* Position and derivatives with respect to t at t, which is clamped to the
  * domain. out (out) has nder + 1 rows, nder clamped to 0..3: out[k][0..1]
@@ -93,12 +95,13 @@ void km_curve_domain(const km_curve *c, double *t0, double *t1);
  * curve are 0; rational curves use the quotient rule. At an interior knot
  * the right-hand limit is used, at the end of the domain the left one;
  * km_curve_eval_side chooses. */
-void km_curve_eval(const km_curve *c, double t, int nder, double out[][2]);
+KM_API void km_curve_eval(const km_curve *c, double t, int nder,
+                          double out[][2]);
 
 /* km_curve_eval with the side chosen at a knot: side < 0 the left limit,
  * side >= 0 the right limit (the left one at the end of the domain). */
-void km_curve_eval_side(const km_curve *c, double t, int side, int nder,
-                        double out[][2]);
+KM_API void km_curve_eval_side(const km_curve *c, double t, int side, int nder,
+                               double out[][2]);
 
 /* Insert knot t (in the domain) `times` times, capped so that no interior
  * multiplicity exceeds the degree; at a domain end nothing is inserted
@@ -106,8 +109,8 @@ void km_curve_eval_side(const km_curve *c, double t, int side, int nder,
  * parameterisation and closed flag. Returns KM_OK, KM_EINVAL (c not a
  * curve; times < 0, field KM_FIELD_TIMES), KM_ENONFINITE (t),
  * KM_ERANGE (t outside the domain; err->param = t), KM_ENOMEM. */
-km_status km_curve_insert_knot(km_curve *out, const km_curve *c, double t,
-                               int times, km_error *err);
+KM_API km_status km_curve_insert_knot(km_curve *out, const km_curve *c,
+                                      double t, int times, km_error *err);
 
 /* Split c at t strictly inside the domain into *left on [t0, t] and
  * *right on [t, t1], both open (closed false), meeting in one
@@ -115,26 +118,28 @@ km_status km_curve_insert_knot(km_curve *out, const km_curve *c, double t,
  * KM_EINVAL (c not a curve), KM_ERANGE / KM_ENONFINITE (t not inside the
  * domain; err->param = t), KM_ENOMEM; on failure neither output is
  * written. */
-km_status km_curve_split(const km_curve *c, double t, km_curve *left,
-                         km_curve *right, km_error *err);
+KM_API km_status km_curve_split(const km_curve *c, double t, km_curve *left,
+                                km_curve *right, km_error *err);
 
 /* Same trace backwards on the same domain: out(a + b - t) = c(t), closed
  * flag kept; out owned by the caller. Returns KM_OK, KM_EINVAL (c not a
  * curve), KM_ENOMEM. */
-km_status km_curve_reverse(km_curve *out, const km_curve *c, km_error *err);
+KM_API km_status km_curve_reverse(km_curve *out, const km_curve *c,
+                                  km_error *err);
 
 /* Bezier form: every interior knot raised to multiplicity `degree`, so
  * span i has control points degree*i .. degree*(i+1). Same trace, domain
  * and closed flag; out owned by the caller. Returns KM_OK, KM_EINVAL (c
  * not a curve), KM_ENOMEM. */
-km_status km_curve_to_bezier(km_curve *out, const km_curve *c, km_error *err);
+KM_API km_status km_curve_to_bezier(km_curve *out, const km_curve *c,
+                                    km_error *err);
 
 /* Degree raised by times >= 0 (exact); each distinct knot's multiplicity
  * grows by times; closed flag kept; out owned by the caller. Returns KM_OK,
  * KM_EINVAL (c not a curve; times < 0, field KM_FIELD_TIMES), KM_EDEGREE
  * (degree + times above KM_MAX_DEGREE, field KM_FIELD_TIMES), KM_ENOMEM. */
-km_status km_curve_elevate(km_curve *out, const km_curve *c, int times,
-                           km_error *err);
+KM_API km_status km_curve_elevate(km_curve *out, const km_curve *c, int times,
+                                  km_error *err);
 
 /* Make a and b compatible: both reparameterised linearly onto [0, 1],
  * raised to the larger degree, one merged knot vector (each knot with the
@@ -145,16 +150,16 @@ km_status km_curve_elevate(km_curve *out, const km_curve *c, int times,
  * by the caller, and on failure neither is written. Returns KM_OK,
  * KM_EINVAL (a or b not a curve), KM_EKNOTS (the merged knot vectors do
  * not agree: rounding, not met in practice), KM_ENOMEM. */
-km_status km_curve_make_compatible(const km_curve *a, const km_curve *b,
-                                   km_curve *out_a, km_curve *out_b,
-                                   km_error *err);
+KM_API km_status km_curve_make_compatible(const km_curve *a, const km_curve *b,
+                                          km_curve *out_a, km_curve *out_b,
+                                          km_error *err);
 
 /* Linear reparameterisation of the domain onto [t0, t1]; the trace is
  * unchanged, the domain ends exact; out owned by the caller. Returns
  * KM_OK, KM_EINVAL (c not a curve), KM_ENONFINITE (t0 or t1), KM_ERANGE
  * (t0 >= t1, or |t0| or |t1| > KM_MAX_COORDINATE), KM_ENOMEM. */
-km_status km_curve_reparam(km_curve *out, const km_curve *c, double t0,
-                           double t1, km_error *err);
+KM_API km_status km_curve_reparam(km_curve *out, const km_curve *c, double t0,
+                                  double t1, km_error *err);
 
 /* Arc length of the whole curve, or between parameters ta and tb (each
  * clamped to the domain; 0 unless ta < tb). Adaptive Gauss-Legendre per
@@ -164,15 +169,15 @@ km_status km_curve_reparam(km_curve *out, const km_curve *c, double t0,
  * when the speed over a span is rounding noise and the quadrature cannot
  * reach that precision (km_signature_compute refuses such a curve with
  * KM_ENOCONVERGE): callers that must not see NaN check isfinite. */
-double km_curve_length(const km_curve *c);
-double km_curve_length_between(const km_curve *c, double ta, double tb);
+KM_API double km_curve_length(const km_curve *c);
+KM_API double km_curve_length_between(const km_curve *c, double ta, double tb);
 
 /* Inverse of arc length: the parameter t with length(t0, t) = s. s <= 0
  * gives t0, s at or beyond the length t1. Safeguarded Newton inside the span
  * holding s (bisection when a step leaves the bracket, at most
  * KM_MAX_NEWTON_ITERATIONS steps), to |length error| <= 1e-13 of that
  * span's length. */
-double km_curve_param_at_length(const km_curve *c, double s);
+KM_API double km_curve_param_at_length(const km_curve *c, double s);
 
 /* The cubic B-spline interpolating the n points pts (2n coordinates),
  * chord-length parameters on [0, 1]. Open: not-a-knot ends; 2 points give
@@ -187,8 +192,8 @@ double km_curve_param_at_length(const km_curve *c, double s);
  * or points too close to separate; KM_FIELD_POINTS), KM_ENOCONVERGE (the
  * interpolation system is singular; KM_FIELD_POINTS), KM_ERANGE (the
  * interpolant overflows the coordinate range, index -1), KM_ENOMEM. */
-km_status km_curve_interpolate(km_curve *out, const double *pts, size_t n,
-                               bool closed, km_error *err);
+KM_API km_status km_curve_interpolate(km_curve *out, const double *pts,
+                                      size_t n, bool closed, km_error *err);
 
 /* A cubic B-spline with few control points that passes through the first
  * and last point (closed: through the first point, tangent continuous at
@@ -199,8 +204,8 @@ km_status km_curve_interpolate(km_curve *out, const double *pts, size_t n,
  * of km_curve_interpolate. out owned by the caller. Returns
  * km_curve_interpolate's statuses, km_curve_create's for the fitted
  * control points (KM_FIELD_CONTROL_POINTS), KM_ENOMEM. */
-km_status km_curve_fit_points(km_curve *out, const double *pts, size_t n,
-                              bool closed, double tol, km_error *err);
+KM_API km_status km_curve_fit_points(km_curve *out, const double *pts, size_t n,
+                                     bool closed, double tol, km_error *err);
 
 /* Rigid motion x' = R x + (tx, ty) of the control points, R the rotation
  * by `rot` radians about the origin (exact for NURBS: rational curves are
@@ -208,8 +213,9 @@ km_status km_curve_fit_points(km_curve *out, const double *pts, size_t n,
  * KM_OK, KM_EINVAL (c not a curve), KM_ENONFINITE (rot, tx or ty),
  * KM_ERANGE (a moved point beyond KM_MAX_COORDINATE; field
  * KM_FIELD_CONTROL_POINTS, err->index names it), KM_ENOMEM. */
-km_status km_curve_transform(km_curve *out, const km_curve *c, double rot,
-                             double tx, double ty, km_error *err);
+KM_API km_status km_curve_transform(km_curve *out, const km_curve *c,
+                                    double rot, double tx, double ty,
+                                    km_error *err);
 
 /* Number of proper self-crossings of c: points where two different
  * parameters meet within tol (absolute, at least 1e-13 of the control
@@ -222,14 +228,16 @@ km_status km_curve_transform(km_curve *out, const km_curve *c, double rot,
  * of the true count. Returns the count, 0 for a curve that is one point,
  * or -1 when c is not a curve (NULL, empty) or memory runs out. Allocates
  * only scratch. */
-long km_curve_self_intersections(const km_curve *c, double tol);
+KM_API long km_curve_self_intersections(const km_curve *c, double tol);
 
 /* km_curve_self_intersections that ends early when stop (km/stop.h; NULL:
  * never) asks it to. *count (out) receives the count on KM_OK only.
  * Returns KM_OK, KM_ECANCELLED, KM_EINVAL (c not a curve), KM_ENOMEM.
  * It takes no km_error: nothing but memory can fail and no field is at
  * fault. */
-km_status km_curve_self_intersections_until(const km_curve *c, double tol,
-                                            const km_stop *stop, long *count);
+KM_API km_status km_curve_self_intersections_until(const km_curve *c,
+                                                   double tol,
+                                                   const km_stop *stop,
+                                                   long *count);
 
 #endif

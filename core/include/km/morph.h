@@ -10,6 +10,8 @@
 #ifndef KM_MORPH_H
 #define KM_MORPH_H
 
+#include "km/export.h"
+
 #include <stdbool.h>
 #include <stddef.h>
 
@@ -98,7 +100,7 @@ typedef struct km_morph_options {
  * turning blend, automatic closure, fit anchor, automatic orientation,
  * default tolerance, degree 3, no matches, no bound beyond the core's, no
  * stop. */
-void km_morph_options_default(km_morph_options *o);
+KM_API void km_morph_options_default(km_morph_options *o);
 
 /* One input: a curve, a signature, or both (the signature of that curve).
  * With only a signature the curve is reconstructed when needed. */
@@ -154,12 +156,12 @@ typedef struct km_morph km_morph;
  *                   automatic matches, start search, plans and preview
  *                   frames all poll it; nothing is leaked);
  *   KM_ENOMEM. */
-km_status km_morph_create(km_morph **out, const km_morph_input *from,
-                          const km_morph_input *to, const km_morph_options *opt,
-                          km_error *err);
+KM_API km_status km_morph_create(km_morph **out, const km_morph_input *from,
+                                 const km_morph_input *to,
+                                 const km_morph_options *opt, km_error *err);
 
 /* Free the morph and everything it holds; m may be NULL. */
-void km_morph_free(km_morph *m);
+KM_API void km_morph_free(km_morph *m);
 
 /* Frame at time t in [0, 1] into *out (owned by the caller): its curve
  * (degree opt.degree for curvature frames; the compatible degree of the
@@ -181,18 +183,19 @@ void km_morph_free(km_morph *m);
  *   km_signature_create's statuses for the blended signature;
  *   KM_ENOMEM.
  * Thread-safe on a shared km_morph: it is only read. */
-km_status km_morph_frame(const km_morph *m, double t, km_curve *out,
-                         km_frame_metrics *metrics, km_signature *sig_out,
-                         km_error *err);
+KM_API km_status km_morph_frame(const km_morph *m, double t, km_curve *out,
+                                km_frame_metrics *metrics,
+                                km_signature *sig_out, km_error *err);
 
 /* km_morph_frame that ends early when stop (km/stop.h; NULL: never) asks
  * it to: then KM_ECANCELLED and nothing written to out, metrics or
  * sig_out. The blend, closure, reconstruction, plan passes and the
  * crossing count of the metrics poll it. Distinct calls may pass distinct
  * stops on one shared morph. Other statuses as km_morph_frame. */
-km_status km_morph_frame_until(const km_morph *m, double t, const km_stop *stop,
-                               km_curve *out, km_frame_metrics *metrics,
-                               km_signature *sig_out, km_error *err);
+KM_API km_status km_morph_frame_until(const km_morph *m, double t,
+                                      const km_stop *stop, km_curve *out,
+                                      km_frame_metrics *metrics,
+                                      km_signature *sig_out, km_error *err);
 
 /* What a frame is asked for: its curve alone, or its metrics or signature
  * too (such frames are blended and reconstructed exactly, not taken from
@@ -209,15 +212,17 @@ typedef enum km_frame_parts {
  * morph's curves; otherwise at the cost of the frame's blend and closure
  * (a third to a half of the frame). Stops as km_morph_frame_until (stop
  * may be NULL). Statuses as km_morph_frame_until. Thread-safe. */
-km_status km_morph_frame_points(const km_morph *m, double t,
-                                km_frame_parts parts, const km_stop *stop,
-                                size_t *points, km_error *err);
+KM_API km_status km_morph_frame_points(const km_morph *m, double t,
+                                       km_frame_parts parts,
+                                       const km_stop *stop, size_t *points,
+                                       km_error *err);
 
 /* The correspondence used, as pairs of arc-length fractions (r_from, r_to)
  * strictly inside (0, 1): writes the first min(count, cap) pairs into
  * pairs (out, 2 cap doubles; may be NULL to ask the count) and returns
  * the count, the given or automatic matches (0 without matches). */
-size_t km_morph_matches_used(const km_morph *m, double *pairs, size_t cap);
+KM_API size_t km_morph_matches_used(const km_morph *m, double *pairs,
+                                    size_t cap);
 
 /* What km_morph_create's crossing avoidance did (intersections AVOID). */
 typedef struct km_morph_avoidance {
@@ -232,11 +237,12 @@ typedef struct km_morph_avoidance {
 
 /* The report of km_morph_create's avoidance into *out (all zero when
  * intersections was ALLOW or the inputs are not curvature-morphed). */
-void km_morph_avoided(const km_morph *m, km_morph_avoidance *out);
+KM_API void km_morph_avoided(const km_morph *m, km_morph_avoidance *out);
 
 /* Lengths and turnings (total tangent turn in radians, 2 pi times the
  * turning number for a closed curve) of the two prepared inputs, from
  * first, to second, into length and turning (out). */
-void km_morph_inputs(const km_morph *m, double length[2], double turning[2]);
+KM_API void km_morph_inputs(const km_morph *m, double length[2],
+                            double turning[2]);
 
 #endif

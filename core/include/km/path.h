@@ -20,6 +20,8 @@
 #ifndef KM_PATH_H
 #define KM_PATH_H
 
+#include "km/export.h"
+
 #include <stdbool.h>
 #include <stddef.h>
 
@@ -45,16 +47,16 @@ typedef struct km_path {
 } km_path;
 
 /* Make *p an empty builder (no start point, no pieces). Allocates nothing. */
-void km_path_init(km_path *p);
+KM_API void km_path_init(km_path *p);
 
 /* Free the pieces and leave *p empty; p may be NULL or empty. */
-void km_path_free(km_path *p);
+KM_API void km_path_free(km_path *p);
 
 /* Set the start point (and current point). Allowed once, before any piece.
  * Returns KM_OK, KM_EINVAL if called again or after close; KM_ENONFINITE /
  * KM_ERANGE (|coordinate| > KM_MAX_COORDINATE) for bad coordinates
  * (KM_FIELD_CONTROL_POINTS, err->index 0 for x, 1 for y). */
-km_status km_path_move_to(km_path *p, double x, double y, km_error *err);
+KM_API km_status km_path_move_to(km_path *p, double x, double y, km_error *err);
 
 /* Append a straight line / quadratic / cubic Bezier from the current point;
  * the last point becomes the current point. Returns KM_OK, KM_EINVAL if
@@ -62,11 +64,11 @@ km_status km_path_move_to(km_path *p, double x, double y, km_error *err);
  * coordinates (KM_FIELD_CONTROL_POINTS, err->index the coordinate
  * argument at fault, 0-based: x1 is 0, y1 is 1, ...); KM_ELIMIT beyond
  * KM_MAX_PIECES pieces; KM_ENOMEM. */
-km_status km_path_line_to(km_path *p, double x, double y, km_error *err);
-km_status km_path_quad_to(km_path *p, double x1, double y1, double x, double y,
-                          km_error *err);
-km_status km_path_cubic_to(km_path *p, double x1, double y1, double x2,
-                           double y2, double x, double y, km_error *err);
+KM_API km_status km_path_line_to(km_path *p, double x, double y, km_error *err);
+KM_API km_status km_path_quad_to(km_path *p, double x1, double y1, double x,
+                                 double y, km_error *err);
+KM_API km_status km_path_cubic_to(km_path *p, double x1, double y1, double x2,
+                                  double y2, double x, double y, km_error *err);
 
 /* Append an elliptical arc to (x, y) in SVG endpoint parameterisation:
  * radii rx, ry (signs ignored), x-axis rotation in degrees, the two flags.
@@ -80,19 +82,19 @@ km_status km_path_cubic_to(km_path *p, double x1, double y1, double x2,
  * eccentric ellipse), which the index does not tell apart. On KM_ELIMIT or
  * KM_ENOMEM the pieces of the arc recorded before the failure stay in p:
  * free the builder rather than go on. */
-km_status km_path_arc_to(km_path *p, double rx, double ry, double x_rot_deg,
-                         bool large_arc, bool sweep, double x, double y,
-                         km_error *err);
+KM_API km_status km_path_arc_to(km_path *p, double rx, double ry,
+                                double x_rot_deg, bool large_arc, bool sweep,
+                                double x, double y, km_error *err);
 
 /* Close the path: a straight line back to the start point when the current
  * point is elsewhere. Further pieces are refused. Returns KM_OK, KM_EINVAL
  * without a start point or when already closed, and km_path_line_to's
  * KM_ELIMIT / KM_ENOMEM for the closing line. */
-km_status km_path_close(km_path *p, km_error *err);
+KM_API km_status km_path_close(km_path *p, km_error *err);
 
 /* Current point into pt (out): the end of the last piece, the start
  * point before any piece, (0, 0) before km_path_move_to. */
-void km_path_current(const km_path *p, double pt[2]);
+KM_API void km_path_current(const km_path *p, double pt[2]);
 
 /* Build the curve. A piece whose control points all lie within eps (>= 0)
  * of the end of the previous kept piece is dropped (eps = 0: only pieces
@@ -102,7 +104,7 @@ void km_path_current(const km_path *p, double pt[2]);
  * taken as 0. Returns KM_OK, KM_EDEGENERATE (no start point, no pieces, or nothing
  * left; KM_FIELD_CONTROL_POINTS), KM_ENOMEM, or a km_curve_create status.
  * *out is owned by the caller (km_curve_free); p is not changed. */
-km_status km_path_to_curve(const km_path *p, double eps, km_curve *out,
-                           km_error *err);
+KM_API km_status km_path_to_curve(const km_path *p, double eps, km_curve *out,
+                                  km_error *err);
 
 #endif

@@ -17,6 +17,8 @@
 #ifndef KM_RECONSTRUCT_H
 #define KM_RECONSTRUCT_H
 
+#include "km/export.h"
+
 #include "km/curve.h"
 #include "km/signature.h"
 #include "km/stop.h"
@@ -42,8 +44,9 @@
  * piece of sig, or than KM_MAX_PIECES; KM_FIELD_TOLERANCE: a looser
  * tolerance helps), KM_EINVAL (an internal inconsistency building the
  * B-spline: a bug, never expected), KM_ENOMEM. */
-km_status km_reconstruct(const km_signature *sig, int degree, double tol,
-                         km_curve *out, double *error_bound, km_error *err);
+KM_API km_status km_reconstruct(const km_signature *sig, int degree, double tol,
+                                km_curve *out, double *error_bound,
+                                km_error *err);
 
 /* km_reconstruct with the result's control points bounded by max_points
  * (0: the core's own bound alone): a curve needing more fails with
@@ -51,17 +54,18 @@ km_status km_reconstruct(const km_signature *sig, int degree, double tol,
  * as `degree` points per output piece, and the first piece has one more,
  * so a result may have max_points + 1 points. The service holds answers
  * to its limit on curves this way. Statuses as km_reconstruct. */
-km_status km_reconstruct_within(const km_signature *sig, int degree, double tol,
-                                size_t max_points, km_curve *out,
-                                double *error_bound, km_error *err);
+KM_API km_status km_reconstruct_within(const km_signature *sig, int degree,
+                                       double tol, size_t max_points,
+                                       km_curve *out, double *error_bound,
+                                       km_error *err);
 
 /* km_reconstruct_within that ends early when stop (km/stop.h; NULL:
  * never) asks it to: then KM_ECANCELLED, *out and *error_bound untouched,
  * nothing leaked. Polled every KM_STOP_POLL_UNITS units of work (an output
  * piece planned, a quadrature node). Other statuses as km_reconstruct. */
-km_status km_reconstruct_until(const km_signature *sig, int degree, double tol,
-                               size_t max_points, const km_stop *stop,
-                               km_curve *out, double *error_bound,
-                               km_error *err);
+KM_API km_status km_reconstruct_until(const km_signature *sig, int degree,
+                                      double tol, size_t max_points,
+                                      const km_stop *stop, km_curve *out,
+                                      double *error_bound, km_error *err);
 
 #endif

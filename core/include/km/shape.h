@@ -30,6 +30,8 @@
 #ifndef KM_SHAPE_H
 #define KM_SHAPE_H
 
+#include "km/export.h"
+
 #include <stdbool.h>
 #include <stddef.h>
 
@@ -84,10 +86,10 @@ typedef struct km_shape_limits {
 } km_shape_limits;
 
 /* Make *s empty; s may be NULL. Allocates nothing. */
-void km_shape_init(km_shape *s);
+KM_API void km_shape_init(km_shape *s);
 
 /* Free what *s owns and leave it empty; s may be NULL or empty. */
-void km_shape_free(km_shape *s);
+KM_API void km_shape_free(km_shape *s);
 
 /* Build a shape from n borrowed contours (deep-copied, reoriented per
  * role) under fill rule `fill`, within *lim (NULL: defaults; fields above
@@ -105,19 +107,19 @@ void km_shape_free(km_shape *s);
  *                  (KM_FIELD_CONTROL_POINTS);
  *   KM_ENONFINITE  a contour's length or area is not finite;
  *   KM_ENOMEM. */
-km_status km_shape_create(km_shape *out, const km_curve *contours, size_t n,
-                          km_fill_rule fill, const km_shape_limits *lim,
-                          km_error *err);
+KM_API km_status km_shape_create(km_shape *out, const km_curve *contours,
+                                 size_t n, km_fill_rule fill,
+                                 const km_shape_limits *lim, km_error *err);
 
 /* Deep copy of s into out (owned by the caller). KM_OK, KM_EINVAL (s
  * empty), KM_ENOMEM. */
-km_status km_shape_copy(km_shape *out, const km_shape *s, km_error *err);
+KM_API km_status km_shape_copy(km_shape *out, const km_shape *s, km_error *err);
 
 /* Winding number of the point p about contour i of s (its flattening, see
  * above): +1 inside a counter-clockwise contour, -1 inside a clockwise
  * one, 0 outside. A point within the chord error of the contour may get
  * either answer. */
-int km_shape_winding(const km_shape *s, size_t i, const double p[2]);
+KM_API int km_shape_winding(const km_shape *s, size_t i, const double p[2]);
 
 /* ---- pairing ------------------------------------------------------------ */
 
@@ -147,7 +149,7 @@ typedef struct km_shape_pair_costs {
 } km_shape_pair_costs;
 
 /* Fill *c with the defaults noted on each field. */
-void km_shape_pair_costs_default(km_shape_pair_costs *c);
+KM_API void km_shape_pair_costs_default(km_shape_pair_costs *c);
 
 /* The optimal pairing of a's contours with b's under *costs (NULL:
  * defaults), level by level: the top-level contours among themselves,
@@ -159,13 +161,13 @@ void km_shape_pair_costs_default(km_shape_pair_costs *c);
  * a's order, then a's unpaired ones, then b's. Returns KM_OK, KM_EINVAL
  * (a or b empty, a cost not finite or negative), KM_ECANCELLED (stop),
  * KM_ENOMEM. */
-km_status km_shape_pair_auto(const km_shape *a, const km_shape *b,
-                             const km_shape_pair_costs *costs,
-                             const km_stop *stop, km_shape_pair **pairs,
-                             size_t *npairs, km_error *err);
+KM_API km_status km_shape_pair_auto(const km_shape *a, const km_shape *b,
+                                    const km_shape_pair_costs *costs,
+                                    const km_stop *stop, km_shape_pair **pairs,
+                                    size_t *npairs, km_error *err);
 
 /* Free pairs from km_shape_pair_auto; NULL is a no-op. */
-void km_shape_pairs_free(km_shape_pair *pairs);
+KM_API void km_shape_pairs_free(km_shape_pair *pairs);
 
 /* Check a caller's pairing of a with b: every contour of a and of b in
  * exactly one pair, indices in range, no pair (-1, -1), paired contours of
@@ -174,9 +176,9 @@ void km_shape_pairs_free(km_shape_pair *pairs);
  * err->index the pair at fault; for a contour in no pair, index npairs and
  * the message names the contour), KM_EINVAL (pairs NULL with npairs > 0,
  * a or b empty). */
-km_status km_shape_pair_check(const km_shape *a, const km_shape *b,
-                              const km_shape_pair *pairs, size_t npairs,
-                              km_error *err);
+KM_API km_status km_shape_pair_check(const km_shape *a, const km_shape *b,
+                                     const km_shape_pair *pairs, size_t npairs,
+                                     km_error *err);
 
 /* ---- the compound morph ------------------------------------------------- */
 
@@ -190,7 +192,7 @@ typedef struct km_shape_morph_options {
 
 /* Fill *o with defaults: km_morph_options_default, automatic pairing,
  * km_shape_pair_costs_default. */
-void km_shape_morph_options_default(km_shape_morph_options *o);
+KM_API void km_shape_morph_options_default(km_shape_morph_options *o);
 
 typedef struct km_shape_morph km_shape_morph;
 
@@ -215,8 +217,8 @@ typedef struct km_shape_frame {
   size_t adjusted;           /* contours moved to keep them in their parent */
 } km_shape_frame;
 
-void km_shape_frame_init(km_shape_frame *f);
-void km_shape_frame_free(km_shape_frame *f);
+KM_API void km_shape_frame_init(km_shape_frame *f);
+KM_API void km_shape_frame_free(km_shape_frame *f);
 
 /* Prepare the morph from -> to into *out (owned by the caller,
  * km_shape_morph_free). opt may be NULL (defaults). Pairs come from
@@ -237,23 +239,23 @@ void km_shape_frame_free(km_shape_frame *f);
  *   km_shape_pair_check's statuses for opt->pairs;
  *   km_morph_create's statuses for a pair (err->index the pair);
  *   KM_ECANCELLED, KM_ENOMEM. */
-km_status km_shape_morph_create(km_shape_morph **out, const km_shape *from,
-                                const km_shape *to,
-                                const km_shape_morph_options *opt,
-                                const km_stop *stop, km_error *err);
+KM_API km_status km_shape_morph_create(km_shape_morph **out,
+                                       const km_shape *from, const km_shape *to,
+                                       const km_shape_morph_options *opt,
+                                       const km_stop *stop, km_error *err);
 
-void km_shape_morph_free(km_shape_morph *m);
+KM_API void km_shape_morph_free(km_shape_morph *m);
 
 /* The pairs used (the pair order of the frames): writes min(count, cap)
  * into pairs (may be NULL) and returns the count. */
-size_t km_shape_morph_pairs(const km_shape_morph *m, km_shape_pair *pairs,
-                            size_t cap);
+KM_API size_t km_shape_morph_pairs(const km_shape_morph *m,
+                                   km_shape_pair *pairs, size_t cap);
 
 /* The point an unpaired contour collapses into: where slot `slot` of m
  * vanishes (at t = 1) or appears from (at t = 0), written to p. False,
  * p untouched, for a paired slot or a slot out of range. */
-bool km_shape_morph_collapse_point(const km_shape_morph *m, size_t slot,
-                                   double p[2]);
+KM_API bool km_shape_morph_collapse_point(const km_shape_morph *m, size_t slot,
+                                          double p[2]);
 
 /* Frame at t in [0, 1] into *out (owned by the caller, km_shape_frame
  * _free; taken as empty). Each pair's curve is km_morph_frame_until's at t
@@ -275,8 +277,8 @@ bool km_shape_morph_collapse_point(const km_shape_morph *m, size_t slot,
  *   km_morph_frame_until's statuses (err->index the pair);
  *   KM_ECANCELLED, KM_ENOMEM.
  * Thread-safe on a shared morph. */
-km_status km_shape_morph_frame_until(const km_shape_morph *m, double t,
-                                     const km_stop *stop, km_shape_frame *out,
-                                     km_error *err);
+KM_API km_status km_shape_morph_frame_until(const km_shape_morph *m, double t,
+                                            const km_stop *stop,
+                                            km_shape_frame *out, km_error *err);
 
 #endif

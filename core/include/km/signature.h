@@ -14,6 +14,8 @@
 #ifndef KM_SIGNATURE_H
 #define KM_SIGNATURE_H
 
+#include "km/export.h"
+
 #include <stdbool.h>
 #include <stddef.h>
 
@@ -39,16 +41,16 @@ typedef struct km_signature {
 
 /* Make *sig empty (all zero, kappa empty); sig may be NULL. Allocates
  * nothing. */
-void km_signature_init(km_signature *sig);
+KM_API void km_signature_init(km_signature *sig);
 
 /* Free what *sig owns and leave it empty; sig may be NULL or empty. */
-void km_signature_free(km_signature *sig);
+KM_API void km_signature_free(km_signature *sig);
 
 /* Deep copy of sig into out (owned by the caller), validated again as
  * km_signature_create, whose statuses it returns (an empty sig gives
  * KM_ERANGE on its length). */
-km_status km_signature_copy(km_signature *out, const km_signature *sig,
-                            km_error *err);
+KM_API km_status km_signature_copy(km_signature *out, const km_signature *sig,
+                                   km_error *err);
 
 /* Validating constructor: kappa (a valid km_fn) and the ncorners corners
  * are borrowed and copied into out (owned by the caller); turning is
@@ -71,10 +73,11 @@ km_status km_signature_copy(km_signature *out, const km_signature *sig,
  *                  times plus one per four coefficients of kappa (see
  *                  km/limits.h; KM_FIELD_KAPPA_COEFFICIENTS);
  *   km_fn_copy's statuses for kappa; KM_ENOMEM. */
-km_status km_signature_create(km_signature *out, double length,
-                              const double start[2], double angle,
-                              const km_fn *kappa, const km_corner *corners,
-                              size_t ncorners, bool closed, km_error *err);
+KM_API km_status km_signature_create(km_signature *out, double length,
+                                     const double start[2], double angle,
+                                     const km_fn *kappa,
+                                     const km_corner *corners, size_t ncorners,
+                                     bool closed, km_error *err);
 
 /* Signature of the curve c into out (owned by the caller). tol is the
  * largest allowed distance between the curve the signature describes and
@@ -105,23 +108,23 @@ km_status km_signature_create(km_signature *out, double length,
  *   KM_ELIMIT       the work budget spent (KM_FIELD_TOLERANCE: a looser
  *                   tolerance helps), or more than KM_MAX_PIECES pieces;
  *   KM_ENOMEM. */
-km_status km_signature_compute(const km_curve *c, double tol, km_signature *out,
-                               km_error *err);
+KM_API km_status km_signature_compute(const km_curve *c, double tol,
+                                      km_signature *out, km_error *err);
 
 /* km_signature_compute that ends early when stop (km/stop.h; NULL: never)
  * asks it to: then KM_ECANCELLED, *out untouched, nothing leaked. It is
  * polled once every KM_STOP_POLL_UNITS curve evaluations. Other statuses
  * and the order as km_signature_compute. */
-km_status km_signature_compute_until(const km_curve *c, double tol,
-                                     const km_stop *stop, km_signature *out,
-                                     km_error *err);
+KM_API km_status km_signature_compute_until(const km_curve *c, double tol,
+                                            const km_stop *stop,
+                                            km_signature *out, km_error *err);
 
 /* Tangent angle theta(s) in radians, unwrapped (it accumulates the
  * turning, not reduced to (-pi, pi]), corner turns at s included (the
  * right-hand limit). Builds kappa's antiderivative on each call: O(number
  * of coefficients). Should that allocation fail, the integral of kappa is
  * left out of the answer. */
-double km_signature_theta(const km_signature *sig, double s);
+KM_API double km_signature_theta(const km_signature *sig, double s);
 
 /* Point of the exact curve at arc length s (clamped to [0, length]) into
  * pos (out), and its tangent angle into *theta (out; may be NULL):
@@ -131,14 +134,14 @@ double km_signature_theta(const km_signature *sig, double s);
  * are included. Used by tests, metrics and closure. Returns KM_OK or
  * KM_ENOMEM (nothing written).
  * It takes no km_error: only memory can fail. */
-km_status km_signature_point(const km_signature *sig, double s, double pos[2],
-                             double *theta);
+KM_API km_status km_signature_point(const km_signature *sig, double s,
+                                    double pos[2], double *theta);
 
 /* Largest |kappa| over [0, length] (km_fn_max_abs: to 1e-13 relative). */
-double km_signature_max_abs_kappa(const km_signature *sig);
+KM_API double km_signature_max_abs_kappa(const km_signature *sig);
 
 /* Bending energy: the integral of kappa^2 ds over [0, length]
  * (km_fn_integral_sq; NaN when memory runs out). Corners add nothing. */
-double km_signature_bending_energy(const km_signature *sig);
+KM_API double km_signature_bending_energy(const km_signature *sig);
 
 #endif

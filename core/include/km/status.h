@@ -12,6 +12,8 @@
 #ifndef KM_STATUS_H
 #define KM_STATUS_H
 
+#include "km/export.h"
+
 #include <stddef.h>
 
 /* X(name, value, default message) */
@@ -77,7 +79,7 @@ typedef struct km_error {
 /* Name of a status ("KM_ECUSP") and its default message (the table above):
  * static strings, never NULL, safe from any thread. A value not in the
  * table gives "KM_UNKNOWN" and "unknown status". */
-const char *km_status_name(km_status s);
-const char *km_status_message(km_status s);
+KM_API const char *km_status_name(km_status s);
+KM_API const char *km_status_message(km_status s);
 
 #endif
