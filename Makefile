@@ -81,7 +81,7 @@ SUPPORT_SRC := $(wildcard tests/support/*.c)
 .PHONY: all deps check-deps check build run test test-compound test-unit test-asan test-server test-clients check-layers format-check \
         bench bench-http fuzz fuzz-svg clean format examples \
         test-fuzz test-hardening bench-load bench-hostile install uninstall \
-        test-packaging
+        test-packaging test-cluster run-cluster stop-cluster
 
 all: build
 
@@ -236,6 +236,8 @@ test: deps
 	@$(MAKE) --no-print-directory test-server || true
 	@echo "== clients: curl, JS, Python and the web page in Chromium"
 	@$(MAKE) --no-print-directory test-clients || true
+	@echo "== several kmorphd over one redis-server behind nginx; deploy/ files"
+	@$(MAKE) --no-print-directory test-cluster || true
 	@echo "== fuzzing: the request and SVG fuzz targets for $(TEST_FUZZ_SECONDS) s each (ASan, UBSan, LSan)"
 	@$(MAKE) --no-print-directory test-fuzz || true
 	@echo "== hardening: bad-input barrage, daemon under ASan, leaks, load, faults"
@@ -260,6 +262,21 @@ test-server: build
 # and the web page in headless Chromium; appends its counts like the others.
 test-clients: build
 	@tests/clients/run.sh
+
+# Several kmorphd sharing jobs through a real redis-server, behind a real
+# nginx, on loopback ports (tests/cluster); and the checks of deploy/.
+# Appends its counts like the others.
+test-cluster: build
+	@tests/cluster/run.sh
+
+# redis-server, two kmorphd and nginx in the background on loopback (pid
+# files and logs in build/cluster/), for trying by hand; stop-cluster ends
+# them by pid. Ports: CLUSTER_PORT, CLUSTER_KMORPHD_PORTS, CLUSTER_REDIS_PORT.
+run-cluster: deps build
+	@tools/run_cluster.py start
+
+stop-cluster:
+	@tools/run_cluster.py stop
 
 # Throughput and latency of kmorphd with wrk (see bench/http/run.sh).
 bench-http: deps build
