@@ -165,11 +165,13 @@ export class Client {
   }
 
   /** POST /v1/reconstruct: the curve of a signature, and its error bound.
-   * Options: tolerance, degree (3 or 5), include (e.g. ["svg_d"]), signal. */
-  async reconstruct(signature, { tolerance, degree, include, signal } = {}) {
+   * Options: tolerance, degree (3 or 5), precision, include (e.g.
+   * ["svg_d"]), signal. */
+  async reconstruct(signature, { tolerance, degree, precision, include, signal } = {}) {
     const req = { signature };
     if (tolerance != null) req.tolerance = tolerance;
     if (degree != null) req.degree = degree;
+    if (precision != null) req.precision = precision;
     if (include != null) req.include = include;
     return (await this.request("POST", "/v1/reconstruct", { body: req, signal })).body;
   }

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # run.sh - the client suites against live kmorphd daemons (each suite
 # starts its own on a free loopback port): the curl scripts, the JS module
-# (node --test, its npm package packed and installed), the Python module (unittest) and, when Chromium and
+# (node --test, its npm package packed and installed, its types checked
+# with tsc), the Python module (unittest) and, when Chromium and
 # playwright-core are there, the web page end to end. Appends
 # "tests/clients/<suite> <passed> <failed>" lines to the results file that
 # tests/summarise.sh totals.
@@ -41,6 +42,11 @@ node_counts() { # node_counts OUTPUT RC -> "passed failed"
 }
 
 echo "-- clients/js"
+# The package's devDependencies (typescript, openapi-typescript) for its
+# types test and npm pack; the tests that need them fail without.
+if [ ! -x clients/js/node_modules/.bin/tsc ]; then
+  (cd clients/js && timeout 300 npm ci --no-audit --no-fund --loglevel=error >/dev/null 2>&1)
+fi
 out=$(timeout "$limit" node --test tests/clients/js/ 2>&1); rc=$?
 printf '%s\n' "$out" | grep -E '^(not )?ok |^# (tests|pass|fail)|Error|expected|actual' | head -n 200
 record js $(node_counts "$out" "$rc")

@@ -33,7 +33,7 @@ test("package.json: name, module type, entry points, and the API's version", () 
   assert.equal(pkg.exports["."].default, "./kmorph.js");
   assert.equal(pkg.exports["."].types, "./kmorph.d.ts");
   assert.equal(pkg.types, "./kmorph.d.ts");
-  assert.deepEqual([...pkg.files].sort(), ["kmorph.d.ts", "kmorph.js"]);
+  assert.deepEqual([...pkg.files].sort(), ["kmorph.d.ts", "kmorph.js", "openapi.d.ts"]);
   const yaml = readFileSync(path.join(ROOT, "api", "openapi.yaml"), "utf8");
   const m = /^info:\n(?:[ \t]+.*\n)*?[ \t]+version:[ \t]*["']?([^"'\s]+)/m.exec(yaml);
   assert.ok(m, "info.version in api/openapi.yaml");
@@ -52,6 +52,34 @@ test("kmorph.d.ts declares every export of kmorph.js, and nothing else", () => {
   for (const name of declared) assert.ok(exported.includes(name), `${name} is declared but not exported`);
 });
 
+/* TypeScript from the package's devDependencies (npm ci in clients/js). */
+const TSC = path.join(PKG_DIR, "node_modules", ".bin", "tsc");
+function tsc(project) {
+  try {
+    execFileSync(TSC, ["-p", project], { encoding: "utf8", timeout: 120000 });
+  } catch (e) {
+    assert.fail(`tsc -p ${project}:\n${e.stdout}${e.stderr}`);
+  }
+}
+
+test("every schema of the contract is an exported type of kmorph.d.ts", () => {
+  const yaml = readFileSync(path.join(ROOT, "api", "openapi.yaml"), "utf8");
+  const block = /^components:\n(?:.*\n)*?  schemas:\n((?:(?:    .*| *)\n)*)/m.exec(yaml);
+  assert.ok(block, "components.schemas in api/openapi.yaml");
+  const schemas = [...block[1].matchAll(/^    ([A-Za-z]\w*):\s*$/gm)].map((m) => m[1]);
+  assert.ok(schemas.length >= 25, `${schemas.length} schemas`);
+  const dts = readFileSync(path.join(PKG_DIR, "kmorph.d.ts"), "utf8");
+  for (const name of schemas)
+    assert.match(dts, new RegExp(`^export type ${name} = Schemas\\["${name}"\\];$`, "m"), name);
+});
+
+test("the types compile strictly with tsc --noEmit, and refuse what the contract refuses", () => {
+  /* openapi.d.ts is generated from the contract, as npm pack does. */
+  execFileSync("npm", ["run", "--silent", "types"], { cwd: PKG_DIR, encoding: "utf8", timeout: 120000 });
+  tsc(path.join(PKG_DIR, "tsconfig.json"));
+  tsc(path.join(ROOT, "tests", "clients", "js", "types", "tsconfig.json"));
+});
+
 /** Pack clients/js, install the tarball offline into a fresh project and
  * import "kmorph" from a module of that project (so resolution goes
  * through node_modules and the package's exports map). */
@@ -60,7 +88,7 @@ async function install() {
   const packed = JSON.parse(execFileSync("npm", ["pack", "--json", "--pack-destination", work, PKG_DIR],
                                          { encoding: "utf8", timeout: 60000 }));
   const files = packed[0].files.map((f) => f.path).sort();
-  assert.deepEqual(files, ["kmorph.d.ts", "kmorph.js", "package.json"]);
+  assert.deepEqual(files, ["kmorph.d.ts", "kmorph.js", "openapi.d.ts", "package.json"]);
   const tarball = packed[0].filename;
   assert.equal(tarball, `kmorph-${pkg.version}.tgz`);
   const project = path.join(work, "app");
@@ -69,7 +97,7 @@ async function install() {
   execFileSync("npm", ["install", "--offline", "--no-audit", "--no-fund", "--loglevel=error", path.join(work, tarball)],
                { cwd: project, encoding: "utf8", timeout: 120000 });
   assert.deepEqual(readdirSync(path.join(project, "node_modules", "kmorph")).sort(),
-                   ["kmorph.d.ts", "kmorph.js", "package.json"]);
+                   ["kmorph.d.ts", "kmorph.js", "openapi.d.ts", "package.json"]);
   writeFileSync(path.join(project, "use.mjs"), 'export * from "kmorph";\n');
   installed = await import(pathToFileURL(path.join(project, "use.mjs")).href);
   return installed;
@@ -119,6 +147,28 @@ test("interpolateAll: one interpolator per pair, or one path with single", async
   const joined = await km.interpolateAll([circleD, squareD], [squareD, shifted], { client, frames: 3, single: true });
   assert.equal((joined(0.5).match(/M/g) || []).length, 2);
   await assert.rejects(km.interpolateAll([circleD], [], { client }), TypeError);
+});
+
+test("the installed package's types resolve by name in a TypeScript project", async () => {
+  await install();
+  const project = path.join(work, "app");
+  writeFileSync(path.join(project, "use.ts"), [
+    'import { Client, type MorphRequest, type MorphResult } from "kmorph";',
+    'const req: MorphRequest = { from: { type: "svg", d: "M 0 0 L 1 0" }, to: { type: "svg", d: "M 0 0 L 0 1" } };',
+    "export async function frames(): Promise<number> {",
+    "  const r: MorphResult | string = await new Client().morph(req);",
+    '  return typeof r === "string" ? 0 : r.frames.length;',
+    "}",
+    '// @ts-expect-error "frames" is a number',
+    'export const bad: MorphRequest = { ...req, frames: "many" };',
+    "",
+  ].join("\n"));
+  writeFileSync(path.join(project, "tsconfig.json"), JSON.stringify({
+    compilerOptions: { strict: true, noEmit: true, module: "nodenext", moduleResolution: "nodenext",
+                       target: "es2022", lib: ["es2022", "dom"], types: [] },
+    files: ["use.ts"],
+  }));
+  tsc(project);
 });
 
 test("interpolate passes request errors on as KmorphError naming the field", async () => {
