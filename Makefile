@@ -81,7 +81,7 @@ SUPPORT_SRC := $(wildcard tests/support/*.c)
 .PHONY: all deps check-deps check build run test test-compound test-unit test-asan test-server test-clients check-layers format-check \
         bench bench-http fuzz fuzz-svg clean format examples \
         test-fuzz test-hardening bench-load bench-hostile install uninstall \
-        test-packaging test-cluster run-cluster stop-cluster
+        test-packaging test-cluster run-cluster stop-cluster image
 
 all: build
 
@@ -495,6 +495,13 @@ uninstall:
 	  $(DESTDIR)$(UNITDIR)/kmorphd.service
 	-rmdir $(DESTDIR)$(INCLUDEDIR)/km $(DESTDIR)$(DATADIR)/kmorph/web \
 	  $(DESTDIR)$(DATADIR)/kmorph 2>/dev/null
+
+# The container image from the Dockerfile, labelled with VERSION: podman,
+# else docker (neither is needed by the build or the tests).
+ENGINE ?= $(firstword $(shell command -v podman docker 2>/dev/null))
+image:
+	@[ -n "$(ENGINE)" ] || { echo "no podman or docker: install one, or set ENGINE"; exit 1; }
+	$(ENGINE) build --build-arg KMORPH_VERSION=$(KM_VERSION) -t kmorph:$(KM_VERSION) .
 
 # make install into a temporary DESTDIR, then the installed library built
 # against with pkg-config, the installed daemon serving the installed
