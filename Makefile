@@ -81,7 +81,7 @@ SUPPORT_SRC := $(wildcard tests/support/*.c)
 .PHONY: all deps check-deps check build run test test-compound test-unit test-asan test-server test-clients check-layers format-check \
         bench bench-http fuzz fuzz-svg clean format examples \
         test-fuzz test-hardening bench-load bench-hostile install uninstall \
-        test-packaging test-cluster run-cluster stop-cluster image
+        test-packaging image
 
 all: build
 
@@ -266,6 +266,7 @@ test-clients: build
 # Several kmorphd sharing jobs through a real redis-server, behind a real
 # nginx, on loopback ports (tests/cluster); and the checks of deploy/.
 # Appends its counts like the others.
+.PHONY: test-cluster run-cluster stop-cluster bench-cluster
 test-cluster: build
 	@tests/cluster/run.sh
 
@@ -277,6 +278,11 @@ run-cluster: deps build
 
 stop-cluster:
 	@tools/run_cluster.py stop
+
+# Throughput of 200 jobs on one instance against two, and the Redis job
+# store against the in-memory one (bench/cluster/bench_cluster.py).
+bench-cluster: deps build
+	@python3 bench/cluster/bench_cluster.py
 
 # Throughput and latency of kmorphd with wrk (see bench/http/run.sh).
 bench-http: deps build
