@@ -8,6 +8,7 @@ the pid in its file (after checking the pid is still that program).
 
 Ports (environment): CLUSTER_PORT (nginx, 8090), CLUSTER_KMORPHD_PORTS
 (8091,8092), CLUSTER_REDIS_PORT (6390). A port in use is an error.
+CLUSTER_STATE: the folder of pid files and logs (build/cluster).
 """
 import os
 import signal
@@ -21,7 +22,7 @@ sys.path.insert(0, os.path.join(ROOT, "tests", "cluster"))
 from cluster import (HOST, NGINX, REDIS_SERVER, daemon_has_jobs_flag,  # noqa
                      nginx_conf)
 
-STATE = os.path.join(ROOT, "build", "cluster")
+STATE = os.environ.get("CLUSTER_STATE", os.path.join(ROOT, "build", "cluster"))
 DAEMON = os.environ.get("KMORPHD", os.path.join(ROOT, "build", "kmorphd"))
 # Stopped in this order: the proxy first, the store last.
 NAMES = ("nginx", "kmorphd1", "kmorphd2", "redis")

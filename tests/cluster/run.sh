@@ -11,7 +11,7 @@ PY=/usr/bin/python3
 [ -x "$PY" ] || PY=python3
 
 out=$(cd tests/cluster && timeout "${KM_TEST_TIMEOUT:-600}" "$PY" -m unittest -v \
-        test_cluster test_deploy 2>&1)
+        test_cluster test_deploy test_run_cluster 2>&1)
 rc=$?
 printf '%s\n' "$out" | grep -E ' \.\.\. |^(FAIL|ERROR):|^Ran |^OK|^FAILED|Error|assert' | head -n 200
 ran=$(printf '%s\n' "$out" | sed -n 's/^Ran \([0-9]*\) tests\{0,1\}.*/\1/p' | tail -n 1)

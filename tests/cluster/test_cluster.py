@@ -16,6 +16,8 @@ without --jobs. Workloads are a few seconds of compute on two cores; every
 wait is bounded.
 """
 import os
+import signal
+import subprocess
 import sys
 import unittest
 
@@ -24,7 +26,8 @@ from cluster import (Cluster, ClusterError, Daemon, require_jobs_flag,
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
                                 "..", "server"))
-from kmtest import circle_svg, ring_morph_body, square_svg  # noqa: E402
+from kmtest import (ContractCase, circle_svg, ring_morph_body,  # noqa: E402
+                    square_svg)
 
 # Every instance: one compute worker (two instances = the two cores), job
 # limits high enough for the batches of jobs submitted here.
@@ -112,14 +115,16 @@ def reference_frames(bodies):
         d.stop()
 
 
-class ClusterCase(unittest.TestCase):
+class ClusterCase(ContractCase):
     instances = 2
     extra_flags = ()
+    persist = False
 
     def setUp(self):
         require_jobs_flag()
         self.cluster = Cluster(instances=self.instances,
-                               flags=FLAGS + tuple(self.extra_flags))
+                               flags=FLAGS + tuple(self.extra_flags),
+                               persist=self.persist)
         self.addCleanup(self.cluster.close)
 
     def assertSameFrames(self, got, want, what):
@@ -259,10 +264,13 @@ class StopAllAndRestart(ClusterCase):
             lambda: sum(metric_sum(d, FRAMES_METRIC) or 0
                         for d in c.instances) >= 1, 30),
             "the instances started rendering")
-        for d in c.instances:  # both at once, then wait
-            d.proc.send_signal(15)
+        for d in c.instances:  # both at once (one SIGTERM each), then wait
+            d.proc.send_signal(signal.SIGTERM)
         for d in c.instances:
-            rc, _ = d.terminate(timeout=30)
+            try:
+                rc = d.proc.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                rc = None
             self.assertEqual(rc, 0, "graceful stop: %s" % d.text()[-1500:])
         fresh = c.start_instance()
         left = [j for j, s in statuses(fresh, ids).items()
@@ -275,6 +283,67 @@ class StopAllAndRestart(ClusterCase):
         self.assertAllDone(final, ids)
         for k, jid in enumerate(ids):
             self.assertSameFrames(frames_of(fresh, jid), want, "job %d" % k)
+
+
+class RedisRestartAndOutage(ClusterCase):
+    """Redis with its append-only file: restarted under running jobs, the
+    instances carry on; while it is down, job endpoints say 503 with
+    Retry-After, /readyz 503, and synchronous morphs still work."""
+
+    JOBS = 20
+    FRAMES = 40
+    persist = True
+
+    def test_redis_restart_mid_run(self):
+        bodies = [ring_morph_body(self.FRAMES) for _ in range(self.JOBS)]
+        want = reference_frames(bodies[:1])[0]
+        c = self.cluster
+        ids = submit(c, bodies)
+        self.assertTrue(wait_for(
+            lambda: sum(metric_sum(d, FRAMES_METRIC) or 0
+                        for d in c.instances) >= 1, 30),
+            "the instances started rendering")
+        c.redis.restart()
+        final = wait_final(c, ids, 180)
+        for d in c.instances:
+            self.assertTrue(d.alive(), d.text()[-1500:])
+        for k, jid in enumerate(ids):
+            s = final[jid]
+            self.assertIn(s.get("state"), ("done", "failed"),
+                          "job %d ends, done or failed: %s" % (k, s))
+            if s["state"] == "failed":
+                self.assertTrue(s.get("error"), "a failed job says why")
+            else:
+                self.assertSameFrames(frames_of(c, jid), want, "job %d" % k)
+
+    def test_redis_unreachable(self):
+        c = self.cluster
+        (jid,) = submit(c, [small_body(1)])
+        wait_final(c, [jid], 30)
+        c.redis.stop()
+        for d in c.instances:
+            self.assertTrue(wait_for(
+                lambda: d.request("GET", "/readyz").status == 503, 15),
+                "/readyz says not ready without Redis")
+            self.assertEqual(d.request("GET", "/healthz").status, 200)
+            r = d.request("POST", "/v1/jobs", body=small_body(2))
+            self.assertProblem(r, 503, "/v1/jobs", "post")
+            self.assertTrue(r.header("Retry-After"))
+            r = d.request("GET", "/v1/jobs/" + jid)
+            self.assertProblem(r, 503, "/v1/jobs/{id}", "get")
+            self.assertTrue(r.header("Retry-After"))
+            r = d.request("POST", "/v1/morph", body=small_body(2))
+            self.assertEqual(r.status, 200, r.body[:300])
+        # Redis back: the instances reconnect by themselves.
+        c.redis.restart()
+        for d in c.instances:
+            self.assertTrue(wait_for(
+                lambda: d.request("GET", "/readyz").status == 200, 60),
+                "ready again once Redis is back")
+        self.assertEqual(statuses(c, [jid])[jid].get("state"), "done",
+                         "the job finished before the outage is kept")
+        (again,) = submit(c, [small_body(3)])
+        self.assertAllDone(wait_final(c, [again], 60), [again])
 
 
 class Harness(unittest.TestCase):
@@ -299,6 +368,13 @@ class Harness(unittest.TestCase):
         for d in c.instances:
             self.assertFalse(d.alive(), "stopped by pid")
         self.assertIsNotNone(c.nginx.proc.poll(), "nginx stopped")
+
+    def test_nginx_passes_over_a_killed_instance(self):
+        with Cluster(instances=2, flags=FLAGS, shared=False) as c:
+            c.instances[0].kill()
+            for _ in range(6):
+                r = c.request("POST", "/v1/morph", body=small_body(1))
+                self.assertEqual(r.status, 200, r.body[:300])
 
     def test_shared_store_needs_jobs_flag(self):
         # A daemon without --jobs is named in the failure, not skipped.
