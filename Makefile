@@ -503,11 +503,13 @@ uninstall:
 	  $(DESTDIR)$(DATADIR)/kmorph 2>/dev/null
 
 # The container image from the Dockerfile, labelled with VERSION: podman,
-# else docker (neither is needed by the build or the tests).
+# else docker (neither is needed by the build or the tests). podman
+# builds the docker format: the OCI one has no HEALTHCHECK.
 ENGINE ?= $(firstword $(shell command -v podman docker 2>/dev/null))
 image:
 	@[ -n "$(ENGINE)" ] || { echo "no podman or docker: install one, or set ENGINE"; exit 1; }
-	$(ENGINE) build --build-arg KMORPH_VERSION=$(KM_VERSION) -t kmorph:$(KM_VERSION) .
+	$(ENGINE) build $(if $(findstring podman,$(ENGINE)),--format docker) \
+	  --build-arg KMORPH_VERSION=$(KM_VERSION) -t kmorph:$(KM_VERSION) .
 
 # make install into a temporary DESTDIR, then the installed library built
 # against with pkg-config, the installed daemon serving the installed
