@@ -11,7 +11,8 @@
  *
  * The choice made by the alignment (and by the start search of morph.c)
  * is previewed first: PREVIEWS interior frames, t = k / (PREVIEWS + 1),
- * their crossings counted. When none crosses it is kept, untouched, so
+ * their crossings counted, and when none crosses CONFIRMS more, halfway
+ * between them. When none of those crosses it is kept, untouched, so
  * frames that did not cross are the same frames. Otherwise other starts
  * are previewed in order of the alignment cost (km__sector_shifts: the
  * best start in each sector, so that the candidates spread over the whole
@@ -25,11 +26,15 @@
  * far. The choice is made once per morph, so every frame comes from one
  * correspondence and the sequence cannot jump between choices.
  *
- * Budget: the inputs' two frames and at most 32 candidates (the first
+ * Budget: the inputs' two frames and at most 48 candidates (the first
  * choice; the best aligned start in each of the other SEAMS - 1 sectors of
  * a closed `to`, times two when matches are automatic; no matches at the
- * first start), each at most PREVIEWS frames and their crossing counts -
- * at most 2 + 7 * 32 = 226 frames. A planned frame is a pass over a few
+ * first start) and the one kept planned again, each at most PREVIEWS +
+ * CONFIRMS frames and their crossing counts - at most 2 + 15 * 49 = 737
+ * frames, though the confirming frames are built only for a candidate
+ * whose previews do not cross, which mostly ends the search. With 16
+ * sectors one pair of the glyph fixtures (a C into an S of DejaVu Serif)
+ * kept seven crossing frames. A planned frame is a pass over a few
  * hundred nodes, so the search costs some tens of frames' work on glyphs;
  * every preview and plan polls the caller's stop, and the choice kept is
  * planned like any morph, so the answer's size is predicted from it.
@@ -45,28 +50,25 @@
 /* Interior frames previewed per candidate, and seam positions tried
  * (shifts of j / SEAMS of the length). */
 #define PREVIEWS 7
-#define SEAMS 16
+#define CONFIRMS 8
+#define SEAMS 24
 /* Candidates are planned and previewed at this multiple of the morph's
  * tolerance (a crossing of stroke sides is wider by orders of magnitude),
  * the one kept planned again at the morph's own and previewed again. */
 #define COARSER 10.0
 
-/* The crossings of m's preview frames into *count, counting stopped once
- * cap is reached; *built adds the frames built. A frame that cannot be
- * built counts as LONG_MAX (the candidate loses); KM_ENOMEM and
+/* The crossings of m's frames at the times t[0..n) into *count, counting
+ * stopped once cap is reached; *built adds the frames built. A frame that
+ * cannot be built counts as LONG_MAX (the candidate loses); KM_ENOMEM and
  * KM_ECANCELLED fail the search rather than let another candidate win. */
-static km_status preview_crossings(const km_morph *m, long cap, km__poll *poll,
-                                   long *count, size_t *built) {
-  /* the middle first, then halving the gaps: crossings of thin strokes
-   * are widest in the middle, and a candidate that crosses is mostly
-   * ruled out by its first preview */
-  static const int order[PREVIEWS] = {4, 2, 6, 1, 3, 5, 7};
+static km_status crossings_at(const km_morph *m, const double *t, int n,
+                              long cap, km__poll *poll, long *count,
+                              size_t *built) {
   long total = 0;
-  for (int k = 0; k < PREVIEWS && total < cap; k++) {
+  for (int k = 0; k < n && total < cap; k++) {
     km_curve c;
     km_curve_init(&c);
-    km_status st =
-        km__morph_frame(m, order[k] / (double)(PREVIEWS + 1), poll, &c, NULL);
+    km_status st = km__morph_frame(m, t[k], poll, &c, NULL);
     if (st == KM_ENOMEM || st == KM_ECANCELLED) return st;
     (*built)++;
     if (st != KM_OK) {
@@ -80,6 +82,27 @@ static km_status preview_crossings(const km_morph *m, long cap, km__poll *poll,
   }
   *count = total;
   return KM_OK;
+}
+
+/* The crossings of m's PREVIEWS frames, and when those show none, of the
+ * CONFIRMS frames between them: a crossing of stroke sides can live
+ * between two previews (frames 0.53 to 0.6 of a 2 into a 5 with the
+ * previews at 0.5 and 0.625), and a choice kept on seven previews alone
+ * would then cross where nobody looked. Only a choice that is about to be
+ * kept pays for the second look. */
+static km_status preview_crossings(const km_morph *m, long cap, km__poll *poll,
+                                   long *count, size_t *built) {
+  /* the middle first, then halving the gaps: crossings of thin strokes
+   * are widest in the middle, and a candidate that crosses is mostly
+   * ruled out by its first preview */
+  static const double previews[PREVIEWS] = {4 / 8.0, 2 / 8.0, 6 / 8.0, 1 / 8.0,
+                                            3 / 8.0, 5 / 8.0, 7 / 8.0};
+  static const double confirms[CONFIRMS] = {7 / 16.0,  9 / 16.0, 5 / 16.0,
+                                            11 / 16.0, 3 / 16.0, 13 / 16.0,
+                                            1 / 16.0,  15 / 16.0};
+  km_status st = crossings_at(m, previews, PREVIEWS, cap, poll, count, built);
+  if (st || *count > 0) return st;
+  return crossings_at(m, confirms, CONFIRMS, cap, poll, count, built);
 }
 
 /* Self-crossings of the frames at t = 0 and 1, the inputs as the morph
