@@ -308,6 +308,23 @@ static bool parse_shape(api_ctx *ctx, const cJSON *v, const char *ptr,
   return true;
 }
 
+/* The members of each type of curve, in the order of types[] below. */
+static const char *const bspline_members[] = {
+    "type", "degree", "knots", "weights", "control_points", "closed"};
+static const char *const points_members[] = {"type", "points", "closed"};
+static const char *const signature_members[] = {"type", "signature"};
+static const char *const svg_members[] = {"type", "d"};
+static const char *const shape_members[] = {"type", "contours", "fill_rule"};
+static const char *const *const curve_members[] = {
+    bspline_members, points_members, signature_members, svg_members,
+    shape_members};
+static const size_t curve_member_counts[] = {
+    sizeof bspline_members / sizeof *bspline_members,
+    sizeof points_members / sizeof *points_members,
+    sizeof signature_members / sizeof *signature_members,
+    sizeof svg_members / sizeof *svg_members,
+    sizeof shape_members / sizeof *shape_members};
+
 bool api__parse_curve(api_ctx *ctx, const cJSON *v, const char *ptr, double tol,
                       api_input *out) {
   static const char *const types[] = {"bspline", "points", "signature", "svg",
@@ -327,6 +344,9 @@ bool api__parse_curve(api_ctx *ctx, const cJSON *v, const char *ptr, double tol,
                         "is required: \"bspline\", \"points\", \"signature\", "
                         "\"svg\" or \"shape\"");
   }
+  if (!api__known_members(ctx, v, ptr, curve_members[type],
+                          curve_member_counts[type]))
+    return false;
   switch (type) {
   case 0:
     if (!parse_bspline(ctx, v, ptr, &out->curve)) return false;

@@ -11,9 +11,10 @@
  *
  * Where each part lives: api.c (the context, problems, dispatch),
  * json_parse.c with json_scan.c and json_tree.c (bodies to trees),
- * json_read.c (typed readers), curve_in.c and signature_in.c (inputs),
- * core_problem.c (core failures), json_out.c (writers and their byte
- * bounds), morph_*.c (the morph route), svg_*.c (SVG in and out).
+ * json_read.c (typed readers), json_members.c (the members an object may
+ * have), curve_in.c and signature_in.c (inputs), core_problem.c (core
+ * failures), json_out.c (writers and their byte bounds), morph_*.c (the
+ * morph route), svg_*.c (SVG in and out).
  */
 #ifndef KMAPI_INTERNAL_H
 #define KMAPI_INTERNAL_H
@@ -232,6 +233,16 @@ bool api__point_array(api_ctx *ctx, const cJSON *v, const char *ptr, size_t max,
                       double **out, size_t *n);
 /* A single [x, y]. */
 bool api__point(api_ctx *ctx, const cJSON *v, const char *ptr, double out[2]);
+/* Every member of obj (at base) is one of names[0..n), else 422 naming
+ * the first that is not by its pointer, with the nearest of names as a
+ * suggestion when one is close (json_members.c). Not an object: true (its
+ * reader reports the type). */
+bool api__known_members(api_ctx *ctx, const cJSON *obj, const char *base,
+                        const char *const *names, size_t n);
+/* The one of names[0..n) close enough to key to suggest, or NULL. */
+const char *api__nearest_name(const char *key, const char *const *names,
+                              size_t n);
+#define API_NAMES(a) (a), (sizeof(a) / sizeof(a)[0])
 /* Member must exist (422 "is required" otherwise). */
 const cJSON *api__require(api_ctx *ctx, const cJSON *obj, const char *base,
                           const char *key);

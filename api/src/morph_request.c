@@ -28,6 +28,18 @@ static const char *const intersections_names[] = {"allow", "avoid"};
 static const char *const format_names[] = {"json", "svg"};
 static const char *const layout_names[] = {"filmstrip", "overlay", "animate",
                                            "curvature_plot"};
+/* The members of a morph request (and of a job's) and of its "svg". */
+static const char *const morph_members[] = {
+    "from",      "to",      "frames",
+    "times",     "method",  "blend",
+    "matches",   "closure", "contour_matches",
+    "anchor",    "orient",  "intersections",
+    "tolerance", "degree",  "metrics",
+    "precision", "include", "format",
+    "svg"};
+static const char *const svg_option_members[] = {
+    "layout",   "width",  "height",     "stroke_width",
+    "duration", "stroke", "from_color", "to_color"};
 
 /* Enum arrays above are in the order of the core's enums; these check it
  * at compile time so a reordering there cannot silently swap meanings. */
@@ -153,6 +165,8 @@ static bool parse_svg_options(api_ctx *ctx, const cJSON *root,
   if (svg == NULL) return true;
   if (!cJSON_IsObject(svg))
     return api__invalid(ctx, "/svg", "must be an object");
+  if (!api__known_members(ctx, svg, "/svg", API_NAMES(svg_option_members)))
+    return false;
   if (!api__member_enum(ctx, svg, "/svg", "layout", NAMES(layout_names),
                         &layout, NULL))
     return false;
@@ -323,7 +337,8 @@ static bool parse_options(api_ctx *ctx, const cJSON *root, api_morph_plan *pl) {
 bool api__morph_read_request(api_ctx *ctx, const cJSON *root,
                              const char *accept, size_t max_frames,
                              api_morph_plan *pl) {
-  if (!parse_options(ctx, root, pl) || !parse_times(ctx, root, max_frames, pl))
+  if (!api__known_members(ctx, root, "", API_NAMES(morph_members)) ||
+      !parse_options(ctx, root, pl) || !parse_times(ctx, root, max_frames, pl))
     return false;
   if (!pl->svg && cJSON_GetObjectItemCaseSensitive(root, "format") == NULL)
     pl->svg = accept_prefers_svg(accept);

@@ -15,6 +15,9 @@ typedef struct options {
   api_precision precision;
 } options;
 
+static const char *const reconstruct_members[] = {
+    "signature", "tolerance", "degree", "include", "precision"};
+
 static bool read_options(api_ctx *ctx, const cJSON *root, options *o) {
   o->tol = 0;
   o->degree = 3;
@@ -93,7 +96,9 @@ api_status api__route_reconstruct(api_ctx *ctx, const api_request *req,
   km_signature_init(&sig);
   km_curve_init(&curve);
   api__svg_buf_init(&b);
-  if (root == NULL || !read_options(ctx, root, &o) ||
+  if (root == NULL ||
+      !api__known_members(ctx, root, "", API_NAMES(reconstruct_members)) ||
+      !read_options(ctx, root, &o) ||
       (js = api__require(ctx, root, "", "signature")) == NULL ||
       !api__parse_signature(ctx, js, "/signature", &sig) ||
       !reconstruct(ctx, req, &o, &sig, &curve, &bound))

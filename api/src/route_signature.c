@@ -210,6 +210,9 @@ static cJSON *shape_route(api_ctx *ctx, const api_request *req,
   return res;
 }
 
+static const char *const signature_members[] = {"curve", "tolerance",
+                                                "samples"};
+
 api_status api__route_signature(api_ctx *ctx, const api_request *req,
                                 api_response *out) {
   cJSON *root = api__parse_body(ctx, req->body, req->length);
@@ -222,7 +225,9 @@ api_status api__route_signature(api_ctx *ctx, const api_request *req,
 
   api__input_init(&in);
   km_signature_init(&sig);
-  if (root == NULL || !api__parse_tolerance(ctx, root, &tol) ||
+  if (root == NULL ||
+      !api__known_members(ctx, root, "", API_NAMES(signature_members)) ||
+      !api__parse_tolerance(ctx, root, &tol) ||
       !api__member_int(ctx, root, "", "samples", false, 2,
                        (long)ctx->cfg->max_samples, &samples, NULL) ||
       !api__parse_curve(ctx, cJSON_GetObjectItemCaseSensitive(root, "curve"),

@@ -5,6 +5,15 @@
 #include "internal.h"
 #include "km/alloc.h"
 
+/* The members of a Signature and of its parts. "turning" is what the
+ * signature route answers (the total turning, derived from the rest): a
+ * signature sent back as it came is accepted, its turning not read. */
+static const char *const signature_members[] = {"length",  "start",   "kappa",
+                                                "corners", "turning", "closed"};
+static const char *const start_members[] = {"point", "angle"};
+static const char *const kappa_members[] = {"degree", "knots", "coefficients"};
+static const char *const corner_members[] = {"s", "turn"};
+
 /* "start": {"point": [x, y], "angle": a}, each optional; absent members
  * leave start and *angle as they are. */
 static bool read_start(api_ctx *ctx, const cJSON *v, const char *ptr,
@@ -16,6 +25,7 @@ static bool read_start(api_ctx *ctx, const cJSON *v, const char *ptr,
   if (!cJSON_IsObject(js))
     return api__invalid(ctx, p, "must be an object, not %s",
                         api__type_name(js));
+  if (!api__known_members(ctx, js, p, API_NAMES(start_members))) return false;
   jpt = cJSON_GetObjectItemCaseSensitive(js, "point");
   if (jpt != NULL) {
     api__ptr_key(q, p, "point");
@@ -42,6 +52,8 @@ static bool read_kappa(api_ctx *ctx, const cJSON *v, const char *ptr,
   if (!cJSON_IsObject(jkappa))
     return api__invalid(ctx, p, "must be an object, not %s",
                         api__type_name(jkappa));
+  if (!api__known_members(ctx, jkappa, p, API_NAMES(kappa_members)))
+    return false;
   if (!api__member_int(ctx, jkappa, p, "degree", true, 0, KM_MAX_FN_DEGREE,
                        &kt->degree, NULL) ||
       (jc = api__require(ctx, jkappa, p, "coefficients")) == NULL)
@@ -87,6 +99,7 @@ static bool read_corners(api_ctx *ctx, const cJSON *v, const char *ptr,
     api__ptr_idx(q, p, i);
     if (!cJSON_IsObject(e))
       return api__invalid(ctx, q, "must be an object {\"s\", \"turn\"}");
+    if (!api__known_members(ctx, e, q, API_NAMES(corner_members))) return false;
     if (!api__member_num(ctx, e, q, "s", true, &(*corners)[i].s, NULL) ||
         !api__member_num(ctx, e, q, "turn", true, &(*corners)[i].turn, NULL))
       return false;
@@ -128,7 +141,9 @@ bool api__parse_signature(api_ctx *ctx, const cJSON *v, const char *ptr,
   if (!cJSON_IsObject(v))
     return api__invalid(ctx, ptr, "must be an object, not %s",
                         api__type_name(v));
-  if (!api__member_num(ctx, v, ptr, "length", true, &length, NULL)) goto done;
+  if (!api__known_members(ctx, v, ptr, API_NAMES(signature_members)) ||
+      !api__member_num(ctx, v, ptr, "length", true, &length, NULL))
+    goto done;
   if (!(length > 0)) {
     api__ptr_key(p, ptr, "length");
     api__fail(ctx, 422, API_P_INVALID_SIGNATURE, "Invalid signature", p,

@@ -40,12 +40,17 @@ static void invalid_utf8_is_400(void **state) {
 static void string_escapes_are_decoded(void **state) {
   (void)state;
   /* "\u0062spline" is "bspline": the curve is read, and its (missing)
-   * knots are what is reported. A surrogate pair elsewhere is fine. */
+   * knots are what is reported. */
   at_problem(SIG,
-             "{\"note\":\"\\ud83d\\ude00 \\\"q\\\" \\/\","
-             "\"curve\":{\"type\":\"\\u0062spline\",\"degree\":1,"
+             "{\"\\u0063urve\":{\"type\":\"\\u0062spline\",\"degree\":1,"
              "\"control_points\":[[0,0],[1,1]]}}",
              422, "/curve/knots");
+  /* A member name with a surrogate pair, quotes and a solidus is decoded
+   * and named by its pointer (RFC 6901 writes "/" as "~1"). */
+  at_problem(SIG,
+             "{\"\\ud83d\\ude00 \\\"q\\\" \\/\":1,"
+             "\"curve\":{\"type\":\"svg\",\"d\":\"M0 0L1 0\"}}",
+             422, "/\xf0\x9f\x98\x80 \"q\" ~1");
   at_problem(SIG, "{\"a\":\"\\ud83d\"}", 400, NULL);
   at_problem(SIG, "{\"a\":\"\\ude00\"}", 400, NULL);
   at_problem(SIG, "{\"a\":\"\\u0000\"}", 400, NULL);
@@ -56,7 +61,7 @@ static void body_without_nul_is_read_to_its_length(void **state) {
   (void)state;
   /* The bytes after `length` must not be read: here they would make the
    * body malformed, so a 422 (missing curve) proves they were ignored. */
-  static const char body[] = "{\"x\":1}garbage";
+  static const char body[] = "{ \t\n\r }garbage";
   api_response res;
   cJSON *j;
   int st = at_call_cfg(NULL, SIG, body, 7, &res, &j);
@@ -73,7 +78,7 @@ static char *nested(size_t depth) {
   char *s = malloc(2 * depth + 16);
   size_t n = 0;
   assert_non_null(s);
-  n += (size_t)sprintf(s, "{\"a\":");
+  n += (size_t)sprintf(s, "{\"curve\":");
   for (size_t i = 1; i < depth; i++) s[n++] = '[';
   s[n++] = '1';
   for (size_t i = 1; i < depth; i++) s[n++] = ']';
@@ -89,7 +94,7 @@ static void nesting_deeper_than_the_limit_is_400(void **state) {
   char *at_limit = nested(cfg.max_json_depth);
   char *over = nested(cfg.max_json_depth + 1);
   char *huge = nested(100000); /* would overflow a recursive parser */
-  /* At the limit the body is well-formed (and then lacks a curve). */
+  /* At the limit the body is well-formed (and its curve is no object). */
   at_problem(SIG, at_limit, 422, "/curve");
   at_problem(SIG, over, 400, NULL);
   at_problem(SIG, huge, 400, NULL);

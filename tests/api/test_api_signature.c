@@ -168,15 +168,21 @@ static void svg_path_signature_has_its_corner(void **state) {
   cJSON_Delete(j);
 }
 
-static void unknown_top_level_fields_are_ignored(void **state) {
+/* A member the contract does not define is never dropped silently: the
+ * request is refused and the member named (test_api_members.c has the
+ * other objects). */
+static void unknown_fields_are_refused_by_name(void **state) {
   (void)state;
-  cJSON *j = signature_of(
-      "{\"comment\":[1,{\"x\":null}],\"curve\":{\"type\":\"bspline\","
-      "\"degree\":1,\"knots\":[0,0,1,1],\"control_points\":[[0,0],[0,3]],"
-      "\"colour\":\"red\"}}");
-  assert_close(num(cJSON_GetObjectItemCaseSensitive(j, "signature"), "length"),
-               3.0, 1e-12);
-  cJSON_Delete(j);
+  at_problem(API_ROUTE_SIGNATURE,
+             "{\"comment\":[1,{\"x\":null}],\"curve\":{\"type\":"
+             "\"bspline\",\"degree\":1,\"knots\":[0,0,1,1],"
+             "\"control_points\":[[0,0],[0,3]]}}",
+             422, "/comment");
+  at_problem(API_ROUTE_SIGNATURE,
+             "{\"curve\":{\"type\":\"bspline\",\"degree\":1,"
+             "\"knots\":[0,0,1,1],\"control_points\":[[0,0],[0,3]],"
+             "\"colour\":\"red\"}}",
+             422, "/curve/colour");
 }
 
 static void numbers_round_trip_through_json(void **state) {
@@ -203,7 +209,7 @@ static const struct CMUnitTest tests[] = {
     cmocka_unit_test(square_signature_has_four_right_angle_corners),
     cmocka_unit_test(signature_input_is_returned_as_given),
     cmocka_unit_test(svg_path_signature_has_its_corner),
-    cmocka_unit_test(unknown_top_level_fields_are_ignored),
+    cmocka_unit_test(unknown_fields_are_refused_by_name),
     cmocka_unit_test(numbers_round_trip_through_json),
 };
 
