@@ -337,6 +337,29 @@ class GeometryEndpoints(ContractCase):
         doc = self.assertProblem(r, 422, "/v1/morph", "post")
         self.assertEqual(doc["errors"][0]["pointer"], "/frames")
 
+    def test_unknown_member_is_422_naming_it_on_every_route(self):
+        # A misspelt option must never be dropped for its default: the
+        # answer names the member by its pointer and the near miss.
+        want = '/blending: unknown member; did you mean "blend"?'
+        for path in ("/v1/morph", "/v1/jobs"):
+            body = morph_body(3)
+            body["blending"] = "paper"
+            r = self.d.request("POST", path, body=body)
+            doc = self.assertProblem(r, 422, path, "post")
+            self.assertEqual(doc["errors"][0]["pointer"], "/blending")
+            self.assertEqual(doc["detail"], want)
+        r = self.d.request("POST", "/v1/signature",
+                           body={"curve": dict(circle_svg(1.0), colour=1)})
+        doc = self.assertProblem(r, 422, "/v1/signature", "post")
+        self.assertEqual(doc["errors"][0]["pointer"], "/curve/colour")
+        r = self.d.request("POST", "/v1/reconstruct",
+                           body={"signature": {"length": 1, "kappa": {
+                               "degree": 0, "knots": [0, 1],
+                               "coefficients": [1]}}, "tolerence": 1e-3})
+        doc = self.assertProblem(r, 422, "/v1/reconstruct", "post")
+        self.assertEqual(doc["errors"][0]["message"],
+                         'unknown member; did you mean "tolerance"?')
+
     def test_morph_of_a_few_tenths_of_a_second_is_answered(self):
         # Six times the limit of MorphTimeLimit below: the default limit
         # (60 s) lets it through.
