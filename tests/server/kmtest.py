@@ -54,8 +54,9 @@ def morph_body(frames, **extra):
 
 
 def heavy_morph_body(frames):
-    """A morph that keeps a worker busy for a while: every frame of a
-    circle-to-square morph is a closed-curve problem."""
+    """A circle-to-square morph with metrics: every frame is a
+    closed-curve problem, but a planned one of tens of microseconds; tests
+    that need a computation still running take ring_morph_body."""
     return {"from": circle_svg(10.0), "to": square_svg(15.0),
             "frames": frames, "metrics": True}
 

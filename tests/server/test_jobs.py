@@ -6,9 +6,8 @@ import threading
 import time
 import unittest
 
-from kmtest import (ContractCase, Daemon, circle_svg, close_to,
-                    heavy_morph_body, metric, morph_body, request, run_job,
-                    wait_for)
+from kmtest import (ContractCase, Daemon, circle_svg, close_to, metric,
+                    morph_body, request, ring_morph_body, run_job, wait_for)
 
 import math
 
@@ -42,9 +41,9 @@ class JobLifeCycle(ContractCase):
 
     def test_life_cycle_cancel_and_expiry(self):
         # Given a long job A and a short job B behind it,
-        a = self.create(heavy_morph_body(10000))
+        a = self.create(ring_morph_body(2000))
         b = self.create(morph_body(5))
-        self.assertEqual(a["frames_total"], 10000)
+        self.assertEqual(a["frames_total"], 2000)
         running = wait_for(lambda: self.status(a["id"])["state"] == "running"
                            and self.status(a["id"]), 10)
         self.assertTrue(running, "job A starts running")
@@ -129,8 +128,8 @@ class JobLifeCycle(ContractCase):
 class JobWallTime(ContractCase):
     @classmethod
     def setUpClass(cls):
-        # 10,000 frames of the heavy morph take about a quarter of a second
-        # on two threads (more under sanitizers): far beyond 0.05 s
+        # 1,000 frames of the ring morph (two contours a frame) take some
+        # seconds on two threads: far beyond 0.05 s
         cls.d = Daemon("--threads", "2", "--job-time", "0.05")
 
     @classmethod
@@ -138,7 +137,7 @@ class JobWallTime(ContractCase):
         cls.d.stop()
 
     def test_job_over_its_wall_time_fails_with_a_clear_error(self):
-        r, jid, s = run_job(self.d, heavy_morph_body(10000))
+        r, jid, s = run_job(self.d, ring_morph_body(1000))
         self.assertEqual(r.status, 202, r.body[:300])
         self.assertTrue(s, "the job ends")
         self.assertEqual(s["state"], "failed")

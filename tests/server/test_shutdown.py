@@ -23,7 +23,7 @@ class GracefulShutdown(ContractCase):
     def test_sigterm_during_a_running_job_exits_0_within_the_grace(self):
         d = Daemon("--threads", "2", "--shutdown-grace", "5")
         try:
-            r = d.request("POST", "/v1/jobs", body=heavy_morph_body(10000))
+            r = d.request("POST", "/v1/jobs", body=ring_morph_body(1000))
             self.assertEqual(r.status, 202, r.body[:300])
             jid = r.json()["id"]
             self.assertTrue(wait_for(lambda: d.request(
@@ -96,7 +96,7 @@ class GracefulShutdown(ContractCase):
 
             def client():
                 out["r"] = d.request("POST", "/v1/morph",
-                                     body=heavy_morph_body(16000), timeout=60)
+                                     body=ring_morph_body(400), timeout=60)
 
             t = threading.Thread(target=client)
             t.start()
@@ -129,7 +129,7 @@ class GracefulShutdown(ContractCase):
             # and the morph in flight still gets its whole answer.
             t.join(timeout=60)
             self.assertEqual(out["r"].status, 200, out["r"].body[:300])
-            self.assertEqual(len(out["r"].json()["frames"]), 16000)
+            self.assertEqual(len(out["r"].json()["frames"]), 400)
             self.assertEqual(d.proc.wait(timeout=20), 0)
         finally:
             d.stop()
@@ -146,7 +146,7 @@ class GracefulShutdown(ContractCase):
             def client(i):
                 try:
                     out[i] = d.request("POST", "/v1/morph",
-                                       body=heavy_morph_body(40000),
+                                       body=ring_morph_body(4000),
                                        headers={"X-Request-Id": "late-%d" % i},
                                        timeout=60)
                 except OSError as e:
