@@ -7,6 +7,7 @@ import { CURVES, PAIRS } from "./examples.js";
 import { splitSubpaths, slotColour, isShapeResult, framePath, frameMetrics, frameIsBad, resultBounds,
          slotPoints } from "./shapes.js";
 import { curvaturePlot } from "./plot.js";
+import { steerCurve, startPoints } from "./steer.js";
 import { parseEasing, ease, easeInverse, cssKeyframes, svgAnimate, dList, EASINGS } from "./motion.js";
 
 const km = new Client();
@@ -31,6 +32,11 @@ const state = {
   picking: false,
   pending: null,                        /* a picked fraction on `from` awaiting its partner */
   matches: [],
+  /* the correspondence the shown morph used, in fractions of the editor's
+   * paths: {pairs: [[a, b]], start: {from, to}, dir: {from, to}} */
+  used: null,
+  sentPin: false,                       /* the morph got [[0.5, 0.5]] only to keep the starts */
+  drag: null,                           /* {index, side} while a used match is dragged */
   results: [],                          /* [{method, result, request}] */
   panels: [],
   t: 0,
@@ -284,7 +290,146 @@ function renderEditor() {
     const p = pointAt("from", state.pending);
     if (p) svgEl("circle", { cx: p.x, cy: p.y, r: r * 1.5, class: "match", fill: "var(--from)" }, g);
   }
+  if (!state.drawing && !compound) {
+    renderStartHelpers(g, r);
+    renderUsed(g, r);
+  }
   renderMatchList();
+}
+
+/** Where each curve starts and which way it runs, as the morph takes it:
+ * the service's chosen start after a morph, else the curve's own. */
+function renderStartHelpers(g, r) {
+  for (const which of ["from", "to"]) {
+    if (!pathOf(which)) continue;
+    const f = state.used ? state.used.start[which] : 0, dir = state.used ? state.used.dir[which] : 1;
+    const p0 = pointAt(which, f), p1 = pointAt(which, wrap01(f + dir * 0.04));
+    if (!p0 || !p1) continue;
+    const colour = which === "from" ? "var(--from)" : "var(--to)";
+    svgEl("circle", { cx: p0.x, cy: p0.y, r: r * 1.6, class: "start", "data-which": which, stroke: colour }, g);
+    const dx = p1.x - p0.x, dy = p1.y - p0.y, len = Math.hypot(dx, dy) || 1, ux = dx / len, uy = dy / len;
+    /* an arrowhead at p1 along the chord from the start */
+    const a = r * 3, w = r * 1.6;
+    svgEl("path", { d: `M${p0.x},${p0.y}L${p1.x},${p1.y}M${p1.x - a * ux + w * uy},${p1.y - a * uy - w * ux}` +
+                       `L${p1.x},${p1.y}L${p1.x - a * ux - w * uy},${p1.y - a * uy + w * ux}`,
+                    class: "direction", "data-which": which, stroke: colour }, g);
+  }
+}
+
+/** The matches the shown morph used, as handles that can be dragged
+ * along their curve (or moved with the arrow keys); letting go morphs
+ * again with them as picked pairs. */
+function renderUsed(g, r) {
+  if (!state.used) return;
+  state.used.pairs.forEach(([a, b], i) => {
+    const pa = pointAt("from", a), pb = pointAt("to", b);
+    if (!pa || !pb) return;
+    svgEl("line", { x1: pa.x, y1: pa.y, x2: pb.x, y2: pb.y, class: "used" }, g);
+    [[pa, "from", a], [pb, "to", b]].forEach(([p, side, f]) => {
+      const c = svgEl("circle", { cx: p.x, cy: p.y, r: r * 1.8, class: "used", "data-which": side, "data-index": i,
+                                  tabindex: "0", role: "slider", "aria-valuemin": "0", "aria-valuemax": "1",
+                                  "aria-valuenow": f.toFixed(4),
+                                  "aria-label": `match ${i + 1} on the ${side} curve (arrow keys move it, Enter morphs)`,
+                                  fill: side === "from" ? "var(--from)" : "var(--to)" }, g);
+      c.addEventListener("pointerdown", (ev) => startDrag(ev, i, side));
+      c.addEventListener("keydown", (ev) => keyDrag(ev, i, side));
+    });
+  });
+}
+
+const wrap01 = (f) => ((f % 1) + 1) % 1;
+
+function startDrag(ev, index, side) {
+  if (state.drawing || state.picking) return;
+  ev.preventDefault();
+  ev.stopPropagation();
+  state.drag = { index, side };
+  $("#editor").setPointerCapture(ev.pointerId);
+}
+
+function onDragMove(ev) {
+  if (!state.drag) return;
+  const [x, y] = editorPoint(ev);
+  const f = nearestFraction(state.drag.side, x, y);
+  if (f == null) return;
+  state.used.pairs[state.drag.index][state.drag.side === "from" ? 0 : 1] = f;
+  renderEditor();
+}
+
+function onDragEnd() {
+  if (!state.drag) return;
+  state.drag = null;
+  state.suppressClick = true;
+  useMatchesAsPicked();
+}
+
+function keyDrag(ev, index, side) {
+  const step = { ArrowLeft: -0.005, ArrowDown: -0.005, ArrowRight: 0.005, ArrowUp: 0.005 }[ev.key];
+  if (ev.key === "Enter") { ev.preventDefault(); useMatchesAsPicked(); return; }
+  if (step === undefined) return;
+  ev.preventDefault();
+  ev.stopPropagation();
+  const k = side === "from" ? 0 : 1, pair = state.used.pairs[index];
+  pair[k] = Math.round(wrap01(pair[k] + step) * 1e4) / 1e4;
+  renderEditor();
+  const again = $(`#editor circle.used[data-which=${side}][data-index="${index}"]`);
+  if (again) again.focus();
+}
+
+/** The used correspondence as picked pairs, and the morph again. Picked
+ * pairs make the starts of closed curves correspond, so a start of `to`
+ * the service chose is kept by starting `to` there (exact at one of its
+ * vertices), else by a pair of the two starts. */
+async function useMatchesAsPicked() {
+  const u = state.used;
+  if (!u) return;
+  let pairs = u.pairs.map((p) => p.slice());
+  let keep = false;
+  if (curvesClosed() && !atSeam(u.start.to)) {
+    const v = nearestStart("to", u.start.to);
+    if (v && Math.abs(wrap01(v.f - u.start.to + 0.5) - 0.5) < 0.01) {
+      await steer("to", { rotate: v.k });
+      pairs = pairs.map(([a, b]) => [a, Math.round(wrap01(b - v.f) * 1e4) / 1e4]);
+      keep = true;
+    } else pairs.push([0, u.start.to]);
+  }
+  state.matches = pairs.filter(([a, b]) => !(keep && atSeam(a) && atSeam(b))).sort((p, q) => p[0] - q[0]);
+  $("#matches-mode").value = "pairs";
+  renderEditor();
+  runMorph();
+}
+
+/** The vertex of a curve nearest to editor fraction f: its index and
+ * fraction, or null. */
+function nearestStart(which, f) {
+  let curve;
+  try { curve = parseCurve($("#curve-" + which).value); } catch { return null; }
+  let best = null;
+  startPoints(curve).forEach(([x, y], k) => {
+    const g = nearestFraction(which, x, y), d = Math.abs(wrap01(g - f + 0.5) - 0.5);
+    if (!best || d < best.d) best = { k, f: g, d };
+  });
+  return best;
+}
+
+/** The correspondence a single-curve morph used, on the editor's paths:
+ * frame 0 is `from` and the last frame `to` where they stand, each
+ * started and run as the morph took it. */
+function usedCorrespondence(result) {
+  const frames = result.frames;
+  if (!frames.length || !frames[0].curve || !pathOf("from") || !pathOf("to")) return null;
+  const N = 1000;
+  const ends = { from: samplePoints(frames[0].curve, N + 1), to: samplePoints(frames[frames.length - 1].curve, N + 1) };
+  const at = (which, f) => { const q = ends[which][Math.round(f * N)]; return nearestFraction(which, q[0], q[1]); };
+  const start = {}, dir = {};
+  for (const which of ["from", "to"]) {
+    start[which] = at(which, 0);
+    const d = wrap01(at(which, 0.02) - start[which] + 0.5) - 0.5;
+    dir[which] = d < 0 ? -1 : 1;
+  }
+  let pairs = (result.matches_used || []).map(([a, b]) => [at("from", a), at("to", b)]);
+  if (state.sentPin) pairs = [];
+  return { pairs, start, dir };
 }
 
 /** The colour of input contour i: its pair's after a morph, else its side's. */
@@ -345,9 +490,7 @@ function onEditorClick(ev) {
   if (state.drawing) {
     const which = state.drawing;
     state.drawn[which].push(editorPoint(ev));
-    $("#curve-" + which).value = JSON.stringify({ type: "points", points: state.drawn[which],
-                                                  closed: $(`.draw-closed[data-which=${which}]`).checked });
-    renderEditor();
+    drawnChanged();
     return;
   }
   if (state.picking) {
@@ -365,6 +508,62 @@ function onEditorClick(ev) {
   }
 }
 
+/** The drawn points into the curve field and the editor. */
+function drawnChanged() {
+  const which = state.drawing;
+  $("#curve-" + which).value = JSON.stringify({ type: "points", points: state.drawn[which],
+                                                closed: $(`.draw-closed[data-which=${which}]`).checked });
+  $("#undo-point").disabled = !state.drawn[which].length;
+  renderEditor();
+}
+
+/** Take back the last drawn point (Undo, Ctrl-Z or Cmd-Z while drawing). */
+function undoPoint() {
+  if (!state.drawing || !state.drawn[state.drawing].length) return;
+  state.drawn[state.drawing].pop();
+  drawnChanged();
+}
+
+/** Add a point at the middle of the editor's view (Enter or the button
+ * while drawing, for drawing without a mouse), then move it with the
+ * arrow keys. */
+function addPointByKey() {
+  if (!state.drawing) return;
+  const vb = $("#editor").viewBox.baseVal;
+  const pts = state.drawn[state.drawing], last = pts[pts.length - 1];
+  const step = Math.max(vb.width, vb.height) / 20;
+  pts.push(last ? [Math.round((last[0] + step) * 100) / 100, last[1]]
+                : [Math.round((vb.x + vb.width / 2) * 100) / 100, Math.round((vb.y + vb.height / 2) * 100) / 100]);
+  drawnChanged();
+}
+
+function nudgePoint(dx, dy) {
+  const pts = state.drawing && state.drawn[state.drawing];
+  if (!pts || !pts.length) return;
+  const vb = $("#editor").viewBox.baseVal, step = Math.max(vb.width, vb.height) / 50, p = pts[pts.length - 1];
+  p[0] = Math.round((p[0] + dx * step) * 100) / 100;
+  p[1] = Math.round((p[1] + dy * step) * 100) / 100;
+  drawnChanged();
+}
+
+/** Reverse a curve or start it at its next or previous vertex, in its
+ * field's own terms; a start chosen here is kept (see optionsRequest). */
+async function steer(which, how) {
+  let curve;
+  try { curve = parseCurve($("#curve-" + which).value); } catch (e) { setFieldError(which, e.message); return; }
+  const out = steerCurve(curve, how);
+  const note = $("#note-" + which);
+  if (!out) {
+    note.textContent = how.reverse ? "Only an SVG path or drawn points can be reversed here."
+                                   : "Only a closed SVG path or closed drawn points can be started elsewhere here.";
+    return;
+  }
+  $("#curve-" + which).value = curveText(out);
+  $(`select.pick[data-testid=pick-${which}]`).value = "";
+  if (!how.reverse) $("#keep-starts").checked = true;
+  await updateCurve(which);
+}
+
 function toggleDraw(which) {
   const btn = $(`.draw[data-which=${which}]`);
   if (state.drawing === which) {
@@ -372,6 +571,8 @@ function toggleDraw(which) {
     btn.textContent = "Draw";
     $("#editor").classList.remove("drawing");
     $("#editor-hint").textContent = EDITOR_HINT;
+    $("#undo-point").disabled = true;
+    $("#add-point").disabled = true;
     updateCurve(which);
     return;
   }
@@ -381,7 +582,10 @@ function toggleDraw(which) {
   state.drawn[which] = [];
   btn.textContent = "Done";
   $("#editor").classList.add("drawing");
-  $("#editor-hint").textContent = `Click control points of the ${which} curve, then Done.`;
+  $("#editor-hint").textContent = `Click control points of the ${which} curve, then Done ` +
+    "(or, with the editor focused: Enter adds a point, the arrow keys move it; Ctrl-Z or Undo takes it back).";
+  $("#undo-point").disabled = true;
+  $("#add-point").disabled = false;
   renderEditor();
 }
 
@@ -399,6 +603,7 @@ function stopPicking() {
  * made on: a changed curve drops them. */
 function forgetMatches() {
   state.contourMatches = null;
+  state.used = null;
   if (!state.matches.length && state.pending == null) return;
   state.matches = [];
   state.pending = null;
@@ -422,13 +627,31 @@ function curvesClosed() {
  * leaves less of the partner's length to the sliver between the two. */
 function sendablePairs() {
   const closed = curvesClosed(), out = [];
-  for (const [a, b] of state.matches) {
+  /* the service runs a closed `to` of the other orientation backwards
+   * from its own start: its fractions then count the other way round */
+  const flip = closed && orientation("from") * orientation("to") < 0;
+  for (const [a, picked] of state.matches) {
+    const b = flip && !atSeam(picked) ? 1 - picked : picked;
     if (closed && atSeam(a) && atSeam(b)) continue;
     const inside = (f, other) => (!atSeam(f) ? f : closed ? (other < 0.5 ? SEAM_EPS : 1 - SEAM_EPS)
                                                           : (f < 0.5 ? SEAM_EPS : 1 - SEAM_EPS));
     out.push([inside(a, b), inside(b, a)]);
   }
   return out.sort((p, q) => p[0] - q[0]);
+}
+
+/** The sign of the area an editor path encloses (1 or -1; 0 without one). */
+function orientation(which) {
+  const p = pathOf(which);
+  if (!p) return 0;
+  const L = p.getTotalLength(), n = 200;
+  let area = 0, prev = p.getPointAtLength(0);
+  for (let i = 1; i <= n; i++) {
+    const q = p.getPointAtLength(L * i / n);
+    area += prev.x * q.y - q.x * prev.y;
+    prev = q;
+  }
+  return Math.sign(area);
 }
 
 function renderMatchList() {
@@ -459,10 +682,18 @@ function optionsRequest() {
     req.tolerance = Number.isFinite(v) ? v : tol;
   }
   const mode = $("#matches-mode").value;
+  state.sentPin = false;
   if (mode === "auto") req.matches = "auto";
   else if (mode === "pairs" && !isCompound()) {
     const pairs = sendablePairs();
     if (pairs.length) req.matches = pairs;
+  }
+  /* Closed curves without pairs get the start of `to` the service aligns
+   * best; one proportional pair keeps both starts as given and is
+   * otherwise the global morph exactly (see NUMERICS.md, Matches). */
+  if (!req.matches && mode !== "auto" && $("#keep-starts").checked && curvesClosed() && !isCompound()) {
+    req.matches = [[0.5, 0.5]];
+    state.sentPin = true;
   }
   return req;
 }
@@ -606,6 +837,7 @@ function clearResults() {
   state.results = [];
   state.panels = [];
   state.contourMatches = null;
+  state.used = null;
   $("#panels").replaceChildren();
   $("#results").hidden = true;
   renderContourList();
@@ -631,6 +863,8 @@ function showResults(outcomes) {
   for (const p of state.panels) panels.appendChild(p.root);
   const shape = isShapeResult(outcomes[0].result);
   state.contourMatches = shape ? outcomes[0].result.contour_matches_used || null : null;
+  const main = outcomes.find((o) => o.method === "curvature") || outcomes[0];
+  state.used = shape ? null : usedCorrespondence(main.result);
   renderContourList();
   renderEditor();
   const n = outcomes[0].result.frames.length;
@@ -1058,10 +1292,12 @@ async function copyText(text, what) {
 
 /* The state kept in the URL's fragment: both curves' text and the options. */
 const URL_FIELDS = ["method", "frames", "matches-mode", "closure", "anchor", "blend", "tolerance", "repeat", "duration", "easing"];
+const URL_CHECKS = ["keep-starts"];
 
 function saveUrl() {
   const st = { from: $("#curve-from").value, to: $("#curve-to").value };
   for (const id of URL_FIELDS) st[id] = $("#" + id).value;
+  for (const id of URL_CHECKS) st[id] = $("#" + id).checked;
   history.replaceState(null, "", "#" + encodeURIComponent(JSON.stringify(st)));
 }
 
@@ -1072,6 +1308,7 @@ function loadUrl() {
   try { st = JSON.parse(decodeURIComponent(location.hash.slice(1))); } catch { return false; }
   if (!st || typeof st.from !== "string" || typeof st.to !== "string") return false;
   for (const id of URL_FIELDS) if (typeof st[id] === "string") $("#" + id).value = st[id];
+  for (const id of URL_CHECKS) if (typeof st[id] === "boolean") $("#" + id).checked = st[id];
   for (const which of ["from", "to"]) {
     $("#curve-" + which).value = st[which];
     $(`select.pick[data-testid=pick-${which}]`).value = "";
@@ -1105,6 +1342,7 @@ function chooseExample(id) {
   if (!pair) return;
   state.matches = [];
   state.pending = null;
+  $("#keep-starts").checked = false;
   if ($("#matches-mode").value === "pairs") $("#matches-mode").value = "none";
   chooseCurve("from", pair[2]);
   chooseCurve("to", pair[3]);
@@ -1122,12 +1360,35 @@ function init() {
       timer = setTimeout(() => updateCurve(which), 300);
     });
     $(`.draw[data-which=${which}]`).addEventListener("click", () => toggleDraw(which));
+    $(`.reverse[data-which=${which}]`).addEventListener("click", () => steer(which, { reverse: true }));
+    $(`.start-prev[data-which=${which}]`).addEventListener("click", () => steer(which, { rotate: -1 }));
+    $(`.start-next[data-which=${which}]`).addEventListener("click", () => steer(which, { rotate: 1 }));
     $(`.draw-closed[data-which=${which}]`).addEventListener("change", (e) => {
       if (state.drawing === which) { renderEditor(); return; }
       setClosed(which, e.target.checked);
     });
   }
-  $("#editor").addEventListener("click", onEditorClick);
+  $("#editor").addEventListener("click", (ev) => {
+    if (state.suppressClick) { state.suppressClick = false; return; }
+    onEditorClick(ev);
+  });
+  $("#editor").addEventListener("pointermove", onDragMove);
+  $("#editor").addEventListener("pointerup", onDragEnd);
+  $("#editor").addEventListener("pointercancel", () => { state.drag = null; });
+  $("#editor").addEventListener("keydown", (e) => {
+    if (e.target !== $("#editor") || !state.drawing) return;
+    const moves = { ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, -1], ArrowDown: [0, 1] };
+    if (e.key === "Enter") { e.preventDefault(); addPointByKey(); }
+    else if (moves[e.key]) { e.preventDefault(); nudgePoint(...moves[e.key]); }
+  });
+  $("#undo-point").addEventListener("click", undoPoint);
+  $("#add-point").addEventListener("click", addPointByKey);
+  document.addEventListener("keydown", (e) => {
+    if (state.drawing && (e.ctrlKey || e.metaKey) && !e.shiftKey && e.key.toLowerCase() === "z") {
+      e.preventDefault();
+      undoPoint();
+    }
+  });
   $("#pick-matches").addEventListener("click", () => {
     if (state.picking) { stopPicking(); renderEditor(); return; }
     if (state.drawing) toggleDraw(state.drawing);
