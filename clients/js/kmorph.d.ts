@@ -88,6 +88,11 @@ export interface ClientOptions {
   maxPollInterval?: number;
 }
 
+/** Bytes of an answer read so far; total is null when unknown (a
+ * compressed body). */
+export interface DownloadProgress { received: number; total: number | null; }
+export interface Download { onDownload?: (progress: DownloadProgress) => void; }
+
 export interface Signal {
   signal?: AbortSignal;
 }
@@ -106,17 +111,17 @@ export class Client {
   pollInterval: number;
   maxPollInterval: number;
   request(method: string, path: string,
-          options?: { body?: unknown; signal?: AbortSignal; accept?: string }): Promise<{ response: Response; body: unknown }>;
+          options?: { body?: unknown; signal?: AbortSignal; accept?: string } & Download): Promise<{ response: Response; body: unknown }>;
   signature(curve: CurveIn, options?: SignatureOptions & Signal): Promise<SignatureResponse>;
   reconstruct(signature: Signature,
               options?: ReconstructOptions & Signal): Promise<ReconstructResponse>;
-  morph(request: MorphRequest, options?: Signal): Promise<MorphResult | string>;
+  morph(request: MorphRequest, options?: Signal & Download): Promise<MorphResult | string>;
   submitJob(request: MorphRequest, options?: Signal): Promise<JobStatus>;
   job(id: string, options?: Signal): Promise<JobStatus>;
-  jobResult(id: string, options?: Signal): Promise<MorphResult | string>;
+  jobResult(id: string, options?: Signal & Download): Promise<MorphResult | string>;
   cancelJob(id: string, options?: Signal): Promise<void>;
   morphJob(request: MorphRequest,
-           options?: { onProgress?: (status: JobStatus) => void } & Signal): Promise<MorphResult | string>;
+           options?: { onProgress?: (status: JobStatus) => void } & Signal & Download): Promise<MorphResult | string>;
   health(options?: Signal): Promise<Health>;
   ready(options?: Signal): Promise<Health>;
 }

@@ -110,6 +110,27 @@ function sleep(ms, signal) {
  * implementation to use instead of globalThis.fetch), headers (added to
  * every request), pollInterval (first job poll delay in ms, default 50,
  * growing to maxPollInterval, default 500). */
+/** The body of a response as text, calling onDownload({received, total})
+ * with every chunk read. */
+async function readWithProgress(response, onDownload) {
+  const length = Number(response.headers.get("Content-Length"));
+  const total = !response.headers.get("Content-Encoding") && length > 0 ? length : null;
+  const reader = response.body.getReader(), chunks = [];
+  let received = 0;
+  onDownload({ received, total });
+  for (;;) {
+    const { done, value } = await reader.read();
+    if (done) break;
+    chunks.push(value);
+    received += value.length;
+    onDownload({ received, total });
+  }
+  const all = new Uint8Array(received);
+  let at = 0;
+  for (const c of chunks) { all.set(c, at); at += c.length; }
+  return new TextDecoder().decode(all);
+}
+
 export class Client {
   constructor(options = {}) {
     const base = options.baseUrl != null ? String(options.baseUrl) : defaultBaseUrl();
@@ -122,8 +143,11 @@ export class Client {
 
   /** One HTTP exchange. Returns {response, body}: body is parsed JSON for
    * JSON answers, text for others, null for 204. Throws KmorphError for
-   * any status >= 400 and for network failures. */
-  async request(method, path, { body, signal, accept } = {}) {
+   * any status >= 400 and for network failures. With onDownload, a
+   * successful answer's body is read chunk by chunk and onDownload({received,
+   * total}) called as bytes arrive (total: null when unknown, as for a
+   * compressed body, whose Content-Length counts other bytes). */
+  async request(method, path, { body, signal, accept, onDownload } = {}) {
     const headers = { Accept: accept || "application/json, application/problem+json", ...this.headers };
     const init = { method, headers, signal };
     if (body !== undefined) {
@@ -141,7 +165,8 @@ export class Client {
     const ctype = response.headers.get("Content-Type") || "";
     let parsed = null;
     if (response.status !== 204) {
-      const text = await response.text();
+      const text = onDownload && response.body && response.status < 400
+        ? await readWithProgress(response, onDownload) : await response.text();
       if (/json/.test(ctype)) {
         try { parsed = JSON.parse(text); } catch { parsed = text; }
       } else parsed = text;
@@ -177,10 +202,11 @@ export class Client {
   }
 
   /** POST /v1/morph: a whole morph, synchronously. Returns the morph
-   * result object, or the SVG text when request.format is "svg". */
-  async morph(request, { signal } = {}) {
+   * result object, or the SVG text when request.format is "svg".
+   * Options: signal, onDownload (see request). */
+  async morph(request, { signal, onDownload } = {}) {
     const accept = request.format === "svg" ? "image/svg+xml, application/problem+json" : undefined;
-    return (await this.request("POST", "/v1/morph", { body: request, signal, accept })).body;
+    return (await this.request("POST", "/v1/morph", { body: request, signal, accept, onDownload })).body;
   }
 
   /** POST /v1/jobs: start a morph job. Returns the job status (id, state,
@@ -197,9 +223,9 @@ export class Client {
 
   /** GET /v1/jobs/{id}/result: the result of a done job (JSON object or
    * SVG text, as asked for when it was submitted). */
-  async jobResult(id, { signal } = {}) {
+  async jobResult(id, { signal, onDownload } = {}) {
     const accept = "application/json, image/svg+xml, application/problem+json";
-    return (await this.request("GET", `/v1/jobs/${encodeURIComponent(id)}/result`, { signal, accept })).body;
+    return (await this.request("GET", `/v1/jobs/${encodeURIComponent(id)}/result`, { signal, accept, onDownload })).body;
   }
 
   /** DELETE /v1/jobs/{id}: cancel a live job or forget a finished one. */
@@ -212,7 +238,7 @@ export class Client {
    * `signal` cancels the job on the service (DELETE) and rejects with the
    * signal's reason. A failed or cancelled job throws a KmorphError whose
    * problem carries the job's error. */
-  async morphJob(request, { onProgress, signal } = {}) {
+  async morphJob(request, { onProgress, onDownload, signal } = {}) {
     const first = await this.submitJob(request, { signal });
     const id = first.id;
     let status = first;
@@ -243,7 +269,7 @@ export class Client {
         }
         if (onProgress) onProgress(status);
       }
-      return await this.jobResult(id, { signal });
+      return await this.jobResult(id, { signal, onDownload });
     } catch (e) {
       if (signal && signal.aborted) {
         /* Free the workers: the caller no longer wants the frames. */

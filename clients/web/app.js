@@ -755,6 +755,17 @@ function setBusy(busy) {
   $("#cancel").disabled = !busy;
 }
 
+/* The last few morph answers by their request: asking again for what
+ * the page has (the same curves and options, or one method of a pair
+ * morphed side by side) takes no call. */
+const ANSWERS_KEPT = 4;
+const answers = new Map();
+
+function remember(key, result) {
+  answers.set(key, result);
+  while (answers.size > ANSWERS_KEPT) answers.delete(answers.keys().next().value);
+}
+
 async function runMorph() {
   try { await morphOnce(); } finally {
     /* finished morphs, counted for whoever waits for the page */
@@ -785,6 +796,14 @@ async function morphOnce() {
   const started = performance.now();
   const runs = methods.map(async (method) => {
     const request = { ...base, method };
+    const key = JSON.stringify(request);
+    const known = answers.get(key);
+    if (known) {
+      /* the same request answered before: its answer, not another call */
+      answers.delete(key);
+      answers.set(key, known);
+      return { method, request, result: known };
+    }
     try {
       const result = asJob
         ? await km.morphJob(request, { signal: ac.signal, onProgress: (s) => {
@@ -794,6 +813,7 @@ async function morphOnce() {
             $("#status").textContent = `job ${s.state}: ${Math.floor(mean * 100)}%`;
           } })
         : await km.morph(request, { signal: ac.signal });
+      remember(key, result);
       return { method, request, result };
     } catch (e) {
       return { method, request, error: e };
@@ -1224,17 +1244,32 @@ function downloadJson() {
 async function downloadSvg() {
   clearErrors();
   const layout = $("#svg-layout").value;
+  const bar = $("#download-progress"), note = $("#download-status");
   for (const o of state.results) {
     const { include, ...rest } = o.request;
     const req = { ...rest, format: "svg", svg: { layout } };
+    const name = `kmorph-${o.method}-${layout}.svg`;
+    /* a large export takes a while to arrive: show how much has */
+    const onDownload = ({ received, total }) => {
+      bar.hidden = false;
+      if (total) bar.value = received / total; else bar.removeAttribute("value");
+      note.textContent = `${name}: ${kib(received)}` + (total ? ` of ${kib(total)} KiB` : " KiB received");
+    };
+    note.textContent = `${name}: waiting for the service…`;
     try {
-      const svg = Number(req.frames) > JOB_FRAMES ? await km.morphJob(req) : await km.morph(req);
-      download(`kmorph-${o.method}-${layout}.svg`, new Blob([svg], { type: "image/svg+xml" }));
+      const svg = Number(req.frames) > JOB_FRAMES ? await km.morphJob(req, { onDownload }) : await km.morph(req, { onDownload });
+      const blob = new Blob([svg], { type: "image/svg+xml" });
+      download(name, blob);
+      note.textContent = `${name}: ${kib(blob.size)} KiB`;
     } catch (e) {
+      note.textContent = `${name}: failed`;
       showProblem(e, o.method);
     }
+    bar.hidden = true;
   }
 }
+
+const kib = (bytes) => (bytes / 1024).toFixed(bytes < 10240 ? 1 : 0);
 
 // ----------------------------------------------------------------- export
 
