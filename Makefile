@@ -236,7 +236,6 @@ test: deps
 	@$(MAKE) --no-print-directory test-server || true
 	@echo "== clients: curl, JS, Python and the web page in Chromium"
 	@$(MAKE) --no-print-directory test-clients || true
-	@echo "== several kmorphd over one redis-server behind nginx; deploy/ files"
 	@echo "== fuzzing: the request and SVG fuzz targets for $(TEST_FUZZ_SECONDS) s each (ASan, UBSan, LSan)"
 	@$(MAKE) --no-print-directory test-fuzz || true
 	@echo "== hardening: bad-input barrage, daemon under ASan, leaks, load, faults"
