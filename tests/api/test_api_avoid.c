@@ -306,10 +306,15 @@ static double hausdorff(const polyline *a, const polyline *b) {
 }
 
 /* The frames of "avoid" move steadily on every pair where it chose
- * another correspondence (the others are the frames of "allow"): no step between
- * consecutive frames (Hausdorff distance of their polylines) exceeds four
- * times the mean step - a sequence that switched correspondence halfway
- * would jump by a good part of the glyph in one step. */
+ * another correspondence (the others are the frames of "allow"): no step
+ * between consecutive frames (Hausdorff distance of their polylines) is
+ * more than twice the larger of its neighbours - a sequence that switched
+ * correspondence halfway would jump by a good part of the glyph in one
+ * step while the steps beside it stay small. A smooth motion may speed up
+ * (S -> 2 in Liberation Serif moves six times faster at mid-morph than at
+ * its ends, its steps 2.3 ... 18.4, 22.7, 22.0, 17.1 ... 3.5), but its
+ * step changes little from one frame to the next: at 41 frames no step
+ * of these pairs is more than 1.15 times the larger of its neighbours. */
 static void avoided_sequences_do_not_jump(void **state) {
   (void)state;
   cJSON *root = fixture();
@@ -324,30 +329,29 @@ static void avoided_sequences_do_not_jump(void **state) {
       continue;
     }
     polyline prev = {0, NULL, false};
-    double step[FRAMES - 1], sum = 0, most = 0;
+    double step[FRAMES - 1];
     int i = 0;
     const cJSON *f;
     cJSON_ArrayForEach(f, member(j, "frames")) {
       polyline cur = polyline_of(member(f, "curve"), 4);
-      if (i > 0) {
-        step[i - 1] = hausdorff(&prev, &cur);
-        sum += step[i - 1];
-        most = fmax(most, step[i - 1]);
-      }
+      if (i > 0) step[i - 1] = hausdorff(&prev, &cur);
       free(prev.p);
       prev = cur;
       i++;
     }
     free(prev.p);
-    double ratio = most / (sum / (FRAMES - 1));
-    if (ratio > 4)
-      print_error("%s -> %s: a step %.3g of mean %.3g\n", from, to, most,
-                  sum / (FRAMES - 1));
-    assert_true(ratio <= 4);
-    worst = fmax(worst, ratio);
+    for (int k = 0; k < FRAMES - 1; k++) {
+      double beside =
+          fmax(k > 0 ? step[k - 1] : 0, k < FRAMES - 2 ? step[k + 1] : 0);
+      if (step[k] > 2 * beside)
+        print_error("%s -> %s: step %d of %.3g beside %.3g\n", from, to, k,
+                    step[k], beside);
+      assert_true(step[k] <= 2 * beside);
+      worst = fmax(worst, step[k] / beside);
+    }
     cJSON_Delete(j);
   }
-  print_message("largest step / mean step: %.2f\n", worst);
+  print_message("largest step / larger neighbour: %.2f\n", worst);
   cJSON_Delete(root);
 }
 
