@@ -55,8 +55,9 @@ static double frames_extent(const api_morph_plan *pl) {
  * quarter more, as the count moves smoothly with t. */
 static km_status frame_points(const api_morph_plan *pl, const km_stop *stop,
                               size_t *points, km_error *err) {
-  km_frame_parts parts =
-      pl->metrics || pl->want_sig ? KM_FRAME_WITH_METRICS : KM_FRAME_CURVE;
+  km_frame_parts parts = pl->want_sig  ? KM_FRAME_WITH_SIGNATURE
+                         : pl->metrics ? KM_FRAME_WITH_METRICS
+                                       : KM_FRAME_CURVE;
   size_t idx[3] = {0, pl->nframes / 2, pl->nframes - 1}, most = 0;
   size_t first = 0, last = 0;
   for (int k = 0; k < 3; k++) {

@@ -533,6 +533,35 @@ static km_status placed_signature(const km_signature *sig, double rot,
                              sig->closed, err);
 }
 
+/* The planned frame with the metrics of the exact frame: the blended and
+ * closed signature gives length, curvature, energy and gap exactly (they
+ * describe the exact frame, not its approximation), and the crossings are
+ * counted on the returned curve, which is within the tolerance of it. The
+ * exact frame's reconstruction, the costly part of the general path, is
+ * not needed: a frame with metrics costs its signature and the crossing
+ * count beyond the planned frame, and has the same curve as without. */
+static km_status planned_frame_with_metrics(const km_morph *m, double t,
+                                            km_closure how, km__poll *poll,
+                                            km_curve *out,
+                                            km_frame_metrics *metrics,
+                                            km_error *err) {
+  km_signature sig;
+  km_signature_init(&sig);
+  km_curve f;
+  km_curve_init(&f);
+  double gap = 0.0;
+  km_status st = frame_signature(m, t, poll, &sig, &gap, err);
+  if (!st) st = planned_frame(m, t, how, poll, &f, err);
+  if (!st) st = exact_metrics(m, &sig, &f, gap, poll, metrics, err);
+  if (!st) {
+    *out = f;
+    km_curve_init(&f);
+  }
+  km_signature_free(&sig);
+  km_curve_free(&f);
+  return st;
+}
+
 static km_status frame_impl(const km_morph *m, double t, km__poll *poll,
                             km_curve *out, km_frame_metrics *metrics,
                             km_signature *sig_out, km_error *err) {
@@ -543,8 +572,10 @@ static km_status frame_impl(const km_morph *m, double t, km__poll *poll,
     return km__linear_frame(m, t, out, metrics, sig_out, poll, err);
   km_closure how =
       m->opt.closure == KM_CLOSURE_AUTO ? KM_CLOSURE_LSQ : m->opt.closure;
-  if (m->plan && !metrics && !sig_out)
-    return planned_frame(m, t, how, poll, out, err);
+  if (m->plan && !sig_out)
+    return metrics
+               ? planned_frame_with_metrics(m, t, how, poll, out, metrics, err)
+               : planned_frame(m, t, how, poll, out, err);
   km_signature sig;
   km_signature_init(&sig);
   km_curve f, placed;
@@ -589,7 +620,7 @@ km_status km_morph_frame_points(const km_morph *m, double t,
     *points = m->lin[0].n;
     return KM_OK;
   }
-  if (m->plan && parts == KM_FRAME_CURVE) {
+  if (m->plan && parts != KM_FRAME_WITH_SIGNATURE) {
     *points = km__frame_plan_points(m->plan);
     return KM_OK;
   }

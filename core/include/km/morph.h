@@ -168,9 +168,11 @@ KM_API void km_morph_free(km_morph *m);
  * two inputs for linear frames), and when asked (NULL: not) its metrics
  * (*metrics) and its exact, blended, closed and placed signature
  * (*sig_out, owned by the caller). t = 0 and t = 1 give the inputs where
- * they stand, within the tolerance. Curvature frames with metrics or a
+ * they stand, within the tolerance. A planned morph's frames come from
+ * its plan, with metrics too (those of the exact blended and closed
+ * signature; the crossings counted on the returned curve); frames with a
  * signature asked for are blended and reconstructed exactly rather than
- * taken from the morph's plan, and may have other control points. For the
+ * taken from the plan, and may have other control points. For the
  * linear method a frame that is not regular (a cusp) has no signature:
  * *sig_out is then left empty (km_signature_init; length 0) with KM_OK.
  * Returns KM_OK, or:
@@ -197,17 +199,19 @@ KM_API km_status km_morph_frame_until(const km_morph *m, double t,
                                       km_frame_metrics *metrics,
                                       km_signature *sig_out, km_error *err);
 
-/* What a frame is asked for: its curve alone, or its metrics or signature
- * too (such frames are blended and reconstructed exactly, not taken from
- * the morph's plan, and may have other control points). */
+/* What a frame is asked for: its curve alone, its metrics too (the same
+ * curve: a planned morph's frame with the metrics of its exact
+ * signature), or its signature too (such frames are blended and
+ * reconstructed exactly, not taken from the morph's plan, and may have
+ * other control points). */
 typedef enum km_frame_parts {
   KM_FRAME_CURVE,
-  KM_FRAME_WITH_METRICS
+  KM_FRAME_WITH_METRICS,
+  KM_FRAME_WITH_SIGNATURE
 } km_frame_parts;
 
 /* Control points the curve of the frame at t will have (km_morph_frame
- * with metrics or a signature asked for when parts is
- * KM_FRAME_WITH_METRICS), into *points (out, on KM_OK only), without
+ * with what parts says asked for), into *points (out, on KM_OK only), without
  * building it: exact, and free for a linear morph and for a planned
  * morph's curves; otherwise at the cost of the frame's blend and closure
  * (a third to a half of the frame). Stops as km_morph_frame_until (stop
