@@ -168,4 +168,32 @@ void api_morph_plan_free(api_morph_plan *plan);
 /* The contract itself, as JSON (GET /openapi.json); static string. */
 const char *api_openapi_json(void);
 
+
+/* ---- a prepared morph's frames apart (for daemons sharing one job's
+ * frames between processes; api/src/morph_frames.c). */
+
+/* True when the plan's answer can be assembled from its frames' texts
+ * (a JSON answer without "animate_d" or crossing avoidance); false for a
+ * NULL plan. The others need every frame of one plan: render them all
+ * there and call api_morph_result. */
+bool api_morph_frames_apart(const api_morph_plan *plan);
+/* Render frame i (if not rendered yet) and write its object of the JSON
+ * answer's "frames" into *out (out; body malloc'd, the caller frees;
+ * not NUL-counted in length). Same threading as api_morph_render_frame.
+ * Returns 200; 404 for a NULL plan, i out of range or a plan not
+ * api_morph_frames_apart; 422 if the frame cannot be built; 503 out of
+ * memory; 500 if the answer could not be cut apart. */
+api_status api_morph_frame_text(api_morph_plan *plan, size_t i,
+                                api_response *out);
+/* The whole answer into *out (out; the caller frees) from the texts of
+ * every frame in order (texts[i] of lengths[i] bytes, borrowed), as
+ * api_morph_frame_text wrote them, possibly in another process: equal to
+ * what api_morph_result would answer. Not concurrent with rendering.
+ * Returns 200; 404 for a NULL plan or one not api_morph_frames_apart;
+ * 503 out of memory (a problem in *out); 500 otherwise. */
+api_status api_morph_result_from_texts(api_morph_plan *plan,
+                                       const char *const *texts,
+                                       const size_t *lengths,
+                                       api_response *out);
+
 #endif
