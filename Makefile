@@ -162,7 +162,7 @@ $(BUILD)/server/src/config.o $(BUILD)/server/src/metrics.o: VERSION
 
 $(DAEMON): $(SRV_OBJ) $(LIBAPI) $(LIBCORE)
 	@mkdir -p $(@D)
-	$(CC) $(SRV_OBJ) -o $@ $(LIBAPI) $(LIBCORE) $(MHD_LIBS) $(CJSON_LIBS) -lm -lpthread $(LDFLAGS)
+	$(CC) $(SRV_OBJ) -o $@ $(LIBAPI) $(LIBCORE) $(MHD_LIBS) $(CJSON_LIBS) -lhiredis -lm -lpthread $(LDFLAGS)
 
 $(BUILD)/tests/core/%: tests/core/%.c $(SUPPORT_SRC) $(LIBCORE) | check-deps
 	@mkdir -p $(@D)

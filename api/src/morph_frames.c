@@ -1,15 +1,19 @@
-/* morph_frames.c - a prepared morph's frames one at a time as JSON text,
- * and its answer assembled from such texts: for daemons that share the
+/* morph_frames.c - a prepared morph's frames one at a time as text, and
+ * its answer assembled from such texts: for daemons that share the
  * frames of one job between processes.
  *
  * DESIGN: both functions run the very code of api_morph_result on a view
  * of the plan (the same struct with another frame range), so a frame's
- * text is byte for byte what the whole answer holds for it: the answer
- * assembled from texts equals the one api_morph_result writes. Answers
- * that need every frame's geometry at once (SVG, "animate_d", crossing
- * avoidance) are not assembled from texts: api_morph_frames_apart says
- * which.
+ * text is byte for byte what the whole answer holds for it and the answer
+ * assembled from texts equals the one api_morph_result writes. A frame's
+ * text is private to this pair of functions: a line saying whether the
+ * frame crosses (and why, as the answer's "intersections" would say),
+ * then its object of "frames". The members that depend on every frame
+ * ("crossing_frames", "reason") are written from those lines; answers
+ * that need every frame's geometry at once (SVG, "animate_d") are not
+ * assembled from texts: api_morph_frames_apart says which.
  */
+#include <stdio.h>
 #include <string.h>
 
 #include "json_write.h"
@@ -18,8 +22,7 @@
 #include "morph_plan.h"
 
 bool api_morph_frames_apart(const api_morph_plan *plan) {
-  return plan != NULL && !plan->svg && !plan->inc.animate_d &&
-         plan->opt.intersections != KM_INTERSECTIONS_AVOID;
+  return plan != NULL && !plan->svg && !plan->inc.animate_d;
 }
 
 /* The answer of plan restricted to frames [first, first + n): a view
@@ -55,6 +58,23 @@ static bool frames_span(const char *text, size_t len, size_t *open,
   return false;
 }
 
+/* The "intersections" member's crossing list and reason in the answer's
+ * tail: where "crossing_frames":[ ends (just after '[') and the reason's
+ * value [*rs, *re); false when the answer has no such member. */
+static bool crossings_span(const char *tail, const char **list,
+                           const char **rs, const char **re) {
+  static const char key[] = "\"intersections\":{\"crossing_frames\":[";
+  const char *a = strstr(tail, key);
+  if (a == NULL) return false;
+  *list = a + sizeof key - 1;
+  const char *r = strstr(*list, "],\"reason\":");
+  const char *e = r ? strstr(r, ",\"changed\":") : NULL;
+  if (r == NULL || e == NULL) return false;
+  *rs = r + 11;
+  *re = e;
+  return true;
+}
+
 api_status api_morph_frame_text(api_morph_plan *plan, size_t i,
                                 api_response *out) {
   api_response_init(out);
@@ -74,11 +94,38 @@ api_status api_morph_frame_text(api_morph_plan *plan, size_t i,
     api_response_free(&whole);
     return 500;
   }
-  memmove(whole.body, whole.body + open, close - open);
-  whole.length = close - open;
-  whole.body[whole.length] = '\0';
-  *out = whole;
+  /* The first line: "1" and the reason if the frame crosses, else "0". */
+  const char *list, *rs, *re;
+  bool crosses = false;
+  size_t head = 2;
+  if (crossings_span(whole.body + close, &list, &rs, &re) && *list != ']') {
+    crosses = true;
+    head = 2 + (size_t)(re - rs);
+  }
+  size_t len = head + (close - open);
+  char *body = km__malloc(len + 1);
+  if (body == NULL) {
+    api_response_free(&whole);
+    api_problem(out, 503, NULL, NULL, "out of memory", NULL, NULL, NULL);
+    return 503;
+  }
+  body[0] = crosses ? '1' : '0';
+  if (crosses) memcpy(body + 1, rs, (size_t)(re - rs));
+  body[head - 1] = '\n';
+  memcpy(body + head, whole.body + open, close - open);
+  body[len] = '\0';
+  out->status = 200;
+  out->content_type = whole.content_type;
+  out->body = body;
+  out->length = len;
+  api_response_free(&whole);
   return 200;
+}
+
+/* Append n bytes of s to buf at *at (room was counted). */
+static void put(char *buf, size_t *at, const char *s, size_t n) {
+  memcpy(buf + *at, s, n);
+  *at += n;
 }
 
 api_status api_morph_result_from_texts(api_morph_plan *plan,
@@ -98,8 +145,23 @@ api_status api_morph_result_from_texts(api_morph_plan *plan,
     api_response_free(&frame);
     return 500;
   }
+  /* Room: the empty answer, the frames, their indexes, one reason. */
   size_t total = frame.length + 1;
-  for (size_t i = 0; i < plan->nframes; i++) total += lengths[i] + 1;
+  const char *reason = NULL;
+  size_t reason_len = 0;
+  for (size_t i = 0; i < plan->nframes; i++) {
+    const char *nl = memchr(texts[i], '\n', lengths[i]);
+    if (nl == NULL) {
+      api_response_free(&frame);
+      return 500;
+    }
+    total += lengths[i] + 24;
+    if (texts[i][0] == '1' && reason == NULL) {
+      reason = texts[i] + 1;
+      reason_len = (size_t)(nl - reason);
+      total += reason_len;
+    }
+  }
   char *body = km__malloc(total);
   if (body == NULL) {
     api_response_free(&frame);
@@ -107,15 +169,33 @@ api_status api_morph_result_from_texts(api_morph_plan *plan,
     return 503;
   }
   size_t n = 0;
-  memcpy(body, frame.body, open);
-  n = open;
+  put(body, &n, frame.body, open);
   for (size_t i = 0; i < plan->nframes; i++) {
-    if (i > 0) body[n++] = ',';
-    memcpy(body + n, texts[i], lengths[i]);
-    n += lengths[i];
+    const char *nl = memchr(texts[i], '\n', lengths[i]);
+    size_t skip = (size_t)(nl - texts[i]) + 1;
+    if (i > 0) put(body, &n, ",", 1);
+    put(body, &n, texts[i] + skip, lengths[i] - skip);
   }
-  memcpy(body + n, frame.body + close, frame.length - close);
-  n += frame.length - close;
+  const char *tail = frame.body + close, *end = frame.body + frame.length;
+  const char *list, *rs, *re;
+  if (crossings_span(tail, &list, &rs, &re)) {
+    put(body, &n, tail, (size_t)(list - tail));
+    bool first = true;
+    for (size_t i = 0; i < plan->nframes; i++)
+      if (texts[i][0] == '1') {
+        char num[24];
+        int k = snprintf(num, sizeof num, first ? "%zu" : ",%zu", i);
+        put(body, &n, num, (size_t)k);
+        first = false;
+      }
+    put(body, &n, "],\"reason\":", 11);
+    if (reason != NULL)
+      put(body, &n, reason, reason_len);
+    else
+      put(body, &n, rs, (size_t)(re - rs));
+    tail = re;
+  }
+  put(body, &n, tail, (size_t)(end - tail));
   body[n] = '\0';
   out->status = 200;
   out->content_type = frame.content_type;

@@ -3,6 +3,7 @@
  * their time limits, and the creation of asynchronous jobs.
  */
 #include "compute.h"
+#include "endpoints.h"
 
 #include <errno.h>
 #include <stdlib.h>
@@ -172,6 +173,10 @@ static void job_refused(srv_req *r, int st) {
                 "the results of the jobs running now would fill the memory "
                 "kept for job results (KMORPH_RESULT_MEMORY); retry later",
                 NULL, NULL, r->rid);
+  } else if (st == SRV_RJOBS_FULL) {
+    job_refused(r, -1);
+  } else if (st == SRV_RJOBS_DOWN) {
+    srv__store_unavailable(&r->resp, r->rid);
   } else if (st == -3) {
     api_problem(&r->resp, 503, "/problems/shutting-down", "Shutting down",
                 "the service is stopping; retry on another instance", NULL,
@@ -196,12 +201,23 @@ static void create_job(srv_req *r, api_request *req) {
     api_morph_plan_free(plan);
     return;
   }
-  /* Admitted, the job runner owns the plan; refused, it is still ours. */
-  int st = srv_jobs_start(s->jobs, plan, r->deadline, predicted, r->job_id);
-  if (st != 0) {
-    api_morph_plan_free(plan);
-    job_refused(r, st);
-    return;
+  if (s->rjobs != NULL) {
+    /* Shared: the record keeps the request, the plan stays in this
+     * instance's cache for the batches it takes. */
+    int st = srv_rjobs_start(s->rjobs, r->body, r->len, r->accept, plan,
+                             r->job_id);
+    if (st != 0) {
+      job_refused(r, st);
+      return;
+    }
+  } else {
+    /* Admitted, the job runner owns the plan; refused, it is still ours. */
+    int st = srv_jobs_start(s->jobs, plan, r->deadline, predicted, r->job_id);
+    if (st != 0) {
+      api_morph_plan_free(plan);
+      job_refused(r, st);
+      return;
+    }
   }
   if (job_created_body(&r->resp, r->job_id, total) != 0) {
     job_refused(r, 0);
@@ -329,6 +345,14 @@ enum MHD_Result srv__hand_off(srv_req *r) {
   if (atomic_load(&s->draining))
     return srv__problem(r, 503, "/problems/shutting-down", "Shutting down",
                         "the service is stopping; retry on another instance",
+                        NULL, NULL);
+  if (r->route == SRV_R_JOBS && s->rjobs != NULL && !srv_rjobs_up(s->rjobs) &&
+      !srv_rjobs_ready(s->rjobs))
+    return srv__problem(r, 503, "/problems/job-store-unavailable",
+                        "Job store unavailable",
+                        "the job store (Redis, KMORPH_JOBS) cannot be reached "
+                        "now; synchronous routes still answer; retry after "
+                        "the time in Retry-After",
                         NULL, NULL);
   if (r->route == SRV_R_JOBS && srv_jobs_full(s->jobs)) {
     srv_metrics_reject(s->metrics, "jobs_full");

@@ -105,6 +105,14 @@ static const opt_def OPTS[] = {
     {"log-file", "KMORPH_LOG_FILE", OPT_STR, F(log_file),
      sizeof(((srv_config *)0)->log_file), 0, 0,
      "append the log here instead of stderr (reopened on SIGHUP)"},
+    {"jobs", "KMORPH_JOBS", OPT_STR, F(jobs), sizeof(((srv_config *)0)->jobs),
+     0, 0,
+     "share jobs with other instances through Redis: redis://HOST:PORT/DB "
+     "(empty: jobs in this process's memory)"},
+    {"job-reclaim", "KMORPH_JOB_RECLAIM", OPT_SECONDS, F(job_reclaim), 0, 0.5,
+     3600,
+     "with --jobs: seconds before the frames another instance took and did "
+     "not finish are rendered here"},
 };
 #undef F
 #define NOPTS (sizeof OPTS / sizeof OPTS[0])
@@ -138,6 +146,7 @@ void srv_config_default(srv_config *cfg) {
   cfg->job_ttl = 600;
   cfg->job_keep = 1000;
   cfg->shutdown_grace = 10;
+  cfg->job_reclaim = 5;
   cfg->retry_after = 1;
   snprintf(cfg->cors_origins, sizeof cfg->cors_origins, "*");
   srv_default_web_root(cfg->web_root, sizeof cfg->web_root);

@@ -45,6 +45,10 @@ typedef struct srv_config {
   char web_root[512];       /* folder of the web page served at / */
   bool access_log;          /* one line per request on stderr */
   char log_file[512];       /* log to this file (reopened on SIGHUP) */
+  char jobs[512];           /* redis://HOST:PORT/DB: jobs shared there;
+                             * "" = in this process's memory */
+  double job_reclaim;       /* seconds before a silent instance's batch
+                             * of a shared job is taken over */
 } srv_config;
 
 /* Fill *cfg with the built-in defaults. */

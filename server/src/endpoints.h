@@ -31,4 +31,8 @@ enum MHD_Result srv__serve_job(srv_req *r);
  * cancelled; 404 or 410 as for srv__serve_job. */
 enum MHD_Result srv__serve_result(srv_req *r);
 
+/* The 503 problem (into *out; the caller frees) of a job route while the
+ * shared job store (--jobs, Redis) cannot be reached; rid may be NULL. */
+void srv__store_unavailable(api_response *out, const char *rid);
+
 #endif

@@ -23,8 +23,35 @@ static enum MHD_Result job_missing(srv_req *r, int rc, const srv_job_view *v) {
                       "no such job", NULL, NULL);
 }
 
+void srv__store_unavailable(api_response *out, const char *rid) {
+  api_problem(out, 503, "/problems/job-store-unavailable",
+              "Job store unavailable",
+              "the job store (Redis, KMORPH_JOBS) cannot be reached now; "
+              "synchronous routes still answer; retry after the time in "
+              "Retry-After",
+              NULL, NULL, rid);
+}
+
+static enum MHD_Result store_down(srv_req *r) {
+  return srv__problem(r, 503, "/problems/job-store-unavailable",
+                      "Job store unavailable",
+                      "the job store (Redis, KMORPH_JOBS) cannot be reached "
+                      "now; synchronous routes still answer; retry after the "
+                      "time in Retry-After",
+                      NULL, NULL);
+}
+
 static enum MHD_Result delete_job(srv_req *r) {
   srv_server *s = r->srv;
+  if (s->rjobs != NULL) {
+    int rc = srv_rjobs_delete(s->rjobs, r->job_id);
+    if (rc == SRV_RJOBS_DOWN) return store_down(r);
+    if (rc == 0) return srv__answer(r, 204, NULL, (char *)"", 0, false);
+    return srv__problem(r, 404, "/problems/job-not-found", "Job not found",
+                        "no such job (finished jobs are forgotten after a "
+                        "while)",
+                        NULL, NULL);
+  }
   if (srv_jobs_cancel(s->jobs, r->job_id) == 0)
     return srv__answer(r, 204, NULL, (char *)"", 0, false);
   /* Not live: a final job is forgotten; an unknown one is 404. */
@@ -41,7 +68,9 @@ enum MHD_Result srv__serve_job(srv_req *r) {
   srv_job_view v;
   double now = srv_now();
   if (strcmp(r->method, "DELETE") == 0) return delete_job(r);
-  int rc = s->store->ops->get(s->store, r->job_id, now, &v);
+  int rc = s->rjobs != NULL ? srv_rjobs_get(s->rjobs, r->job_id, &v)
+                            : s->store->ops->get(s->store, r->job_id, now, &v);
+  if (rc == SRV_RJOBS_DOWN) return store_down(r);
   if (rc != SRV_STORE_OK) return job_missing(r, rc, &v);
   double progress =
       v.frames_total ? (double)v.frames_done / (double)v.frames_total : 0.0;
@@ -90,7 +119,15 @@ enum MHD_Result srv__serve_result(srv_req *r) {
   srv_server *s = r->srv;
   srv_job_view v;
   srv_result *res = NULL;
-  int rc = s->store->ops->result(s->store, r->job_id, srv_now(), &v, &res);
+  int rc = s->rjobs != NULL
+               ? srv_rjobs_result(s->rjobs, r->job_id, &v, &res)
+               : s->store->ops->result(s->store, r->job_id, srv_now(), &v,
+                                       &res);
+  if (rc == SRV_RJOBS_DOWN) return store_down(r);
+  if (rc == SRV_RJOBS_NOMEM) {
+    r->cut = "out of memory";
+    return MHD_NO;
+  }
   if (rc != SRV_STORE_OK) return job_missing(r, rc, &v);
   if (v.state == SRV_JOB_DONE && res != NULL) return answer_result(r, res);
   srv_result_unref(res);

@@ -29,6 +29,7 @@ struct srv_jobs {
   size_t max_active;
   double job_time;
   bool closed; /* shutting down: no new jobs */
+  atomic_size_t frames; /* frames rendered, for /metrics */
   srv_jobstore *store;
 };
 
@@ -37,6 +38,7 @@ srv_jobs *srv_jobs_create(srv_jobstore *store, size_t max_active,
   srv_jobs *j = calloc(1, sizeof *j);
   if (j == NULL) return NULL;
   pthread_mutex_init(&j->mu, NULL);
+  atomic_init(&j->frames, 0);
   j->store = store;
   j->max_active = max_active;
   j->job_time = job_time;
@@ -208,6 +210,7 @@ bool srv_jobs_work(void *ctx) {
   pthread_mutex_lock(&j->mu);
   x->in_flight--;
   if (rc == 0) {
+    atomic_fetch_add_explicit(&j->frames, 1, memory_order_relaxed);
     x->done++;
     if (!x->cancelled && !x->failed)
       j->store->ops->progress(j->store, x->id, SRV_JOB_RUNNING, x->done, now);
@@ -278,6 +281,10 @@ void srv_jobs_cancel_all(srv_jobs *j) {
     done_list = p->next;
     finalize(j, p);
   }
+}
+
+size_t srv_jobs_frames_rendered(srv_jobs *j) {
+  return atomic_load_explicit(&j->frames, memory_order_relaxed);
 }
 
 size_t srv_jobs_live(srv_jobs *j) {

@@ -57,6 +57,9 @@ int srv_jobs_cancel(srv_jobs *j, const char *id);
 /* Cancel every live job and admit no more (shutdown). */
 void srv_jobs_cancel_all(srv_jobs *j);
 
+/* Frames rendered so far (for /metrics). */
+size_t srv_jobs_frames_rendered(srv_jobs *j);
+
 /* Jobs whose plan is still held (live, or finishing in-flight frames). */
 size_t srv_jobs_live(srv_jobs *j);
 

@@ -234,6 +234,15 @@ char *srv_metrics_render(srv_metrics *m, const srv_gauges *g, size_t *len) {
   put_rejections(&b, m);
   pthread_mutex_unlock(&m->mu);
   put_gauges(&b, g);
+  if (g->extra != NULL)
+    put(&b, "%s", g->extra);
+  else
+    put(&b,
+        "# HELP kmorph_job_frames_rendered_total Frames of jobs rendered by "
+        "this instance.\n"
+        "# TYPE kmorph_job_frames_rendered_total counter\n"
+        "kmorph_job_frames_rendered_total %zu\n",
+        g->frames_rendered);
   if (b.oom) {
     free(b.p);
     return NULL;

@@ -55,6 +55,8 @@ typedef struct srv_gauges {
   size_t late_requests, late_sends; /* connections cut by their deadlines */
   size_t jobs[5];                   /* by srv_job_state */
   const char *const *job_state_names;
+  size_t frames_rendered; /* frames of jobs this process rendered */
+  const char *extra;      /* more lines in the exposition format, or NULL */
 } srv_gauges;
 
 /* Render everything as text; malloc'd, NUL-terminated, caller frees.

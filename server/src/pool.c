@@ -3,6 +3,7 @@
 
 #include <pthread.h>
 #include <stdlib.h>
+#include <time.h>
 
 typedef struct task {
   srv_task_fn fn;
@@ -21,6 +22,7 @@ struct srv_pool {
   bool stopping;
   srv_idle_fn idle;
   void *idle_ctx;
+  double poll; /* seconds between asks of idle when not kicked; 0: never */
   pthread_t *threads;
   size_t nthreads;
 };
@@ -52,7 +54,16 @@ static void *worker_main(void *arg) {
       p->busy--;
       if (did || p->kicks != seen || p->count > 0) continue;
     }
-    pthread_cond_wait(&p->cv, &p->mu);
+    if (p->poll > 0 && !p->stopping) {
+      struct timespec ts;
+      clock_gettime(CLOCK_REALTIME, &ts);
+      long ns = ts.tv_nsec + (long)(p->poll * 1e9);
+      ts.tv_sec += ns / 1000000000L;
+      ts.tv_nsec = ns % 1000000000L;
+      pthread_cond_timedwait(&p->cv, &p->mu, &ts);
+    } else {
+      pthread_cond_wait(&p->cv, &p->mu);
+    }
   }
   pthread_mutex_unlock(&p->mu);
   return NULL;
@@ -106,6 +117,13 @@ void srv_pool_submit(srv_pool *p, srv_task_fn fn, void *arg) {
   p->reserved--;
   p->ring[(p->head + p->count) % p->capacity] = (task){fn, arg};
   p->count++;
+  pthread_cond_broadcast(&p->cv);
+  pthread_mutex_unlock(&p->mu);
+}
+
+void srv_pool_set_poll(srv_pool *p, double seconds) {
+  pthread_mutex_lock(&p->mu);
+  p->poll = seconds;
   pthread_cond_broadcast(&p->cv);
   pthread_mutex_unlock(&p->mu);
 }

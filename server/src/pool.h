@@ -39,6 +39,11 @@ void srv_pool_unreserve(srv_pool *p);
 /* Put a task into a reserved slot; never fails. */
 void srv_pool_submit(srv_pool *p, srv_task_fn fn, void *arg);
 
+/* Make idle workers ask the background source again every `seconds`
+ * even without a kick (a source fed from outside the process, such as a
+ * shared job stream); 0, the default, waits for a kick. */
+void srv_pool_set_poll(srv_pool *p, double seconds);
+
 /* Tell idle workers that background work may have appeared. */
 void srv_pool_kick(srv_pool *p);
 

@@ -68,6 +68,12 @@ static enum MHD_Result dispatch(srv_req *r) {
     if (atomic_load(&s->draining))
       return srv__problem(r, 503, "/problems/shutting-down", "Shutting down",
                           "the service is stopping", NULL, NULL);
+    if (s->rjobs != NULL && !srv_rjobs_ready(s->rjobs))
+      return srv__problem(r, 503, "/problems/job-store-unavailable",
+                          "Job store unavailable",
+                          "the job store (Redis, KMORPH_JOBS) cannot be "
+                          "reached",
+                          NULL, NULL);
     return srv__answer(r, 200, SRV_JSON_TYPE, (char *)"{\"status\":\"ready\"}",
                        18, false);
   case SRV_R_METRICS: return srv__serve_metrics(r);

@@ -77,6 +77,32 @@ static void mhd_log(void *cls, const char *fmt, va_list ap) {
 
 /* -------------------------------------------------------- life cycle */
 
+/* --jobs: the Redis connections and the shared job runner. False (with
+ * the reason logged) if the URL is malformed or memory is short; Redis
+ * itself need not be up yet. */
+static bool shared_jobs(srv_server *s) {
+  char err[600];
+  s->redis = srv_redis_create(s->cfg.jobs, err, sizeof err);
+  if (s->redis == NULL) {
+    fprintf(s->log, "kmorphd: %s\n", err);
+    return false;
+  }
+  srv_rjobs_config rc = {.api = s->api,
+                         .max_job_frames = s->cfg.max_job_frames,
+                         .max_jobs = s->cfg.max_jobs,
+                         .job_time = s->cfg.job_time,
+                         .job_ttl = s->cfg.job_ttl,
+                         .visibility = s->cfg.job_reclaim};
+  /* As plan_job prepares a job: held to the memory kept for results. */
+  rc.api.max_output_bytes = s->cfg.result_memory;
+  s->rjobs = srv_rjobs_create(s->redis, &rc);
+  if (s->rjobs == NULL) return false;
+  if (!srv_redis_ping(s->redis))
+    fprintf(s->log, "kmorphd: jobs in Redis at %s, not reachable yet: "
+                    "retrying\n", srv_redis_name(s->redis));
+  return true;
+}
+
 srv_server *srv_server_create(const srv_config *cfg, srv_log *logger) {
   srv_server *s = calloc(1, sizeof *s);
   if (s == NULL) return NULL;
@@ -109,9 +135,19 @@ srv_server *srv_server_create(const srv_config *cfg, srv_log *logger) {
                                         cfg->result_memory);
   s->jobs =
       s->store ? srv_jobs_create(s->store, cfg->max_jobs, cfg->job_time) : NULL;
-  s->pool = s->jobs ? srv_pool_create(cfg->workers, cfg->queue, srv_jobs_work,
-                                      s->jobs)
-                    : NULL;
+  if (cfg->jobs[0] != '\0' && !shared_jobs(s)) {
+    srv_server_destroy(s);
+    return NULL;
+  }
+  if (s->rjobs != NULL)
+    s->pool = srv_pool_create(cfg->workers, cfg->queue, srv_rjobs_work,
+                              s->rjobs);
+  else
+    s->pool = s->jobs ? srv_pool_create(cfg->workers, cfg->queue,
+                                        srv_jobs_work, s->jobs)
+                      : NULL;
+  /* Batches of shared jobs appear without a kick from this process. */
+  if (s->pool != NULL && s->rjobs != NULL) srv_pool_set_poll(s->pool, 0.02);
   if (s->metrics == NULL || s->pool == NULL || s->watch == NULL) {
     fprintf(s->log, "kmorphd: cannot create the compute pool (%u workers)\n",
             cfg->workers);
@@ -175,6 +211,7 @@ static bool wait_until(srv_server *s, bool (*cond)(srv_server *),
 
 static bool compute_idle(srv_server *s) {
   return atomic_load(&s->suspended) == 0 && srv_jobs_live(s->jobs) == 0 &&
+         (s->rjobs == NULL || srv_rjobs_busy(s->rjobs) == 0) &&
          srv_pool_depth(s->pool) == 0;
 }
 
@@ -203,6 +240,9 @@ int srv_server_shutdown(srv_server *s) {
   /* Jobs stop between frames; queued requests are answered 503 by the
    * workers; requests already computing have the grace to finish. */
   srv_jobs_cancel_all(s->jobs);
+  /* Shared jobs are not cancelled: their batches go back to the stream
+   * for the other instances, or for this one once it is started again. */
+  if (s->rjobs != NULL) srv_rjobs_stop(s->rjobs);
   srv_pool_stop(s->pool);
   if (!wait_until(s, compute_idle, deadline)) {
     fprintf(s->log,
@@ -234,6 +274,13 @@ void srv_server_destroy(srv_server *s) {
   if (s->daemon != NULL) MHD_stop_daemon(s->daemon);
   srv_front_destroy(s->front); /* after: it flushes what the daemon wrote */
   srv_pool_destroy(s->pool);
+  if (s->rjobs != NULL) {
+    size_t n = srv_rjobs_hand_back_all(s->rjobs);
+    if (n > 0)
+      fprintf(s->log, "kmorphd: handed %zu batches of shared jobs back\n", n);
+  }
+  srv_rjobs_destroy(s->rjobs);
+  srv_redis_destroy(s->redis);
   srv_jobs_destroy(s->jobs);
   if (s->store) s->store->ops->destroy(s->store);
   srv_metrics_destroy(s->metrics);

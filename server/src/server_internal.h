@@ -25,6 +25,7 @@
 #include "front.h"
 #include "http_guard.h"
 #include "jobs.h"
+#include "jobs_redis.h"
 #include "jobstore.h"
 #include "kmapi/api.h"
 #include "log.h"
@@ -45,6 +46,10 @@ struct srv_server {
   srv_pool *pool;            /* compute workers and their bounded queue */
   srv_jobstore *store;       /* jobs' states and results */
   srv_jobs *jobs;            /* admission and running of asynchronous jobs */
+  srv_redis *redis;          /* --jobs: connections to Redis, else NULL */
+  srv_rjobs *rjobs;          /* --jobs: jobs shared through Redis (then
+                              * they, not store and jobs, hold every job),
+                              * else NULL */
   srv_metrics *metrics;      /* counters and histograms for /metrics */
   srv_watch *watch;          /* deadlines libmicrohttpd does not enforce */
   atomic_bool draining;      /* shutdown began: refuse new work, close */

@@ -108,6 +108,13 @@ enum MHD_Result srv__serve_metrics(srv_req *r) {
   g.result_bytes = s->store->ops->result_bytes(s->store);
   srv_watch_counts(s->watch, &g.late_requests, &g.late_sends);
   g.job_state_names = names;
+  char extra[2048];
+  if (s->rjobs != NULL) {
+    srv_rjobs_metrics(s->rjobs, extra, sizeof extra);
+    g.extra = extra;
+  } else {
+    g.frames_rendered = srv_jobs_frames_rendered(s->jobs);
+  }
   size_t len = 0;
   char *text = srv_metrics_render(s->metrics, &g, &len);
   if (text == NULL) return MHD_NO;

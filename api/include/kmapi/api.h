@@ -173,13 +173,13 @@ const char *api_openapi_json(void);
  * frames between processes; api/src/morph_frames.c). */
 
 /* True when the plan's answer can be assembled from its frames' texts
- * (a JSON answer without "animate_d" or crossing avoidance); false for a
- * NULL plan. The others need every frame of one plan: render them all
+ * (a JSON answer without "animate_d"); false for a NULL plan. The others need every frame of one plan: render them all
  * there and call api_morph_result. */
 bool api_morph_frames_apart(const api_morph_plan *plan);
-/* Render frame i (if not rendered yet) and write its object of the JSON
- * answer's "frames" into *out (out; body malloc'd, the caller frees;
- * not NUL-counted in length). Same threading as api_morph_render_frame.
+/* Render frame i (if not rendered yet) and write its text into *out
+ * (out; body malloc'd, the caller frees): its object of the answer's
+ * "frames" and what the answer's "intersections" needs of it, in a form
+ * only api_morph_result_from_texts reads. Same threading as api_morph_render_frame.
  * Returns 200; 404 for a NULL plan, i out of range or a plan not
  * api_morph_frames_apart; 422 if the frame cannot be built; 503 out of
  * memory; 500 if the answer could not be cut apart. */

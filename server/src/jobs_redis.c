@@ -1,0 +1,681 @@
+/* jobs_redis.c - batches of shared jobs: take one (XREADGROUP, or
+ * XAUTOCLAIM from a silent consumer), render its frames, store them by
+ * index, assemble the result when the last one is in, hand the batch back
+ * on a graceful stop (see jobs_redis.h). */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "jobs_redis_internal.h"
+#include "util.h"
+
+/* Plans kept per instance; unused ones beyond this are freed, oldest
+ * first (a later batch of the job prepares it again). */
+#define PLANS_MAX 64
+/* Seconds between two looks at a job's state from inside a frame. */
+static const double STATE_POLL = 0.2;
+/* Seconds between two XAUTOCLAIM tries of this instance. */
+static const double CLAIM_EVERY = 1.0;
+
+srv_rjobs *srv_rjobs_create(srv_redis *rd, const srv_rjobs_config *cfg) {
+  srv_rjobs *j = calloc(1, sizeof *j);
+  if (j == NULL) return NULL;
+  j->rd = rd;
+  j->cfg = *cfg;
+  char host[64] = "host", hex[9];
+  gethostname(host, sizeof host - 1);
+  srv_random_hex(hex, 8);
+  snprintf(j->consumer, sizeof j->consumer, "%s-%ld-%s", host, (long)getpid(),
+           hex);
+  pthread_mutex_init(&j->mu, NULL);
+  atomic_init(&j->stopping, false);
+  atomic_init(&j->group_ok, false);
+  atomic_init(&j->busy, 0);
+  atomic_init(&j->frames, 0);
+  atomic_init(&j->reclaimed, 0);
+  atomic_init(&j->handed, 0);
+  atomic_init(&j->assembled, 0);
+  atomic_init(&j->next_claim, 0.0);
+  return j;
+}
+
+/* ------------------------------------------------------- plan cache */
+
+/* Free unused plans beyond PLANS_MAX, least recently used first (mu
+ * held). */
+static void evict_locked(srv_rjobs *j) {
+  while (j->nplans > PLANS_MAX) {
+    rj_plan **victim = NULL;
+    for (rj_plan **pp = &j->plans; *pp; pp = &(*pp)->next)
+      if ((*pp)->refs == 0 && (victim == NULL || (*pp)->used < (*victim)->used))
+        victim = pp;
+    if (victim == NULL) return;
+    rj_plan *v = *victim;
+    *victim = v->next;
+    j->nplans--;
+    api_morph_plan_free(v->plan);
+    free(v);
+  }
+}
+
+void srv__rj_cache_put(srv_rjobs *j, const char *id, api_morph_plan *plan) {
+  rj_plan *e = calloc(1, sizeof *e);
+  if (e == NULL) {
+    api_morph_plan_free(plan);
+    return;
+  }
+  memcpy(e->id, id, SRV_JOB_ID_LEN + 1);
+  e->plan = plan;
+  e->used = srv_now();
+  pthread_mutex_lock(&j->mu);
+  e->next = j->plans;
+  j->plans = e;
+  j->nplans++;
+  evict_locked(j);
+  pthread_mutex_unlock(&j->mu);
+}
+
+void srv__rj_cache_drop(srv_rjobs *j, const char *id) {
+  rj_plan *v = NULL;
+  pthread_mutex_lock(&j->mu);
+  for (rj_plan **pp = &j->plans; *pp; pp = &(*pp)->next)
+    if (strcmp((*pp)->id, id) == 0) {
+      if ((*pp)->refs == 0) {
+        v = *pp;
+        *pp = v->next;
+        j->nplans--;
+      }
+      break;
+    }
+  pthread_mutex_unlock(&j->mu);
+  if (v) {
+    api_morph_plan_free(v->plan);
+    free(v);
+  }
+}
+
+static rj_plan *cache_find_locked(srv_rjobs *j, const char *id) {
+  for (rj_plan *p = j->plans; p; p = p->next)
+    if (strcmp(p->id, id) == 0) return p;
+  return NULL;
+}
+
+/* The plan of job id with a reference held, prepared from its stored
+ * request if this instance has none. NULL with the problem's status in
+ * *status (and the reason in why) if it cannot be prepared. */
+static rj_plan *cache_get(srv_rjobs *j, const char *id, const char *body,
+                          size_t len, const char *accept, int *status,
+                          char *why, size_t whycap) {
+  pthread_mutex_lock(&j->mu);
+  rj_plan *p = cache_find_locked(j, id);
+  if (p) {
+    p->refs++;
+    p->used = srv_now();
+  }
+  pthread_mutex_unlock(&j->mu);
+  if (p) return p;
+  api_request req = {.route = API_ROUTE_MORPH,
+                     .body = body,
+                     .length = len,
+                     .accept = accept[0] ? accept : NULL};
+  api_morph_plan *plan = NULL;
+  api_response err;
+  int rc = api_morph_prepare(&j->cfg.api, &req, j->cfg.max_job_frames, &plan,
+                             &err);
+  if (rc != 0 || plan == NULL) {
+    *status = rc >= 400 ? rc : 500;
+    snprintf(why, whycap, "the stored request could not be prepared again "
+                          "(%d)", rc);
+    api_response_free(&err);
+    return NULL;
+  }
+  api_response_free(&err);
+  srv__rj_cache_put(j, id, plan);
+  pthread_mutex_lock(&j->mu);
+  p = cache_find_locked(j, id);
+  if (p) p->refs++;
+  pthread_mutex_unlock(&j->mu);
+  if (p == NULL) *status = 503, snprintf(why, whycap, "out of memory");
+  return p;
+}
+
+static void cache_release(srv_rjobs *j, rj_plan *p) {
+  pthread_mutex_lock(&j->mu);
+  p->refs--;
+  evict_locked(j);
+  pthread_mutex_unlock(&j->mu);
+}
+
+/* ---------------------------------------------------------- batches */
+
+typedef struct batch {
+  char eid[64];                /* the stream entry */
+  char id[SRV_JOB_ID_LEN + 1]; /* the job */
+  size_t from, to;             /* frames [from, to) */
+  bool again;                  /* delivered before (claimed) */
+} batch;
+
+/* An entry [eid, [field, value, ...]] into *b; false if malformed. */
+static bool parse_entry(const redisReply *e, batch *b) {
+  if (e->type != REDIS_REPLY_ARRAY || e->elements != 2 ||
+      e->element[0]->type != REDIS_REPLY_STRING)
+    return false;
+  memset(b, 0, sizeof *b);
+  snprintf(b->eid, sizeof b->eid, "%s", e->element[0]->str);
+  const redisReply *f = e->element[1];
+  if (f->type != REDIS_REPLY_ARRAY) return true; /* deleted: acked below */
+  bool have_id = false;
+  for (size_t k = 0; k + 1 < f->elements; k += 2) {
+    const char *name = f->element[k]->str, *val = f->element[k + 1]->str;
+    if (name == NULL || val == NULL) continue;
+    if (strcmp(name, "id") == 0 && strlen(val) == SRV_JOB_ID_LEN) {
+      memcpy(b->id, val, SRV_JOB_ID_LEN + 1);
+      have_id = true;
+    } else if (strcmp(name, "from") == 0) {
+      b->from = strtoull(val, NULL, 10);
+    } else if (strcmp(name, "to") == 0) {
+      b->to = strtoull(val, NULL, 10);
+    }
+  }
+  if (!have_id) b->from = b->to = 0;
+  return true;
+}
+
+static void ensure_group(srv_rjobs *j, redisContext *c, bool *broken) {
+  redisReply *rep = srv__rj_cmd(c, broken, "XGROUP CREATE %s %s 0 MKSTREAM",
+                                RJ_STREAM, RJ_GROUP);
+  if (rep && (rep->type == REDIS_REPLY_STATUS ||
+              (rep->type == REDIS_REPLY_ERROR && strstr(rep->str, "BUSYGROUP"))))
+    atomic_store(&j->group_ok, true);
+  if (rep) freeReplyObject(rep);
+}
+
+/* After an error reply: a Redis that lost the group (restarted without
+ * its data) gets it again on the next try. */
+static void check_error(srv_rjobs *j, const redisReply *rep) {
+  if (rep->type == REDIS_REPLY_ERROR && strstr(rep->str, "NOGROUP"))
+    atomic_store(&j->group_ok, false);
+}
+
+/* One new batch for this consumer; false if none. */
+static bool read_one(srv_rjobs *j, redisContext *c, bool *broken, batch *b) {
+  redisReply *rep = srv__rj_cmd(c, broken,
+                                "XREADGROUP GROUP %s %s COUNT 1 STREAMS %s >",
+                                RJ_GROUP, j->consumer, RJ_STREAM);
+  if (rep == NULL) return false;
+  bool got = false;
+  if (rep->type == REDIS_REPLY_ARRAY && rep->elements == 1) {
+    const redisReply *s = rep->element[0];
+    if (s->type == REDIS_REPLY_ARRAY && s->elements == 2 &&
+        s->element[1]->type == REDIS_REPLY_ARRAY &&
+        s->element[1]->elements == 1)
+      got = parse_entry(s->element[1]->element[0], b);
+  } else {
+    check_error(j, rep);
+  }
+  freeReplyObject(rep);
+  return got;
+}
+
+/* One batch left pending by a consumer silent for the visibility
+ * timeout, claimed for this one; false if none. */
+static bool claim_one(srv_rjobs *j, redisContext *c, bool *broken, batch *b) {
+  long long idle_ms = (long long)(j->cfg.visibility * 1000.0);
+  redisReply *rep = srv__rj_cmd(c, broken,
+                                "XAUTOCLAIM %s %s %s %lld 0-0 COUNT 1",
+                                RJ_STREAM, RJ_GROUP, j->consumer, idle_ms);
+  if (rep == NULL) return false;
+  bool got = false;
+  if (rep->type == REDIS_REPLY_ARRAY && rep->elements >= 2 &&
+      rep->element[1]->type == REDIS_REPLY_ARRAY &&
+      rep->element[1]->elements >= 1) {
+    got = parse_entry(rep->element[1]->element[0], b);
+    b->again = true;
+  } else if (rep->type == REDIS_REPLY_ERROR) {
+    check_error(j, rep);
+  }
+  freeReplyObject(rep);
+  return got;
+}
+
+static const char ACK_LUA[] =
+    "redis.call('XACK', KEYS[1], ARGV[1], ARGV[2]) "
+    "redis.call('XDEL', KEYS[1], ARGV[2]) return 0";
+
+static void ack(redisContext *c, bool *broken, const batch *b) {
+  redisReply *rep = srv__rj_cmd(c, broken, "EVAL %s 1 %s %s %s", ACK_LUA,
+                                RJ_STREAM, RJ_GROUP, b->eid);
+  if (rep) freeReplyObject(rep);
+}
+
+/* The frames [from, to) of b as a new entry, delivered at once to any
+ * consumer, and b acknowledged: in one script, so that the frames are
+ * neither lost nor pending twice. */
+static const char HAND_BACK_LUA[] =
+    "redis.call('XADD', KEYS[1], '*', 'id', ARGV[3], 'from', ARGV[4], "
+    "'to', ARGV[5]) "
+    "redis.call('XACK', KEYS[1], ARGV[1], ARGV[2]) "
+    "redis.call('XDEL', KEYS[1], ARGV[2]) return 0";
+
+static void hand_back(srv_rjobs *j, redisContext *c, bool *broken,
+                      const batch *b, size_t from) {
+  redisReply *rep = srv__rj_cmd(
+      c, broken, "EVAL %s 1 %s %s %s %s %llu %llu", HAND_BACK_LUA, RJ_STREAM,
+      RJ_GROUP, b->eid, b->id, (unsigned long long)from,
+      (unsigned long long)b->to);
+  if (rep) freeReplyObject(rep);
+  if (!*broken) atomic_fetch_add(&j->handed, 1);
+}
+
+/* Why a frame's computation was stopped. */
+enum { WHY_NONE, WHY_SHUTDOWN, WHY_TIME, WHY_FINAL, WHY_BROKEN };
+
+typedef struct run_ctx {
+  srv_rjobs *j;
+  redisContext *c;
+  bool *broken;
+  char key[80];    /* the job's record */
+  double deadline; /* Unix seconds */
+  double next_look;
+  int why;
+} run_ctx;
+
+/* The job is still queued or running (false on a broken connection). */
+static bool still_live(run_ctx *x) {
+  redisReply *rep = srv__rj_cmd(x->c, x->broken, "HGET %s st", x->key);
+  if (rep == NULL) {
+    x->why = WHY_BROKEN;
+    return false;
+  }
+  bool live = rep->type == REDIS_REPLY_STRING &&
+              (strcmp(rep->str, "queued") == 0 ||
+               strcmp(rep->str, "running") == 0);
+  freeReplyObject(rep);
+  if (!live) x->why = WHY_FINAL;
+  return live;
+}
+
+/* A frame's stop condition: shutdown, out of time, or (looked up at most
+ * every STATE_POLL seconds) the job cancelled or failed elsewhere. */
+static bool run_should_stop(void *ctx) {
+  run_ctx *x = ctx;
+  if (atomic_load(&x->j->stopping)) return x->why = WHY_SHUTDOWN, true;
+  if (srv__rj_wall() > x->deadline) return x->why = WHY_TIME, true;
+  double now = srv_now();
+  if (now < x->next_look) return false;
+  x->next_look = now + STATE_POLL;
+  return !still_live(x);
+}
+
+/* KEYS: job, frames. ARGV: index, text. {new, done}; done is -1 if the
+ * job is no longer live. */
+static const char FRAME_LUA[] =
+    "local st = redis.call('HGET', KEYS[1], 'st') "
+    "if st ~= 'queued' and st ~= 'running' then return {0, -1} end "
+    "if st == 'queued' then redis.call('HSET', KEYS[1], 'st', 'running') end "
+    "if redis.call('HSETNX', KEYS[2], ARGV[1], ARGV[2]) == 1 then "
+    "return {1, redis.call('HINCRBY', KEYS[1], 'd', 1)} end "
+    "return {0, tonumber(redis.call('HGET', KEYS[1], 'd'))}";
+
+/* Store frame i's text; *done receives the frames stored in all, -1 if
+ * the job is no longer live. True if this call stored it. */
+static bool store_frame(run_ctx *x, const char *id, size_t i,
+                        const api_response *text, long long *done) {
+  char kf[80];
+  srv__rj_key(kf, sizeof kf, "frames", id);
+  redisReply *rep = srv__rj_cmd(
+      x->c, x->broken, "EVAL %s 2 %s %s %llu %b", FRAME_LUA, x->key, kf,
+      (unsigned long long)i, text->body ? text->body : "",
+      text->body ? text->length : (size_t)0);
+  bool fresh = false;
+  *done = -1;
+  if (rep && rep->type == REDIS_REPLY_ARRAY && rep->elements == 2) {
+    fresh = rep->element[0]->integer == 1;
+    *done = rep->element[1]->integer;
+  }
+  if (rep) freeReplyObject(rep);
+  return fresh;
+}
+
+static void fail_job(run_ctx *x, const char *id, int status, const char *msg) {
+  if (srv__rj_finish(x->j, x->c, id, SRV_JOB_FAILED, NULL, status, msg) < 0)
+    *x->broken = true;
+}
+
+/* Every frame is stored: the result, in frame order, into the record. */
+static void assemble(run_ctx *x, const char *id, api_morph_plan *plan,
+                     size_t total) {
+  api_response res;
+  api_response_init(&res);
+  int rc = 500;
+  if (!api_morph_frames_apart(plan)) {
+    rc = api_morph_result(plan, &res);
+  } else {
+    char kf[80];
+    srv__rj_key(kf, sizeof kf, "frames", id);
+    redisReply *rep = srv__rj_cmd(x->c, x->broken, "HGETALL %s", kf);
+    if (rep == NULL) return;
+    const char **texts = calloc(total ? total : 1, sizeof *texts);
+    size_t *lens = calloc(total ? total : 1, sizeof *lens);
+    size_t have = 0;
+    if (texts && lens && rep->type == REDIS_REPLY_ARRAY)
+      for (size_t k = 0; k + 1 < rep->elements; k += 2) {
+        size_t i = strtoull(rep->element[k]->str, NULL, 10);
+        if (i < total && texts[i] == NULL) {
+          texts[i] = rep->element[k + 1]->str;
+          lens[i] = rep->element[k + 1]->len;
+          have++;
+        }
+      }
+    if (have == total)
+      rc = api_morph_result_from_texts(plan, texts, lens, &res);
+    free(texts);
+    free(lens);
+    freeReplyObject(rep);
+    if (have != total && texts && lens) {
+      /* The count says all are in, the hash does not: a job cancelled
+       * and forgotten meanwhile. Nothing to assemble. */
+      return;
+    }
+  }
+  if (rc == 200 && res.body != NULL) {
+    if (srv__rj_finish(x->j, x->c, id, SRV_JOB_DONE, &res, 0, NULL) < 0)
+      *x->broken = true;
+    else
+      atomic_fetch_add(&x->j->assembled, 1);
+  } else {
+    char msg[96];
+    snprintf(msg, sizeof msg, "the result could not be assembled (%d)", rc);
+    fail_job(x, id, rc >= 400 ? rc : 500, msg);
+  }
+  api_response_free(&res);
+}
+
+static void out_of_time(run_ctx *x, const char *id, long long done,
+                        size_t total) {
+  char msg[200];
+  snprintf(msg, sizeof msg,
+           "the job ran out of time: wall-time limit %g s (KMORPH_JOB_TIME) "
+           "reached after %lld of %zu frames",
+           x->j->cfg.job_time, done > 0 ? done : 0, total);
+  fail_job(x, id, 503, msg);
+}
+
+/* What the record says a batch should do. */
+typedef struct record {
+  bool live;
+  size_t total;
+  double deadline;
+  long long done;
+} record;
+
+/* Read the record and its request; *p receives the job's plan (NULL if
+ * the job is not live or its plan failed, then recorded as failed). */
+static record open_job(run_ctx *x, const batch *b, rj_plan **p) {
+  record r = {false, 0, 0, 0};
+  *p = NULL;
+  redisReply *rep =
+      srv__rj_cmd(x->c, x->broken, "HMGET %s st n dl b a d", x->key);
+  if (rep == NULL) return r;
+  const char *st = NULL;
+  if (rep->type == REDIS_REPLY_ARRAY && rep->elements == 6 &&
+      rep->element[0]->type == REDIS_REPLY_STRING &&
+      rep->element[3]->type == REDIS_REPLY_STRING)
+    st = rep->element[0]->str;
+  if (st && (strcmp(st, "queued") == 0 || strcmp(st, "running") == 0)) {
+    r.live = true;
+    r.total = strtoull(rep->element[1]->str ? rep->element[1]->str : "0",
+                       NULL, 10);
+    r.deadline = strtod(rep->element[2]->str ? rep->element[2]->str : "0",
+                        NULL);
+    r.done = strtoll(rep->element[5]->str ? rep->element[5]->str : "0", NULL,
+                     10);
+    x->deadline = r.deadline;
+    if (srv__rj_wall() > r.deadline) {
+      out_of_time(x, b->id, r.done, r.total);
+      r.live = false;
+    } else {
+      int status = 0;
+      char why[160];
+      const char *acc = rep->element[4]->str ? rep->element[4]->str : "";
+      *p = cache_get(x->j, b->id, rep->element[3]->str, rep->element[3]->len,
+                     acc, &status, why, sizeof why);
+      if (*p == NULL) {
+        fail_job(x, b->id, status, why);
+        r.live = false;
+      } else if (api_morph_frame_count((*p)->plan) != r.total) {
+        cache_release(x->j, *p);
+        *p = NULL;
+        fail_job(x, b->id, 500, "the stored request plans another count of "
+                                "frames");
+        r.live = false;
+      }
+    }
+  }
+  freeReplyObject(rep);
+  return r;
+}
+
+/* Render frames [from, to) of b and store them; assemble the result if
+ * the job is then complete; acknowledge (or hand back) the batch. */
+static void run_batch(srv_rjobs *j, redisContext *c, bool *broken,
+                      const batch *b) {
+  run_ctx x = {.j = j, .c = c, .broken = broken, .why = WHY_NONE};
+  srv__rj_key(x.key, sizeof x.key, "job", b->id);
+  rj_plan *p = NULL;
+  record r = b->from < b->to ? open_job(&x, b, &p) : (record){0};
+  bool last = false;
+  long long done = r.done;
+  size_t i = b->from;
+  if (*broken) goto out;
+  for (; r.live && i < b->to && i < r.total; i++) {
+    if (atomic_load(&j->stopping)) {
+      x.why = WHY_SHUTDOWN;
+      break;
+    }
+    if (i > b->from && !still_live(&x)) break;
+    x.next_look = srv_now() + STATE_POLL;
+    int rc = api_morph_render_frame_until(p->plan, i, run_should_stop, &x);
+    if (rc != 0) {
+      if (x.why == WHY_NONE && srv__rj_wall() > r.deadline) x.why = WHY_TIME;
+      if (x.why == WHY_TIME) out_of_time(&x, b->id, done, r.total);
+      if (x.why == WHY_NONE) {
+        char msg[96];
+        snprintf(msg, sizeof msg, "frame %zu could not be built", i);
+        fail_job(&x, b->id, rc >= 400 ? rc : 422, msg);
+      }
+      break;
+    }
+    atomic_fetch_add(&j->frames, 1);
+    api_response text;
+    api_response_init(&text);
+    if (api_morph_frames_apart(p->plan)) {
+      rc = api_morph_frame_text(p->plan, i, &text);
+      if (rc != 200) {
+        api_response_free(&text);
+        char msg[96];
+        snprintf(msg, sizeof msg, "frame %zu could not be written (%d)", i,
+                 rc);
+        fail_job(&x, b->id, rc >= 400 ? rc : 500, msg);
+        break;
+      }
+    }
+    bool fresh = store_frame(&x, b->id, i, &text, &done);
+    api_response_free(&text);
+    if (done < 0) break;
+    if (fresh && (size_t)done == r.total) last = true;
+  }
+  if (*broken) goto out; /* pending: reclaimed after the timeout */
+  if (x.why == WHY_SHUTDOWN && r.live && i < b->to) {
+    hand_back(j, c, broken, b, i);
+    goto out;
+  }
+  /* A batch delivered again may find every frame stored by a consumer
+   * that died before it assembled the result. */
+  if (r.live && done >= 0 && (size_t)done == r.total &&
+      (last || b->again || r.done == (long long)r.total))
+    assemble(&x, b->id, p->plan, r.total);
+  if (!*broken) ack(c, broken, b);
+out:
+  if (p) {
+    cache_release(j, p);
+    if (!r.live || (done >= 0 && (size_t)done == r.total) || x.why == WHY_FINAL)
+      srv__rj_cache_drop(j, b->id);
+  }
+}
+
+bool srv_rjobs_work(void *ctx) {
+  srv_rjobs *j = ctx;
+  if (atomic_load(&j->stopping)) return false;
+  redisContext *c = srv_redis_acquire(j->rd);
+  if (c == NULL) return false;
+  bool broken = false, got = false;
+  batch b;
+  if (!atomic_load(&j->group_ok)) ensure_group(j, c, &broken);
+  double now = srv_now();
+  double next = atomic_load(&j->next_claim);
+  if (!broken && now >= next &&
+      atomic_compare_exchange_strong(&j->next_claim, &next, now + CLAIM_EVERY)) {
+    got = claim_one(j, c, &broken, &b);
+    if (got) atomic_fetch_add(&j->reclaimed, 1);
+  }
+  if (!got && !broken) got = read_one(j, c, &broken, &b);
+  if (got && !broken) {
+    atomic_fetch_add(&j->busy, 1);
+    run_batch(j, c, &broken, &b);
+    atomic_fetch_sub(&j->busy, 1);
+  }
+  srv_redis_release(j->rd, c, broken);
+  return got && !broken;
+}
+
+void srv_rjobs_stop(srv_rjobs *j) {
+  atomic_store(&j->stopping, true);
+}
+
+size_t srv_rjobs_busy(srv_rjobs *j) {
+  return atomic_load(&j->busy);
+}
+
+size_t srv_rjobs_hand_back_all(srv_rjobs *j) {
+  redisContext *c = srv_redis_acquire(j->rd);
+  if (c == NULL) return 0;
+  bool broken = false;
+  size_t n = 0;
+  /* Claimed by this consumer (idle 0) so that XCLAIM returns the fields. */
+  redisReply *rep = srv__rj_cmd(c, &broken, "XPENDING %s %s - + 100 %s",
+                                RJ_STREAM, RJ_GROUP, j->consumer);
+  if (rep && rep->type == REDIS_REPLY_ARRAY) {
+    for (size_t k = 0; k < rep->elements && !broken; k++) {
+      const redisReply *e = rep->element[k];
+      if (e->type != REDIS_REPLY_ARRAY || e->elements < 1) continue;
+      redisReply *cl = srv__rj_cmd(c, &broken, "XCLAIM %s %s %s 0 %s",
+                                   RJ_STREAM, RJ_GROUP, j->consumer,
+                                   e->element[0]->str);
+      batch b;
+      if (cl && cl->type == REDIS_REPLY_ARRAY && cl->elements == 1 &&
+          parse_entry(cl->element[0], &b)) {
+        if (b.from < b.to)
+          hand_back(j, c, &broken, &b, b.from);
+        else
+          ack(c, &broken, &b);
+        n++;
+      }
+      if (cl) freeReplyObject(cl);
+    }
+  }
+  if (rep) freeReplyObject(rep);
+  srv_redis_release(j->rd, c, broken);
+  return n;
+}
+
+bool srv_rjobs_ready(srv_rjobs *j) {
+  return srv_redis_ping(j->rd);
+}
+
+bool srv_rjobs_up(srv_rjobs *j) {
+  return srv_redis_up(j->rd);
+}
+
+/* The group's pending count and this consumer's, and the stream's
+ * length; false if Redis did not answer. */
+static bool stream_counts(srv_rjobs *j, long long *len, long long *pending,
+                          long long *mine) {
+  redisContext *c = srv_redis_acquire(j->rd);
+  if (c == NULL) return false;
+  bool broken = false;
+  *len = *pending = *mine = 0;
+  redisReply *rep = srv__rj_cmd(c, &broken, "XLEN %s", RJ_STREAM);
+  if (rep && rep->type == REDIS_REPLY_INTEGER) *len = rep->integer;
+  if (rep) freeReplyObject(rep);
+  rep = broken ? NULL
+               : srv__rj_cmd(c, &broken, "XPENDING %s %s", RJ_STREAM, RJ_GROUP);
+  if (rep && rep->type == REDIS_REPLY_ARRAY && rep->elements == 4) {
+    *pending = rep->element[0]->integer;
+    const redisReply *per = rep->element[3];
+    if (per->type == REDIS_REPLY_ARRAY)
+      for (size_t k = 0; k < per->elements; k++) {
+        const redisReply *e = per->element[k];
+        if (e->type == REDIS_REPLY_ARRAY && e->elements == 2 &&
+            strcmp(e->element[0]->str, j->consumer) == 0)
+          *mine = strtoll(e->element[1]->str, NULL, 10);
+      }
+  }
+  if (rep) freeReplyObject(rep);
+  srv_redis_release(j->rd, c, broken);
+  return !broken;
+}
+
+void srv_rjobs_metrics(srv_rjobs *j, char *buf, size_t cap) {
+  long long len = 0, pending = 0, mine = 0;
+  bool up = stream_counts(j, &len, &pending, &mine);
+  /* Acknowledged batches are deleted, so the stream holds the batches
+   * not yet delivered plus the pending ones. */
+  long long lag = len - pending > 0 ? len - pending : 0;
+  snprintf(
+      buf, cap,
+      "# HELP kmorph_job_frames_rendered_total Frames of jobs rendered by "
+      "this instance.\n"
+      "# TYPE kmorph_job_frames_rendered_total counter\n"
+      "kmorph_job_frames_rendered_total %zu\n"
+      "# HELP kmorph_redis_up Whether Redis (--jobs) answered now.\n"
+      "# TYPE kmorph_redis_up gauge\n"
+      "kmorph_redis_up %d\n"
+      "# HELP kmorph_jobs_stream_lag Batches in the work stream not yet "
+      "delivered to any instance.\n"
+      "# TYPE kmorph_jobs_stream_lag gauge\n"
+      "kmorph_jobs_stream_lag %lld\n"
+      "# HELP kmorph_jobs_pending_batches Batches delivered and not yet "
+      "acknowledged: by every instance, by this one.\n"
+      "# TYPE kmorph_jobs_pending_batches gauge\n"
+      "kmorph_jobs_pending_batches{consumer=\"all\"} %lld\n"
+      "kmorph_jobs_pending_batches{consumer=\"self\"} %lld\n"
+      "# HELP kmorph_jobs_reclaimed_batches_total Batches this instance "
+      "claimed from an instance silent past the visibility timeout.\n"
+      "# TYPE kmorph_jobs_reclaimed_batches_total counter\n"
+      "kmorph_jobs_reclaimed_batches_total %zu\n"
+      "# HELP kmorph_jobs_handed_back_batches_total Batches this instance "
+      "handed back unfinished when stopping.\n"
+      "# TYPE kmorph_jobs_handed_back_batches_total counter\n"
+      "kmorph_jobs_handed_back_batches_total %zu\n"
+      "# HELP kmorph_jobs_assembled_total Job results this instance "
+      "assembled.\n"
+      "# TYPE kmorph_jobs_assembled_total counter\n"
+      "kmorph_jobs_assembled_total %zu\n",
+      (size_t)atomic_load(&j->frames), up ? 1 : 0, lag, pending, mine,
+      (size_t)atomic_load(&j->reclaimed), (size_t)atomic_load(&j->handed),
+      (size_t)atomic_load(&j->assembled));
+}
+
+void srv_rjobs_destroy(srv_rjobs *j) {
+  if (j == NULL) return;
+  while (j->plans) {
+    rj_plan *p = j->plans;
+    j->plans = p->next;
+    api_morph_plan_free(p->plan);
+    free(p);
+  }
+  pthread_mutex_destroy(&j->mu);
+  free(j);
+}
