@@ -236,6 +236,8 @@ test: deps
 	@$(MAKE) --no-print-directory test-server || true
 	@echo "== clients: curl, JS, Python and the web page in Chromium"
 	@$(MAKE) --no-print-directory test-clients || true
+	@echo "== scale-out: redis-server, two kmorphd and nginx on loopback (tests/cluster)"
+	@$(MAKE) --no-print-directory test-cluster || true
 	@echo "== fuzzing: the request and SVG fuzz targets for $(TEST_FUZZ_SECONDS) s each (ASan, UBSan, LSan)"
 	@$(MAKE) --no-print-directory test-fuzz || true
 	@echo "== hardening: bad-input barrage, daemon under ASan, leaks, load, faults"
