@@ -49,20 +49,10 @@ km_status km__shape_flatten(const km_curve *c, double **pts, size_t *np) {
   return KM_OK;
 }
 
-/* Sunday's crossing-number form of the winding number: exact for the
- * polyline given, with half-open edges so a vertex is counted once. */
 int km__poly_winding(const double *P, size_t np, const double p[2]) {
   int w = 0;
-  for (size_t i = 0; i < np; i++) {
-    const double *a = P + 2 * i, *b = P + 2 * ((i + 1) % np);
-    double cross =
-        (b[0] - a[0]) * (p[1] - a[1]) - (p[0] - a[0]) * (b[1] - a[1]);
-    if (a[1] <= p[1]) {
-      if (b[1] > p[1] && cross > 0) w++;
-    } else if (b[1] <= p[1] && cross < 0) {
-      w--;
-    }
-  }
+  for (size_t i = 0; i < np; i++)
+    w += km__edge_winding(P + 2 * i, P + 2 * ((i + 1) % np), p);
   return w;
 }
 
@@ -100,20 +90,6 @@ void km__curve_area(const km_curve *c, double *area, double centroid[2]) {
   centroid[1] = a2 != 0.0 ? my / a2 : NAN;
 }
 
-static double orient2(const double *a, const double *b, const double *c) {
-  return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-}
-
-/* Strictly opposite signs on both sides: touching or collinear segments
- * are not proper crossings. */
-static bool proper_cross(const double *a, const double *b, const double *c,
-                         const double *d) {
-  double o1 = orient2(a, b, c), o2 = orient2(a, b, d);
-  double o3 = orient2(c, d, a), o4 = orient2(c, d, b);
-  return ((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) &&
-         ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0));
-}
-
 long km__poly_crossings(const double *P, size_t np, const double *Q, size_t nq,
                         km__poll *poll) {
   long count = 0;
@@ -126,7 +102,7 @@ long km__poly_crossings(const double *P, size_t np, const double *Q, size_t nq,
       if (fmax(c[0], d[0]) < x0 || fmin(c[0], d[0]) > x1 ||
           fmax(c[1], d[1]) < y0 || fmin(c[1], d[1]) > y1)
         continue;
-      if (proper_cross(a, b, c, d)) count++;
+      if (km__edge_crosses(a, b, c, d)) count++;
     }
     if (km__poll_stop(poll, (long)(nq / 64) + 1)) return -1;
   }
@@ -419,8 +395,10 @@ cleanup:
 /* The point nearest x among points set in from the closed polyline P by
  * 3% of its extent along each edge's normal, on the side whose winding
  * is not 0: a point well inside a region of any shape, near x. */
-void km__poly_interior_point(const double *P, size_t np, const double x[2],
+void km__poly_interior_point(const km__poly_index *ix, const double x[2],
                              double out[2]) {
+  const double *P = ix->P;
+  size_t np = ix->np;
   double x0 = P[0], x1 = P[0], y0 = P[1], y1 = P[1];
   for (size_t i = 1; i < np; i++) {
     x0 = fmin(x0, P[2 * i]);
@@ -439,7 +417,7 @@ void km__poly_interior_point(const double *P, size_t np, const double x[2],
       double q[2] = {0.5 * (a[0] + b[0]) - side * delta * dy / l,
                      0.5 * (a[1] + b[1]) + side * delta * dx / l};
       double d = hypot(q[0] - x[0], q[1] - x[1]);
-      if (d < best && km__poly_winding(P, np, q) != 0) {
+      if (d < best && km__poly_index_winding(ix, q) != 0) {
         best = d;
         out[0] = q[0];
         out[1] = q[1];

@@ -125,11 +125,48 @@ bool km__follow_parent(const km_shape_morph *m, size_t k, long parent,
   return true;
 }
 
-static bool all_inside(const double *P, size_t np, const double *Q, size_t nq,
+/* The flattenings of a frame's slots, and the band index of each (built
+ * when a contour is first asked about, dropped when it moves). */
+typedef struct flats {
+  double **pt;
+  size_t *n;
+  km__poly_index *ix;
+  bool *indexed;
+} flats;
+
+static km_status flats_alloc(flats *fs, size_t n) {
+  fs->pt = km__calloc(n, sizeof *fs->pt);
+  fs->n = km__calloc(n, sizeof *fs->n);
+  fs->ix = km__calloc(n, sizeof *fs->ix);
+  fs->indexed = km__calloc(n, sizeof *fs->indexed);
+  return fs->pt && fs->n && fs->ix && fs->indexed ? KM_OK : KM_ENOMEM;
+}
+
+static void flats_free(flats *fs, size_t n) {
+  for (size_t k = 0; fs->pt && k < n; k++) km__free(fs->pt[k]);
+  for (size_t k = 0; fs->ix && k < n; k++) km__poly_index_free(&fs->ix[k]);
+  km__free(fs->pt);
+  km__free(fs->n);
+  km__free(fs->ix);
+  km__free(fs->indexed);
+}
+
+/* Slot k's index, NULL when out of memory. */
+static km__poly_index *index_of(flats *fs, size_t k) {
+  if (!fs->indexed[k]) {
+    if (km__poly_index_build(&fs->ix[k], fs->pt[k], fs->n[k]) != KM_OK)
+      return NULL;
+    fs->indexed[k] = true;
+  }
+  return &fs->ix[k];
+}
+
+/* Every point of P moved by d lies inside Q. */
+static bool all_inside(const double *P, size_t np, const km__poly_index *Q,
                        const double d[2]) {
   for (size_t i = 0; i < np; i++) {
     double q[2] = {P[2 * i] + d[0], P[2 * i + 1] + d[1]};
-    if (km__poly_winding(Q, nq, q) == 0) return false;
+    if (km__poly_index_winding(Q, q) == 0) return false;
   }
   return true;
 }
@@ -144,36 +181,49 @@ static void centroid_of(const double *P, size_t np, double g[2]) {
   g[1] /= (double)(np - 1);
 }
 
+static void translate(km_shape_frame *f, size_t k, flats *fs,
+                      const double d[2]) {
+  const double zero[2] = {0, 0};
+  move_curve(&f->contours[k], zero, 1.0, d);
+  for (size_t i = 0; i < fs->n[k]; i++) {
+    fs->pt[k][2 * i] += d[0];
+    fs->pt[k][2 * i + 1] += d[1];
+  }
+  fs->indexed[k] = false;
+}
+
 /* Translate slot k toward the point inside its parent nearest its
- * centroid by the smallest fraction
- * (to 1/1024) that puts all its points inside the parent; true if moved. */
-static bool adjust(km_shape_frame *f, size_t k, double **fl, size_t *np) {
+ * centroid by the smallest fraction (to 1/1024) that puts all its points
+ * inside the parent; *moved says whether it did. */
+static km_status adjust(km_shape_frame *f, size_t k, flats *fs, bool *moved) {
   size_t p = (size_t)f->parent[k];
   const double zero[2] = {0, 0};
-  if (all_inside(fl[k], np[k], fl[p], np[p], zero)) return false;
+  const km__poly_index *Q = index_of(fs, p);
+  *moved = false;
+  if (!Q) return KM_ENOMEM;
+  const double *P = fs->pt[k];
+  size_t np = fs->n[k];
+  if (all_inside(P, np, Q, zero)) return KM_OK;
   double gk[2], gp[2], d[2];
-  centroid_of(fl[k], np[k], gk);
-  km__poly_interior_point(fl[p], np[p], gk, gp);
+  centroid_of(P, np, gk);
+  km__poly_interior_point(Q, gk, gp);
   double full[2] = {gp[0] - gk[0], gp[1] - gk[1]};
-  if (!all_inside(fl[k], np[k], fl[p], np[p], full)) return false;
+  if (!all_inside(P, np, Q, full)) return KM_OK;
   double lo = 0.0, hi = 1.0;
   for (int it = 0; it < 10; it++) {
     double mid = 0.5 * (lo + hi);
     d[0] = mid * full[0];
     d[1] = mid * full[1];
-    if (all_inside(fl[k], np[k], fl[p], np[p], d))
+    if (all_inside(P, np, Q, d))
       hi = mid;
     else
       lo = mid;
   }
   d[0] = hi * full[0];
   d[1] = hi * full[1];
-  move_curve(&f->contours[k], zero, 1.0, d);
-  for (size_t i = 0; i < np[k]; i++) {
-    fl[k][2 * i] += d[0];
-    fl[k][2 * i + 1] += d[1];
-  }
-  return true;
+  translate(f, k, fs, d);
+  *moved = true;
+  return KM_OK;
 }
 
 static int frame_depth(const km_shape_frame *f, size_t k) {
@@ -184,26 +234,16 @@ static int frame_depth(const km_shape_frame *f, size_t k) {
   return d;
 }
 
-static void translate(km_shape_frame *f, size_t k, double **fl, size_t *np,
-                      const double d[2]) {
-  const double zero[2] = {0, 0};
-  move_curve(&f->contours[k], zero, 1.0, d);
-  for (size_t i = 0; i < np[k]; i++) {
-    fl[k][2 * i] += d[0];
-    fl[k][2 * i + 1] += d[1];
-  }
-}
-
 /* Slot k follows its parent's motion (km__follow_parent) where it has one
  * paired parent: the parts move as one shape, turning with it. */
 static void follow(const km_shape_morph *m, km_shape_frame *f, size_t k,
-                   double t, double **fl, size_t *np) {
+                   double t, flats *fs) {
   double at[2], a, g[2];
   long p = f->parent[k];
   if (!km__follow_parent(m, k, p, &f->contours[p], t, at)) return;
   km__curve_area(&f->contours[k], &a, g);
   double d[2] = {at[0] - g[0], at[1] - g[1]};
-  translate(f, k, fl, np, d);
+  translate(f, k, fs, d);
 }
 
 /* The schedule's scale of slot k at t as a fraction of its nominal size
@@ -219,14 +259,16 @@ static double scheduled_ratio(const km_shape_morph *m, size_t k, double t) {
   return fmin(1.0, v / s);
 }
 
-static void scale_about(km_shape_frame *f, size_t k, double **fl, size_t *np,
+static void scale_about(km_shape_frame *f, size_t k, flats *fs,
                         const double g[2], double r) {
   const double zero[2] = {0, 0};
   move_curve(&f->contours[k], g, r, zero);
-  for (size_t i = 0; i < np[k]; i++) {
-    fl[k][2 * i] = g[0] + r * (fl[k][2 * i] - g[0]);
-    fl[k][2 * i + 1] = g[1] + r * (fl[k][2 * i + 1] - g[1]);
+  double *P = fs->pt[k];
+  for (size_t i = 0; i < fs->n[k]; i++) {
+    P[2 * i] = g[0] + r * (P[2 * i] - g[0]);
+    P[2 * i + 1] = g[1] + r * (P[2 * i + 1] - g[1]);
   }
+  fs->indexed[k] = false;
   km_frame_metrics *mt = &f->metrics[k];
   mt->length *= r;
   mt->closure_gap *= r;
@@ -243,53 +285,55 @@ static void scale_about(km_shape_frame *f, size_t k, double **fl, size_t *np,
  * vanishes sooner rather than cross. *ratio: its size as a fraction of
  * its nominal. */
 static km_status shrink_to_fit(const km_shape_morph *m, double t,
-                               km_shape_frame *f, size_t k, double **fl,
-                               size_t *np, double *ratio) {
+                               km_shape_frame *f, size_t k, flats *fs,
+                               double *ratio) {
   size_t p = (size_t)f->parent[k];
   const double zero[2] = {0, 0};
   if (m->kind[k] == KM__PAIRED) return KM_OK;
+  const km__poly_index *Q = index_of(fs, p);
+  if (!Q) return KM_ENOMEM;
   double a, g[2], cap = scheduled_ratio(m, k, t);
   km__curve_area(&f->contours[k], &a, g);
-  if (cap < 1.0) scale_about(f, k, fl, np, g, cap);
+  if (cap < 1.0) scale_about(f, k, fs, g, cap);
   *ratio = cap;
-  if (all_inside(fl[k], np[k], fl[p], np[p], zero)) return KM_OK;
-  if (km__poly_winding(fl[p], np[p], g) == 0) {
+  if (all_inside(fs->pt[k], fs->n[k], Q, zero)) return KM_OK;
+  if (km__poly_index_winding(Q, g) == 0) {
     /* its centre first to the nearest point well inside the parent */
     double q[2];
-    km__poly_interior_point(fl[p], np[p], g, q);
-    if (km__poly_winding(fl[p], np[p], q) == 0) return KM_OK;
+    km__poly_interior_point(Q, g, q);
+    if (km__poly_index_winding(Q, q) == 0) return KM_OK;
     double d[2] = {q[0] - g[0], q[1] - g[1]};
-    translate(f, k, fl, np, d);
+    translate(f, k, fs, d);
     g[0] = q[0];
     g[1] = q[1];
   }
   /* a scheduled size is kept even where it does not fit: shrinking more
    * here and less at the next frame would make it grow */
   if (m->scheduled) return KM_OK;
-  double lo = 0.0, hi = 1.0, *cur = fl[k];
-  double *buf = km__malloc(2 * np[k] * sizeof *buf);
+  double lo = 0.0, hi = 1.0, *cur = fs->pt[k];
+  size_t np = fs->n[k];
+  double *buf = km__malloc(2 * np * sizeof *buf);
   if (!buf) return KM_ENOMEM;
   for (int it = 0; it < 10; it++) {
     double mid = 0.5 * (lo + hi);
-    for (size_t i = 0; i < np[k]; i++) {
+    for (size_t i = 0; i < np; i++) {
       buf[2 * i] = g[0] + mid * (cur[2 * i] - g[0]);
       buf[2 * i + 1] = g[1] + mid * (cur[2 * i + 1] - g[1]);
     }
-    if (all_inside(buf, np[k], fl[p], np[p], zero))
+    if (all_inside(buf, np, Q, zero))
       lo = mid;
     else
       hi = mid;
   }
   km__free(buf);
-  scale_about(f, k, fl, np, g, lo);
+  scale_about(f, k, fs, g, lo);
   *ratio = cap * lo;
   return KM_OK;
 }
 
 /* Placement and nesting adjustment parents first, then the metrics. */
 static km_status finish(const km_shape_morph *m, double t, km_shape_frame *f,
-                        double **fl, size_t *np, km__poll *poll,
-                        double *ratio) {
+                        flats *fs, km__poll *poll, double *ratio) {
   int maxd = 0;
   for (size_t k = 0; k < f->ncontours; k++)
     if (frame_depth(f, k) > maxd) maxd = frame_depth(f, k);
@@ -299,22 +343,30 @@ static km_status finish(const km_shape_morph *m, double t, km_shape_frame *f,
       if (!f->present[k] || f->parent[k] < 0 || !f->present[f->parent[k]] ||
           frame_depth(f, k) != d)
         continue;
-      follow(m, f, k, t, fl, np);
+      follow(m, f, k, t, fs);
       double r = 1.0;
-      if (shrink_to_fit(m, t, f, k, fl, np, &r) != KM_OK) return KM_ENOMEM;
+      bool moved;
+      km_status st = shrink_to_fit(m, t, f, k, fs, &r);
+      if (st == KM_OK) st = adjust(f, k, fs, &moved);
+      if (st != KM_OK) return st;
       if (ratio) ratio[k] = r;
-      if (adjust(f, k, fl, np)) f->adjusted++;
+      if (moved) f->adjusted++;
     }
   f->nesting_ok = true;
-  for (size_t k = 0; k < f->ncontours; k++)
-    if (f->present[k] && f->parent[k] >= 0 && f->present[f->parent[k]] &&
-        !all_inside(fl[k], np[k], fl[f->parent[k]], np[f->parent[k]], zero))
-      f->nesting_ok = false;
+  for (size_t k = 0; k < f->ncontours; k++) {
+    long p = f->parent[k];
+    if (!f->present[k] || p < 0 || !f->present[p]) continue;
+    const km__poly_index *Q = index_of(fs, (size_t)p);
+    if (!Q) return KM_ENOMEM;
+    if (!all_inside(fs->pt[k], fs->n[k], Q, zero)) f->nesting_ok = false;
+  }
   f->mutual_intersections = 0;
   for (size_t k = 0; k < f->ncontours; k++)
     for (size_t l = k + 1; f->present[k] && l < f->ncontours; l++) {
       if (!f->present[l]) continue;
-      long c = km__poly_crossings(fl[k], np[k], fl[l], np[l], poll);
+      km__poly_index *Q = index_of(fs, l);
+      if (!Q) return KM_ENOMEM;
+      long c = km__poly_index_crossings(fs->pt[k], fs->n[k], Q, poll);
       if (c < 0) return KM_ECANCELLED;
       f->mutual_intersections += c;
     }
@@ -342,36 +394,27 @@ static km_status frame_at(const km_shape_morph *m, double t,
   km_shape_frame f;
   km_shape_frame_init(&f);
   size_t n = m->npairs;
-  double **fl = km__calloc(n, sizeof *fl);
-  size_t *np = km__calloc(n, sizeof *np);
+  flats fs = {0};
   km__poll poll;
   km__poll_init(&poll, stop);
-  km_status st = fl && np ? frame_alloc(&f, n) : KM_ENOMEM;
-  if (st == KM_ENOMEM)
-    km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, "out of memory");
+  km_status st = flats_alloc(&fs, n);
+  if (st == KM_OK) st = frame_alloc(&f, n);
   for (size_t k = 0; st == KM_OK && k < n; k++) {
     bool near_from = (t < 0.5 && m->pairs[k].from >= 0) || m->pairs[k].to < 0;
     f.parent[k] = near_from ? m->parent_from[k] : m->parent_to[k];
     st = contour_at(m, k, t, stop, &f, err);
-    if (st == KM_OK && f.present[k]) {
-      st = km__shape_flatten(&f.contours[k], &fl[k], &np[k]);
-      if (st == KM_ENOMEM)
-        km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, "out of memory");
-    }
+    if (st == KM_OK && f.present[k])
+      st = km__shape_flatten(&f.contours[k], &fs.pt[k], &fs.n[k]);
   }
-  if (st == KM_OK) {
-    st = finish(m, t, &f, fl, np, &poll, ratio);
-    if (st == KM_ENOMEM)
-      km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, "out of memory");
-  }
+  if (st == KM_OK) st = finish(m, t, &f, &fs, &poll, ratio);
+  if (st == KM_ENOMEM)
+    km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, "out of memory");
   if (st == KM_ECANCELLED) km__stopped(err);
   if (st != KM_OK) goto cleanup;
   *out = f;
   km_shape_frame_init(&f);
 cleanup:
-  for (size_t k = 0; fl && k < n; k++) km__free(fl[k]);
-  km__free(fl);
-  km__free(np);
+  flats_free(&fs, n);
   km_shape_frame_free(&f);
   return st;
 }

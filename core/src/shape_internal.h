@@ -4,7 +4,9 @@
 #ifndef KM_SHAPE_INTERNAL_H
 #define KM_SHAPE_INTERNAL_H
 
+#include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 
 #include "km/curve.h"
 #include "km/shape.h"
@@ -19,6 +21,60 @@ km_status km__shape_flatten(const km_curve *c, double **pts, size_t *np);
  * joined to the first). */
 int km__poly_winding(const double *P, size_t np, const double p[2]);
 
+/* What the edge a -> b adds to the winding number of p: Sunday's
+ * crossing-number form, half-open in y so a vertex is counted once. */
+static inline int km__edge_winding(const double *a, const double *b,
+                                   const double p[2]) {
+  double cross = (b[0] - a[0]) * (p[1] - a[1]) - (p[0] - a[0]) * (b[1] - a[1]);
+  if (a[1] <= p[1]) return b[1] > p[1] && cross > 0 ? 1 : 0;
+  return b[1] <= p[1] && cross < 0 ? -1 : 0;
+}
+
+static inline double km__orient2(const double *a, const double *b,
+                                 const double *c) {
+  return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+}
+
+/* Segments a b and c d cross properly: strictly opposite signs on both
+ * sides (touching or collinear segments do not). */
+static inline bool km__edge_crosses(const double *a, const double *b,
+                                    const double *c, const double *d) {
+  double o1 = km__orient2(a, b, c), o2 = km__orient2(a, b, d);
+  double o3 = km__orient2(c, d, a), o4 = km__orient2(c, d, b);
+  return ((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) &&
+         ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0));
+}
+
+/* Horizontal bands over the edges of a closed polyline (poly_index.c):
+ * the winding number of a point and the crossings with another polyline,
+ * identical to km__poly_winding and km__poly_crossings, visiting only
+ * the edges near the height asked about. P is borrowed: it must not move
+ * while the index is used. */
+typedef struct km__poly_index {
+  const double *P;
+  size_t np;
+  double y0, y1, inv_h; /* P's height range; bands per unit of height */
+  size_t nbands;
+  size_t *start;  /* nbands + 1: band k lists edge[start[k] .. start[k+1]) */
+  uint32_t *edge; /* edge i joins point i to point i + 1 (mod np) */
+  size_t *seen, stamp; /* crossings: an edge once for each edge of the other */
+} km__poly_index;
+
+void km__poly_index_init(km__poly_index *ix);
+void km__poly_index_free(km__poly_index *ix);
+/* KM_OK or KM_ENOMEM (ix then empty). Rebuilding frees what ix held. */
+km_status km__poly_index_build(km__poly_index *ix, const double *P, size_t np);
+int km__poly_index_winding(const km__poly_index *ix, const double p[2]);
+/* As km__poly_crossings(P, np, Q->P, Q->np, poll). */
+long km__poly_index_crossings(const double *P, size_t np, km__poly_index *Q,
+                              km__poll *poll);
+
+/* A point inside the closed polyline an index was built over, near x
+ * (shape.c); x itself when no edge offset lands inside. x and out must
+ * not overlap. */
+void km__poly_interior_point(const km__poly_index *ix, const double x[2],
+                             double out[2]);
+
 /* Signed area (counter-clockwise positive) and area centroid of a closed
  * curve by Gauss-Legendre quadrature of Green's formulas, exact up to
  * rounding for polynomial curves of degree <= 4 (8 points on 4 panels a
@@ -30,11 +86,6 @@ void km__curve_area(const km_curve *c, double *area, double centroid[2]);
  * when stopped. */
 long km__poly_crossings(const double *P, size_t np, const double *Q, size_t nq,
                         km__poll *poll);
-
-/* A point inside the closed polyline P (np points) near x (shape.c); x
- * itself when no edge offset lands inside. */
-void km__poly_interior_point(const double *P, size_t np, const double x[2],
-                             double out[2]);
 
 /* The compound morph (shape_morph.c), read by its frames (shape_frame.c). */
 typedef enum km__pair_kind { KM__PAIRED, KM__VANISH, KM__APPEAR } km__pair_kind;

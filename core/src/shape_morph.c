@@ -101,18 +101,22 @@ static long nearest_host(const km_shape_morph *m, const km_shape *s,
 
 /* p itself when inside contour j of o, else the nearest of the points
  * set in from j's flattening (km__poly_interior_point). */
-static void pull_inside(const km_shape *o, size_t j, double p[2]) {
-  if (km_shape_winding(o, j, p) != 0) return;
+static km_status pull_inside(const km_shape *o, size_t j, double p[2]) {
+  if (km_shape_winding(o, j, p) != 0) return KM_OK;
+  km__poly_index ix;
+  km__poly_index_init(&ix);
+  km_status st = km__poly_index_build(&ix, o->flat + 2 * o->flat_off[j],
+                                      o->flat_off[j + 1] - o->flat_off[j]);
   double q[2];
-  km__poly_interior_point(o->flat + 2 * o->flat_off[j],
-                          o->flat_off[j + 1] - o->flat_off[j], p, q);
-  p[0] = q[0];
-  p[1] = q[1];
+  if (st == KM_OK) km__poly_interior_point(&ix, p, q);
+  km__poly_index_free(&ix);
+  if (st == KM_OK) memcpy(p, q, sizeof q);
+  return st;
 }
 
 /* Where the unpaired contour of slot k ends (vanishing) or starts. */
-static void place_point(km_shape_morph *m, size_t k, const km_shape *a,
-                        const km_shape *b) {
+static km_status place_point(km_shape_morph *m, size_t k, const km_shape *a,
+                             const km_shape *b) {
   bool from = m->kind[k] == KM__VANISH;
   const km_shape *s = from ? a : b, *o = from ? b : a;
   long i = from ? m->pairs[k].from : m->pairs[k].to;
@@ -123,7 +127,7 @@ static void place_point(km_shape_morph *m, size_t k, const km_shape *a,
   if (h >= 0 && m->kind[h] != KM__PAIRED) {
     p[0] = m->point[2 * h];
     p[1] = m->point[2 * h + 1];
-    return;
+    return KM_OK;
   }
   if (h < 0) {
     /* nothing paired: the same place in the other shape's box */
@@ -131,14 +135,14 @@ static void place_point(km_shape_morph *m, size_t k, const km_shape *a,
     double wo = fmax(o->box[2] - o->box[0], o->box[3] - o->box[1]);
     p[0] = o->box[0] + (c[0] - s->box[0]) * wo / ws;
     p[1] = o->box[1] + (c[1] - s->box[1]) * wo / ws;
-    return;
+    return KM_OK;
   }
   long hs = from ? m->pairs[h].from : m->pairs[h].to;
   long ho = from ? m->pairs[h].to : m->pairs[h].from;
   double f = sqrt(o->area[ho] / s->area[hs]);
   p[0] = o->centroid[2 * ho] + (c[0] - s->centroid[2 * hs]) * f;
   p[1] = o->centroid[2 * ho + 1] + (c[1] - s->centroid[2 * hs + 1]) * f;
-  pull_inside(o, (size_t)ho, p);
+  return pull_inside(o, (size_t)ho, p);
 }
 
 static km_status morph_pair(km_shape_morph *m, size_t k, const km_shape *a,
@@ -212,9 +216,10 @@ static km_status take_pairs(km_shape_morph *m, const km_shape *a,
 }
 
 /* Kinds, parent slots and the points of unpaired contours, parents
- * before children (a child's point may be its vanishing parent's). */
-static void plan_slots(km_shape_morph *m, const km_shape *a,
-                       const km_shape *b) {
+ * before children (a child's point may be its vanishing parent's). KM_OK
+ * or KM_ENOMEM. */
+static km_status plan_slots(km_shape_morph *m, const km_shape *a,
+                            const km_shape *b) {
   int maxd = 0;
   for (size_t k = 0; k < m->npairs; k++) {
     long i = m->pairs[k].from, j = m->pairs[k].to;
@@ -228,10 +233,12 @@ static void plan_slots(km_shape_morph *m, const km_shape *a,
     int d = slot_depth(m, k);
     if (d > maxd) maxd = d;
   }
+  km_status st = KM_OK;
   for (int d = 0; d <= maxd; d++)
-    for (size_t k = 0; k < m->npairs; k++)
+    for (size_t k = 0; st == KM_OK && k < m->npairs; k++)
       if (m->kind[k] != KM__PAIRED && slot_depth(m, k) == d)
-        place_point(m, k, a, b);
+        st = place_point(m, k, a, b);
+  return st;
 }
 
 /* Anchors of every slot, and the sampled end frames of every paired slot
@@ -336,7 +343,11 @@ km_status km_shape_morph_create(km_shape_morph **out, const km_shape *from,
       km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, "out of memory");
   }
   if (st != KM_OK) goto cleanup;
-  plan_slots(m, from, to);
+  st = plan_slots(m, from, to);
+  if (st != KM_OK) {
+    km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, "out of memory");
+    goto cleanup;
+  }
   km_morph_options mo = opt->morph;
   mo.stop = stop;
   for (size_t k = 0; st == KM_OK && k < m->npairs; k++)
