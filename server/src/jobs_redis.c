@@ -12,7 +12,7 @@
 
 /* Plans kept per instance; unused ones beyond this are freed, oldest
  * first (a later batch of the job prepares it again). */
-#define PLANS_MAX 64
+#define PLANS_MAX 16
 /* Seconds between two looks at a job's state from inside a frame. */
 static const double STATE_POLL = 0.2;
 /* Seconds between two XAUTOCLAIM tries of this instance. */
