@@ -188,6 +188,43 @@ static void o_to_c_loses_the_hole_at_the_end(void **state) {
   free(body);
 }
 
+/* The linear baseline pairs contours as the curvature morph does and
+ * blends each pair's control points: two unit squares at x = 0 and
+ * x = 6 to two at x = 0 and x = 3 give, halfway, one square where it
+ * stood and one at x = 4.5, corner for corner. */
+static void linear_shapes_blend_each_pair(void **state) {
+  (void)state;
+  cJSON *j = at_expect_json(
+      MORPH,
+      "{\"method\":\"linear\",\"frames\":3,"
+      "\"from\":{\"type\":\"shape\",\"contours\":[" SQ(0) "," SQ(
+          6) "]},"
+             "\"to\":{\"type\":\"shape\",\"contours\":[" SQ(0) "," SQ(3) "]}}");
+  const cJSON *used = member(j, "contour_matches_used");
+  assert_int_equal(cJSON_GetArraySize(used), 2);
+  const cJSON *mid =
+      member(cJSON_GetArrayItem(member(j, "frames"), 1), "contours");
+  int seen[2] = {0, 0};
+  for (int k = 0; k < 2; k++) {
+    const cJSON *pr = cJSON_GetArrayItem(used, k);
+    int from = cJSON_GetArrayItem(pr, 0)->valueint;
+    assert_int_equal(cJSON_GetArrayItem(pr, 1)->valueint, from);
+    double x0 = from == 0 ? 0.0 : 4.5; /* halfway from 6 to 3 */
+    const cJSON *cp = member(cJSON_GetArrayItem(mid, k), "control_points");
+    const double want[5][2] = {
+        {x0, 0}, {x0 + 1, 0}, {x0 + 1, 1}, {x0, 1}, {x0, 0}};
+    assert_int_equal(cJSON_GetArraySize(cp), 5);
+    for (int i = 0; i < 5; i++)
+      for (int c = 0; c < 2; c++)
+        assert_true(
+            fabs(cJSON_GetArrayItem(cJSON_GetArrayItem(cp, i), c)->valuedouble -
+                 want[i][c]) < 1e-12);
+    seen[from]++;
+  }
+  assert_true(seen[0] == 1 && seen[1] == 1);
+  cJSON_Delete(j);
+}
+
 static void json_shape_is_the_svg_shape(void **state) {
   (void)state;
   api_response a, b;
@@ -691,6 +728,7 @@ static const struct CMUnitTest tests[] = {
     cmocka_unit_test(ring_to_ring_keeps_both_contours),
     cmocka_unit_test(o_to_c_loses_the_hole_at_the_end),
     cmocka_unit_test(json_shape_is_the_svg_shape),
+    cmocka_unit_test(linear_shapes_blend_each_pair),
     cmocka_unit_test(a_circle_against_a_ring_is_a_shape_of_one),
     cmocka_unit_test(caller_pairs_are_used_and_checked),
     cmocka_unit_test(bad_contours_are_named),
