@@ -293,10 +293,24 @@ run: deps build
 	else echo "kmorphd not built yet: CLI demo"; \
 	  $(CLI) signature < docs/examples/circle-signature.json; fi
 
-bench: deps bench-morph bench-shapes
+bench: deps bench-morph bench-shapes bench-e2e
 	@$(MAKE) --no-print-directory build/bench/bench_core build/bench/bench_avoid
 	build/bench/bench_core
 	build/bench/bench_avoid
+
+# End to end, as users get it: 1,000-frame morphs of glyph and icon pairs
+# (one contour and compound) and the shapes.json pairs through the CLI
+# and over HTTP to a live kmorphd, JSON with metrics off and on and SVG,
+# per frame beside flubber's default and flubber at equal accuracy, with
+# bytes and control points per frame (bench/e2e/run.py; E2E_ARGS passes
+# options, e.g. --frames 200 --runs 1).
+.PHONY: bench-e2e
+bench-e2e: deps build
+	@if [ -d bench/flubber/node_modules/flubber ] || \
+	   (cd bench/flubber && npm ci --no-audit --no-fund >/dev/null 2>&1); then \
+	  python3 bench/e2e/run.py $(E2E_ARGS); \
+	else echo "flubber could not be installed with npm: kmorph figures only"; \
+	  python3 bench/e2e/run.py --no-flubber $(E2E_ARGS); fi
 
 # 60-frame morphs (bench/bench_morph.c), and the shapes.json pairs beside
 # flubber from npm (bench/flubber, a benchmark-only dependency; skipped
