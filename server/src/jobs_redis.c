@@ -101,12 +101,8 @@ static rj_plan *cache_find_locked(srv_rjobs *j, const char *id) {
   return NULL;
 }
 
-/* The plan of job id with a reference held, prepared from its stored
- * request if this instance has none. NULL with the problem's status in
- * *status (and the reason in why) if it cannot be prepared. */
-static rj_plan *cache_get(srv_rjobs *j, const char *id, const char *body,
-                          size_t len, const char *accept, int *status,
-                          char *why, size_t whycap) {
+/* Job id's cached plan with a reference held, or NULL. */
+static rj_plan *cache_ref(srv_rjobs *j, const char *id) {
   pthread_mutex_lock(&j->mu);
   rj_plan *p = cache_find_locked(j, id);
   if (p) {
@@ -114,7 +110,16 @@ static rj_plan *cache_get(srv_rjobs *j, const char *id, const char *body,
     p->used = srv_now();
   }
   pthread_mutex_unlock(&j->mu);
-  if (p) return p;
+  return p;
+}
+
+/* Job id's plan prepared from its stored request (body of len bytes,
+ * accept "" for none), cached, with a reference held. NULL with the
+ * problem's status in *status and the reason in why if it cannot be
+ * prepared. */
+static rj_plan *cache_prepare(srv_rjobs *j, const char *id, const char *body,
+                              size_t len, const char *accept, int *status,
+                              char *why, size_t whycap) {
   api_request req = {.route = API_ROUTE_MORPH,
                      .body = body,
                      .length = len,
@@ -123,19 +128,15 @@ static rj_plan *cache_get(srv_rjobs *j, const char *id, const char *body,
   api_response err;
   int rc = api_morph_prepare(&j->cfg.api, &req, j->cfg.max_job_frames, &plan,
                              &err);
+  api_response_free(&err);
   if (rc != 0 || plan == NULL) {
     *status = rc >= 400 ? rc : 500;
-    snprintf(why, whycap, "the stored request could not be prepared again "
-                          "(%d)", rc);
-    api_response_free(&err);
+    snprintf(why, whycap,
+             "the stored request could not be prepared again (%d)", rc);
     return NULL;
   }
-  api_response_free(&err);
   srv__rj_cache_put(j, id, plan);
-  pthread_mutex_lock(&j->mu);
-  p = cache_find_locked(j, id);
-  if (p) p->refs++;
-  pthread_mutex_unlock(&j->mu);
+  rj_plan *p = cache_ref(j, id);
   if (p == NULL) *status = 503, snprintf(why, whycap, "out of memory");
   return p;
 }
@@ -308,33 +309,66 @@ static bool run_should_stop(void *ctx) {
   return !still_live(x);
 }
 
-/* KEYS: job, frames. ARGV: index, text. {new, done}; done is -1 if the
- * job is no longer live. */
-static const char FRAME_LUA[] =
+/* KEYS: job, frames. ARGV: index, text, index, text... {new, done}:
+ * frames this call stored, frames stored in all; done is -1 if the job
+ * is no longer live. */
+static const char FRAMES_LUA[] =
     "local st = redis.call('HGET', KEYS[1], 'st') "
     "if st ~= 'queued' and st ~= 'running' then return {0, -1} end "
     "if st == 'queued' then redis.call('HSET', KEYS[1], 'st', 'running') end "
-    "if redis.call('HSETNX', KEYS[2], ARGV[1], ARGV[2]) == 1 then "
-    "return {1, redis.call('HINCRBY', KEYS[1], 'd', 1)} end "
-    "return {0, tonumber(redis.call('HGET', KEYS[1], 'd'))}";
+    "local new = 0 "
+    "for k = 1, #ARGV, 2 do "
+    "new = new + redis.call('HSETNX', KEYS[2], ARGV[k], ARGV[k + 1]) end "
+    "return {new, redis.call('HINCRBY', KEYS[1], 'd', new)}";
 
-/* Store frame i's text; *done receives the frames stored in all, -1 if
- * the job is no longer live. True if this call stored it. */
-static bool store_frame(run_ctx *x, const char *id, size_t i,
-                        const api_response *text, long long *done) {
-  char kf[80];
+/* Store the texts of frames [first, first + n) in one script (one round
+ * trip a batch, not one a frame); *done receives the frames stored in
+ * all, -1 if the job is no longer live. Returns how many this call
+ * stored (0 on a broken connection). */
+static long long store_frames(run_ctx *x, const char *id, size_t first,
+                              size_t n, const api_response *texts,
+                              long long *done) {
+  char kf[80], script_keys[] = "2";
   srv__rj_key(kf, sizeof kf, "frames", id);
-  redisReply *rep = srv__rj_cmd(
-      x->c, x->broken, "EVAL %s 2 %s %s %llu %b", FRAME_LUA, x->key, kf,
-      (unsigned long long)i, text->body ? text->body : "",
-      text->body ? text->length : (size_t)0);
-  bool fresh = false;
+  size_t argc = 5 + 2 * n;
+  const char **argv = malloc(argc * sizeof *argv);
+  size_t *lens = malloc(argc * sizeof *lens);
+  char(*nums)[24] = malloc((n ? n : 1) * sizeof *nums);
   *done = -1;
-  if (rep && rep->type == REDIS_REPLY_ARRAY && rep->elements == 2) {
-    fresh = rep->element[0]->integer == 1;
+  if (argv == NULL || lens == NULL || nums == NULL) {
+    free(argv);
+    free(lens);
+    free(nums);
+    *x->broken = true; /* the batch stays pending and is retried */
+    return 0;
+  }
+  const char *head[5] = {"EVAL", FRAMES_LUA, script_keys, x->key, kf};
+  for (size_t k = 0; k < 5; k++) {
+    argv[k] = head[k];
+    lens[k] = strlen(head[k]);
+  }
+  for (size_t k = 0; k < n; k++) {
+    snprintf(nums[k], sizeof nums[k], "%zu", first + k);
+    argv[5 + 2 * k] = nums[k];
+    lens[5 + 2 * k] = strlen(nums[k]);
+    argv[6 + 2 * k] = texts[k].body ? texts[k].body : "";
+    lens[6 + 2 * k] = texts[k].body ? texts[k].length : 0;
+  }
+  redisReply *rep = redisCommandArgv(x->c, (int)argc, argv, lens);
+  free(argv);
+  free(lens);
+  free(nums);
+  if (rep == NULL || x->c->err) {
+    if (rep) freeReplyObject(rep);
+    *x->broken = true;
+    return 0;
+  }
+  long long fresh = 0;
+  if (rep->type == REDIS_REPLY_ARRAY && rep->elements == 2) {
+    fresh = rep->element[0]->integer;
     *done = rep->element[1]->integer;
   }
-  if (rep) freeReplyObject(rep);
+  freeReplyObject(rep);
   return fresh;
 }
 
@@ -410,18 +444,38 @@ typedef struct record {
   long long done;
 } record;
 
-/* Read the record and its request; *p receives the job's plan (NULL if
- * the job is not live or its plan failed, then recorded as failed). */
+/* The job's plan: this instance's, else prepared from the request in
+ * the record (read only then: it is the record's largest part). NULL,
+ * with the job recorded as failed, if it cannot be prepared. */
+static rj_plan *job_plan(run_ctx *x, const char *id) {
+  rj_plan *p = cache_ref(x->j, id);
+  if (p != NULL) return p;
+  redisReply *rep = srv__rj_cmd(x->c, x->broken, "HMGET %s b a", x->key);
+  if (rep == NULL) return NULL;
+  int status = 500;
+  char why[160] = "the job's request is no longer stored";
+  if (rep->type == REDIS_REPLY_ARRAY && rep->elements == 2 &&
+      rep->element[0]->type == REDIS_REPLY_STRING) {
+    const char *acc = rep->element[1]->str ? rep->element[1]->str : "";
+    p = cache_prepare(x->j, id, rep->element[0]->str, rep->element[0]->len,
+                      acc, &status, why, sizeof why);
+  }
+  freeReplyObject(rep);
+  if (p == NULL && !*x->broken) fail_job(x, id, status, why);
+  return p;
+}
+
+/* Read the record; *p receives the job's plan (NULL if the job is not
+ * live or its plan failed, then recorded as failed). */
 static record open_job(run_ctx *x, const batch *b, rj_plan **p) {
   record r = {false, 0, 0, 0};
   *p = NULL;
   redisReply *rep =
-      srv__rj_cmd(x->c, x->broken, "HMGET %s st n dl b a d", x->key);
+      srv__rj_cmd(x->c, x->broken, "HMGET %s st n dl d", x->key);
   if (rep == NULL) return r;
   const char *st = NULL;
-  if (rep->type == REDIS_REPLY_ARRAY && rep->elements == 6 &&
-      rep->element[0]->type == REDIS_REPLY_STRING &&
-      rep->element[3]->type == REDIS_REPLY_STRING)
+  if (rep->type == REDIS_REPLY_ARRAY && rep->elements == 4 &&
+      rep->element[0]->type == REDIS_REPLY_STRING)
     st = rep->element[0]->str;
   if (st && (strcmp(st, "queued") == 0 || strcmp(st, "running") == 0)) {
     r.live = true;
@@ -429,31 +483,27 @@ static record open_job(run_ctx *x, const batch *b, rj_plan **p) {
                        NULL, 10);
     r.deadline = strtod(rep->element[2]->str ? rep->element[2]->str : "0",
                         NULL);
-    r.done = strtoll(rep->element[5]->str ? rep->element[5]->str : "0", NULL,
+    r.done = strtoll(rep->element[3]->str ? rep->element[3]->str : "0", NULL,
                      10);
-    x->deadline = r.deadline;
-    if (srv__rj_wall() > r.deadline) {
-      out_of_time(x, b->id, r.done, r.total);
-      r.live = false;
-    } else {
-      int status = 0;
-      char why[160];
-      const char *acc = rep->element[4]->str ? rep->element[4]->str : "";
-      *p = cache_get(x->j, b->id, rep->element[3]->str, rep->element[3]->len,
-                     acc, &status, why, sizeof why);
-      if (*p == NULL) {
-        fail_job(x, b->id, status, why);
-        r.live = false;
-      } else if (api_morph_frame_count((*p)->plan) != r.total) {
-        cache_release(x->j, *p);
-        *p = NULL;
-        fail_job(x, b->id, 500, "the stored request plans another count of "
-                                "frames");
-        r.live = false;
-      }
-    }
   }
   freeReplyObject(rep);
+  if (!r.live) return r;
+  x->deadline = r.deadline;
+  if (srv__rj_wall() > r.deadline) {
+    out_of_time(x, b->id, r.done, r.total);
+    r.live = false;
+    return r;
+  }
+  *p = job_plan(x, b->id);
+  if (*p == NULL) {
+    r.live = false;
+  } else if (api_morph_frame_count((*p)->plan) != r.total) {
+    cache_release(x->j, *p);
+    *p = NULL;
+    fail_job(x, b->id, 500, "the stored request plans another count of "
+                            "frames");
+    r.live = false;
+  }
   return r;
 }
 
@@ -461,21 +511,31 @@ static record open_job(run_ctx *x, const batch *b, rj_plan **p) {
  * the job is then complete; acknowledge (or hand back) the batch. */
 static void run_batch(srv_rjobs *j, redisContext *c, bool *broken,
                       const batch *b) {
-  run_ctx x = {.j = j, .c = c, .broken = broken, .why = WHY_NONE};
+  run_ctx x = {.j = j,
+               .c = c,
+               .broken = broken,
+               .why = WHY_NONE,
+               .next_look = srv_now() + STATE_POLL};
   srv__rj_key(x.key, sizeof x.key, "job", b->id);
   rj_plan *p = NULL;
   record r = b->from < b->to ? open_job(&x, b, &p) : (record){0};
   bool last = false;
   long long done = r.done;
   size_t i = b->from;
-  if (*broken) goto out;
+  size_t span = b->to > b->from ? b->to - b->from : 0;
+  api_response *texts = span ? calloc(span, sizeof *texts) : NULL;
+  if (*broken || (span && texts == NULL)) goto out;
   for (; r.live && i < b->to && i < r.total; i++) {
     if (atomic_load(&j->stopping)) {
       x.why = WHY_SHUTDOWN;
       break;
     }
-    if (i > b->from && !still_live(&x)) break;
-    x.next_look = srv_now() + STATE_POLL;
+    /* Between frames as inside them: the state is looked up at most
+     * every STATE_POLL seconds. */
+    if (srv_now() >= x.next_look) {
+      x.next_look = srv_now() + STATE_POLL;
+      if (!still_live(&x)) break;
+    }
     int rc = api_morph_render_frame_until(p->plan, i, run_should_stop, &x);
     if (rc != 0) {
       if (x.why == WHY_NONE && srv__rj_wall() > r.deadline) x.why = WHY_TIME;
@@ -488,12 +548,9 @@ static void run_batch(srv_rjobs *j, redisContext *c, bool *broken,
       break;
     }
     atomic_fetch_add(&j->frames, 1);
-    api_response text;
-    api_response_init(&text);
     if (api_morph_frames_apart(p->plan)) {
-      rc = api_morph_frame_text(p->plan, i, &text);
+      rc = api_morph_frame_text(p->plan, i, &texts[i - b->from]);
       if (rc != 200) {
-        api_response_free(&text);
         char msg[96];
         snprintf(msg, sizeof msg, "frame %zu could not be written (%d)", i,
                  rc);
@@ -501,10 +558,14 @@ static void run_batch(srv_rjobs *j, redisContext *c, bool *broken,
         break;
       }
     }
-    bool fresh = store_frame(&x, b->id, i, &text, &done);
-    api_response_free(&text);
-    if (done < 0) break;
-    if (fresh && (size_t)done == r.total) last = true;
+  }
+  /* The frames rendered (all of them, or those before a stop) are
+   * stored; a failed or cancelled job stores nothing more. */
+  bool whole = i == b->to || x.why == WHY_SHUTDOWN;
+  if (!*broken && r.live && i > b->from && whole) {
+    long long fresh = store_frames(&x, b->id, b->from, i - b->from, texts,
+                                   &done);
+    if (fresh > 0 && done >= 0 && (size_t)done == r.total) last = true;
   }
   if (*broken) goto out; /* pending: reclaimed after the timeout */
   if (x.why == WHY_SHUTDOWN && r.live && i < b->to) {
@@ -518,6 +579,8 @@ static void run_batch(srv_rjobs *j, redisContext *c, bool *broken,
     assemble(&x, b->id, p->plan, r.total);
   if (!*broken) ack(c, broken, b);
 out:
+  for (size_t k = 0; texts && k < span; k++) api_response_free(&texts[k]);
+  free(texts);
   if (p) {
     cache_release(j, p);
     if (!r.live || (done >= 0 && (size_t)done == r.total) || x.why == WHY_FINAL)
