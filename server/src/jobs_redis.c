@@ -309,28 +309,39 @@ static bool run_should_stop(void *ctx) {
   return !still_live(x);
 }
 
-/* KEYS: job, frames. ARGV: index, text, index, text... {new, done}:
- * frames this call stored, frames stored in all; done is -1 if the job
- * is no longer live. */
+/* KEYS: job, frames, stream. ARGV: group, entry, frames of the job, then
+ * index, text, index, text... {new, done}: frames this call stored,
+ * frames stored in all (-1 if the job is no longer live). The entry is
+ * acknowledged here too unless every frame is now stored: then it stays
+ * pending until the result is, so that a consumer dying in between
+ * leaves it to be claimed and the result assembled by another. An
+ * empty entry stores the frames only (a batch being handed back). */
 static const char FRAMES_LUA[] =
+    "local function ack() if ARGV[2] ~= '' then "
+    "redis.call('XACK', KEYS[3], ARGV[1], ARGV[2]) "
+    "redis.call('XDEL', KEYS[3], ARGV[2]) end end "
     "local st = redis.call('HGET', KEYS[1], 'st') "
-    "if st ~= 'queued' and st ~= 'running' then return {0, -1} end "
+    "if st ~= 'queued' and st ~= 'running' then ack() return {0, -1} end "
     "if st == 'queued' then redis.call('HSET', KEYS[1], 'st', 'running') end "
     "local new = 0 "
-    "for k = 1, #ARGV, 2 do "
+    "for k = 4, #ARGV, 2 do "
     "new = new + redis.call('HSETNX', KEYS[2], ARGV[k], ARGV[k + 1]) end "
-    "return {new, redis.call('HINCRBY', KEYS[1], 'd', new)}";
+    "local d = redis.call('HINCRBY', KEYS[1], 'd', new) "
+    "if d < tonumber(ARGV[3]) then ack() end "
+    "return {new, d}";
 
 /* Store the texts of frames [first, first + n) in one script (one round
  * trip a batch, not one a frame); *done receives the frames stored in
  * all, -1 if the job is no longer live. Returns how many this call
  * stored (0 on a broken connection). */
-static long long store_frames(run_ctx *x, const char *id, size_t first,
+static long long store_frames(run_ctx *x, const batch *b, size_t total,
                               size_t n, const api_response *texts,
                               long long *done) {
-  char kf[80], script_keys[] = "2";
-  srv__rj_key(kf, sizeof kf, "frames", id);
-  size_t argc = 5 + 2 * n;
+  char kf[80], script_keys[] = "3", tot[24];
+  srv__rj_key(kf, sizeof kf, "frames", b->id);
+  snprintf(tot, sizeof tot, "%zu", total);
+  size_t first = b->from;
+  size_t argc = 9 + 2 * n;
   const char **argv = malloc(argc * sizeof *argv);
   size_t *lens = malloc(argc * sizeof *lens);
   char(*nums)[24] = malloc((n ? n : 1) * sizeof *nums);
@@ -342,17 +353,18 @@ static long long store_frames(run_ctx *x, const char *id, size_t first,
     *x->broken = true; /* the batch stays pending and is retried */
     return 0;
   }
-  const char *head[5] = {"EVAL", FRAMES_LUA, script_keys, x->key, kf};
-  for (size_t k = 0; k < 5; k++) {
+  const char *head[9] = {"EVAL",  FRAMES_LUA, script_keys, x->key, kf,
+                         RJ_STREAM, RJ_GROUP,  b->eid,      tot};
+  for (size_t k = 0; k < 9; k++) {
     argv[k] = head[k];
     lens[k] = strlen(head[k]);
   }
   for (size_t k = 0; k < n; k++) {
     snprintf(nums[k], sizeof nums[k], "%zu", first + k);
-    argv[5 + 2 * k] = nums[k];
-    lens[5 + 2 * k] = strlen(nums[k]);
-    argv[6 + 2 * k] = texts[k].body ? texts[k].body : "";
-    lens[6 + 2 * k] = texts[k].body ? texts[k].length : 0;
+    argv[9 + 2 * k] = nums[k];
+    lens[9 + 2 * k] = strlen(nums[k]);
+    argv[10 + 2 * k] = texts[k].body ? texts[k].body : "";
+    lens[10 + 2 * k] = texts[k].body ? texts[k].length : 0;
   }
   redisReply *rep = redisCommandArgv(x->c, (int)argc, argv, lens);
   free(argv);
@@ -561,11 +573,21 @@ static void run_batch(srv_rjobs *j, redisContext *c, bool *broken,
   }
   /* The frames rendered (all of them, or those before a stop) are
    * stored; a failed or cancelled job stores nothing more. */
-  bool whole = i == b->to || x.why == WHY_SHUTDOWN;
+  bool whole = i == b->to || x.why == WHY_SHUTDOWN, acked = false;
   if (!*broken && r.live && i > b->from && whole) {
-    long long fresh = store_frames(&x, b->id, b->from, i - b->from, texts,
-                                   &done);
-    if (fresh > 0 && done >= 0 && (size_t)done == r.total) last = true;
+    if (x.why == WHY_SHUTDOWN) {
+      /* Stored without the entry (its rest is handed back below). */
+      batch part = *b;
+      part.eid[0] = '\0';
+      long long fresh = store_frames(&x, &part, r.total, i - b->from, texts,
+                                     &done);
+      (void)fresh;
+    } else {
+      long long fresh = store_frames(&x, b, r.total, i - b->from, texts,
+                                     &done);
+      if (fresh > 0 && done >= 0 && (size_t)done == r.total) last = true;
+      acked = done < 0 || (size_t)done < r.total;
+    }
   }
   if (*broken) goto out; /* pending: reclaimed after the timeout */
   if (x.why == WHY_SHUTDOWN && r.live && i < b->to) {
@@ -577,7 +599,7 @@ static void run_batch(srv_rjobs *j, redisContext *c, bool *broken,
   if (r.live && done >= 0 && (size_t)done == r.total &&
       (last || b->again || r.done == (long long)r.total))
     assemble(&x, b->id, p->plan, r.total);
-  if (!*broken) ack(c, broken, b);
+  if (!*broken && !acked) ack(c, broken, b);
 out:
   for (size_t k = 0; texts && k < span; k++) api_response_free(&texts[k]);
   free(texts);

@@ -47,13 +47,13 @@ static const char CREATE_LUA[] =
     "i = k end return 0";
 
 /* Frames per batch: about 16 batches a job, so that two or more
- * instances share a long one; at least 8 frames, so that the few round
- * trips of a batch are spread over several frames; at most 64, so that a
- * batch takes far less than the visibility timeout. */
+ * instances share a long one; at least 16 frames, so that the three
+ * round trips of a batch are spread over many frames; at most 64, so
+ * that a batch takes far less than the visibility timeout. */
 static size_t batch_frames(size_t total, bool apart) {
   if (!apart) return total > 0 ? total : 1;
   size_t b = (total + 15) / 16;
-  return b < 8 ? 8 : b > 64 ? 64 : b;
+  return b < 16 ? 16 : b > 64 ? 64 : b;
 }
 
 int srv_rjobs_start(srv_rjobs *j, const char *body, size_t len,
