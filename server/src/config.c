@@ -76,6 +76,8 @@ static const opt_def OPTS[] = {
      1e13, "bytes of kept job results (oldest evicted: 410)"},
     {"max-points", "KMORPH_MAX_POINTS", OPT_SIZE, F(max_points), 0, 1, 1e9,
      "control points per curve, given or returned"},
+    {"max-contours", "KMORPH_MAX_CONTOURS", OPT_SIZE, F(max_contours), 0, 1,
+     4096, "contours (subpaths) per shape"},
     {"max-frames", "KMORPH_MAX_FRAMES", OPT_SIZE, F(max_frames), 0, 1, 1e9,
      "frames per POST /v1/morph"},
     {"max-job-frames", "KMORPH_MAX_JOB_FRAMES", OPT_SIZE, F(max_job_frames), 0,
@@ -138,6 +140,7 @@ void srv_config_default(srv_config *cfg) {
   cfg->body_memory = (size_t)256 << 20;
   cfg->result_memory = (size_t)512 << 20;
   cfg->max_points = 100000;
+  cfg->max_contours = 64;
   cfg->max_frames = 1000;
   cfg->max_job_frames = 10000;
   cfg->max_samples = 100000;

@@ -32,6 +32,7 @@ typedef struct srv_config {
   size_t body_memory;       /* bytes of all bodies in flight */
   size_t result_memory;     /* bytes of all kept job results */
   size_t max_points;        /* control points per curve */
+  size_t max_contours;      /* contours per shape (at most 4,096) */
   size_t max_frames;        /* frames per POST /v1/morph */
   size_t max_job_frames;    /* frames per POST /v1/jobs */
   size_t max_samples;       /* kappa samples per request */

@@ -117,6 +117,7 @@ srv_server *srv_server_create(const srv_config *cfg, srv_log *logger) {
   api_config_default(&s->api);
   s->api.max_body_bytes = cfg->max_body;
   s->api.max_control_points = cfg->max_points;
+  s->api.max_contours = cfg->max_contours;
   s->api.max_frames_sync = cfg->max_frames;
   s->api.max_frames_job = cfg->max_job_frames;
   s->api.max_samples = cfg->max_samples;

@@ -156,5 +156,36 @@ class CompoundMorphs(ContractCase):
         self.assertGreaterEqual(subpaths.pop(), max(PAIR["counts"]))
 
 
+class ContourLimit(ContractCase):
+    """--max-contours bounds the contours of a shape: at the limit a shape
+    morphs, one past it is a 422 naming the side."""
+    @classmethod
+    def setUpClass(cls):
+        cls.d = Daemon("--threads", "1", "--max-contours", "3")
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.d.stop()
+
+    @staticmethod
+    def squares(n):
+        """n unit squares side by side, 2 apart: n contours, no nesting."""
+        return {"type": "svg", "d": " ".join(
+            "M %d 0 H %d V 1 H %d Z" % (2 * i, 2 * i + 1, 2 * i)
+            for i in range(n))}
+
+    def test_three_contours_morph_and_four_are_refused(self):
+        r = self.d.request("POST", "/v1/morph", body={
+            "from": self.squares(3), "to": self.squares(3), "frames": 3})
+        doc = self.assertDocumented(r, "/v1/morph", "post")
+        self.assertEqual(r.status, 200)
+        self.assertEqual(len(doc["contour_matches_used"]), 3)
+        r = self.d.request("POST", "/v1/morph", body={
+            "from": self.squares(3), "to": self.squares(4), "frames": 3})
+        doc = self.assertProblem(r, 422, "/v1/morph", "post")
+        self.assertTrue(doc["errors"][0]["pointer"].startswith("/to"),
+                        doc["errors"])
+
+
 if __name__ == "__main__":
     unittest.main()
