@@ -542,6 +542,11 @@ static void run_batch(srv_rjobs *j, redisContext *c, bool *broken,
       x.why = WHY_SHUTDOWN;
       break;
     }
+    /* Requests waiting for a worker go first, as they do between the
+     * frames of in-memory jobs. */
+    if (i > b->from && j->yield != NULL)
+      while (j->yield(j->yield_ctx)) {
+      }
     /* Between frames as inside them: the state is looked up at most
      * every STATE_POLL seconds. */
     if (srv_now() >= x.next_look) {
@@ -633,6 +638,11 @@ bool srv_rjobs_work(void *ctx) {
   }
   srv_redis_release(j->rd, c, broken);
   return got && !broken;
+}
+
+void srv_rjobs_set_yield(srv_rjobs *j, bool (*yield)(void *), void *ctx) {
+  j->yield = yield;
+  j->yield_ctx = ctx;
 }
 
 void srv_rjobs_stop(srv_rjobs *j) {

@@ -88,6 +88,11 @@ int srv_rjobs_delete(srv_rjobs *j, const char *id);
  * when there is none or Redis is unreachable. */
 bool srv_rjobs_work(void *ctx);
 
+/* Between two frames of a batch, workers call yield(ctx) until it
+ * returns false (e.g. srv_pool_run_queued: requests waiting for a worker
+ * are not held back by a batch). Set before the workers start. */
+void srv_rjobs_set_yield(srv_rjobs *j, bool (*yield)(void *), void *ctx);
+
 /* Graceful stop: workers take no more batches and hand back the frames
  * of the ones they hold at their next frame boundary. */
 void srv_rjobs_stop(srv_rjobs *j);

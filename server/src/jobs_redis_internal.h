@@ -37,6 +37,8 @@ struct srv_rjobs {
   atomic_size_t handed;     /* batches handed back on stopping */
   atomic_size_t assembled;  /* results assembled by this instance */
   _Atomic double next_claim; /* srv_now(): next XAUTOCLAIM */
+  bool (*yield)(void *ctx);  /* run waiting requests between frames */
+  void *yield_ctx;
 };
 
 /* Unix seconds (records are read by other hosts' instances). */

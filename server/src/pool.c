@@ -121,6 +121,25 @@ void srv_pool_submit(srv_pool *p, srv_task_fn fn, void *arg) {
   pthread_mutex_unlock(&p->mu);
 }
 
+bool srv_pool_run_queued(srv_pool *p) {
+  pthread_mutex_lock(&p->mu);
+  if (p->count == 0) {
+    pthread_mutex_unlock(&p->mu);
+    return false;
+  }
+  /* The calling worker is already counted busy (it runs the source). */
+  task t = p->ring[p->head];
+  p->head = (p->head + 1) % p->capacity;
+  p->count--;
+  bool cancelled = p->stopping;
+  pthread_mutex_unlock(&p->mu);
+  t.fn(t.arg, cancelled);
+  pthread_mutex_lock(&p->mu);
+  pthread_cond_broadcast(&p->cv);
+  pthread_mutex_unlock(&p->mu);
+  return true;
+}
+
 void srv_pool_set_poll(srv_pool *p, double seconds) {
   pthread_mutex_lock(&p->mu);
   p->poll = seconds;

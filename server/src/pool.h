@@ -44,6 +44,12 @@ void srv_pool_submit(srv_pool *p, srv_task_fn fn, void *arg);
  * shared job stream); 0, the default, waits for a kick. */
 void srv_pool_set_poll(srv_pool *p, double seconds);
 
+/* From inside the background source (on a worker): run one queued task
+ * now, if there is one, so that a unit of background work longer than a
+ * frame (a batch of a shared job) does not hold interactive requests
+ * back. True if a task ran. */
+bool srv_pool_run_queued(srv_pool *p);
+
 /* Tell idle workers that background work may have appeared. */
 void srv_pool_kick(srv_pool *p);
 

@@ -77,6 +77,10 @@ static void mhd_log(void *cls, const char *fmt, va_list ap) {
 
 /* -------------------------------------------------------- life cycle */
 
+static bool yield_to_requests(void *pool) {
+  return srv_pool_run_queued(pool);
+}
+
 /* --jobs: the Redis connections and the shared job runner. False (with
  * the reason logged) if the URL is malformed or memory is short; Redis
  * itself need not be up yet. */
@@ -148,7 +152,10 @@ srv_server *srv_server_create(const srv_config *cfg, srv_log *logger) {
                                         srv_jobs_work, s->jobs)
                       : NULL;
   /* Batches of shared jobs appear without a kick from this process. */
-  if (s->pool != NULL && s->rjobs != NULL) srv_pool_set_poll(s->pool, 0.02);
+  if (s->pool != NULL && s->rjobs != NULL) {
+    srv_pool_set_poll(s->pool, 0.02);
+    srv_rjobs_set_yield(s->rjobs, yield_to_requests, s->pool);
+  }
   if (s->metrics == NULL || s->pool == NULL || s->watch == NULL) {
     fprintf(s->log, "kmorphd: cannot create the compute pool (%u workers)\n",
             cfg->workers);
