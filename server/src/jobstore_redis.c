@@ -51,7 +51,9 @@ static const char CREATE_LUA[] =
  * round trips of a batch are spread over many frames; at most 64, so
  * that a batch takes far less than the visibility timeout. */
 static size_t batch_frames(size_t total, bool apart) {
-  if (!apart) return total > 0 ? total : 1;
+  /* Up to two batches' worth is one batch: a job split in two would
+   * be prepared by two instances for little parallel work. */
+  if (!apart || total <= 32) return total > 0 ? total : 1;
   size_t b = (total + 15) / 16;
   return b < 16 ? 16 : b > 64 ? 64 : b;
 }
