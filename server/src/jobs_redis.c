@@ -519,8 +519,152 @@ static record open_job(run_ctx *x, const batch *b, rj_plan **p) {
   return r;
 }
 
-/* Render frames [from, to) of b and store them; assemble the result if
- * the job is then complete; acknowledge (or hand back) the batch. */
+/* Before frame i of a batch: run waiting requests (as in-memory jobs
+ * do between frames), look at the job's state (at most every STATE_POLL
+ * seconds, as the stop callback does inside a frame), then render it.
+ * False when the batch must end: x->why says why (WHY_NONE after a
+ * failure, recorded in the job). */
+static bool render_step(srv_rjobs *j, run_ctx *x, rj_plan *p, const batch *b,
+                        const record *r, size_t i) {
+  if (atomic_load(&j->stopping)) {
+    x->why = WHY_SHUTDOWN;
+    return false;
+  }
+  if (i > b->from && j->yield != NULL)
+    while (j->yield(j->yield_ctx)) {
+    }
+  if (srv_now() >= x->next_look) {
+    x->next_look = srv_now() + STATE_POLL;
+    if (!still_live(x)) return false;
+  }
+  int rc = api_morph_render_frame_until(p->plan, i, run_should_stop, x);
+  if (rc == 0) {
+    atomic_fetch_add(&j->frames, 1);
+    return true;
+  }
+  if (x->why == WHY_NONE && srv__rj_wall() > r->deadline) x->why = WHY_TIME;
+  if (x->why == WHY_TIME) out_of_time(x, b->id, (long long)(i - b->from),
+                                      r->total);
+  if (x->why == WHY_NONE) {
+    char msg[96];
+    snprintf(msg, sizeof msg, "frame %zu could not be built", i);
+    fail_job(x, b->id, rc >= 400 ? rc : 422, msg);
+  }
+  return false;
+}
+
+/* KEYS: job. ARGV: frames rendered. The job's progress raised to it
+ * (never lowered: a batch delivered again starts from 0); -1 if the job
+ * is no longer live. */
+static const char PROGRESS_LUA[] =
+    "local st = redis.call('HGET', KEYS[1], 'st') "
+    "if st ~= 'queued' and st ~= 'running' then return -1 end "
+    "if st == 'queued' then redis.call('HSET', KEYS[1], 'st', 'running') end "
+    "local d = tonumber(redis.call('HGET', KEYS[1], 'd')) "
+    "if tonumber(ARGV[1]) > d then d = tonumber(ARGV[1]) "
+    "redis.call('HSET', KEYS[1], 'd', d) end return d";
+
+/* Record that n frames of a solo batch are rendered; false if the job is
+ * no longer live (or the connection broke). */
+static bool solo_progress(run_ctx *x, size_t n) {
+  redisReply *rep = srv__rj_cmd(x->c, x->broken, "EVAL %s 1 %s %llu",
+                                PROGRESS_LUA, x->key, (unsigned long long)n);
+  bool live = rep && rep->type == REDIS_REPLY_INTEGER && rep->integer >= 0;
+  if (rep) freeReplyObject(rep);
+  if (!live && !*x->broken) x->why = WHY_FINAL;
+  return live;
+}
+
+/* A batch of every frame of its job: rendered here and assembled from
+ * this plan alone, no frame text stored (progress is recorded every
+ * STATE_POLL seconds). Stopped gracefully, it is handed back whole: the
+ * frames rendered here are not kept anywhere else. */
+static void run_solo(srv_rjobs *j, run_ctx *x, rj_plan *p, const batch *b,
+                     const record *r) {
+  size_t i = 0;
+  double next_progress = srv_now() + STATE_POLL;
+  for (; i < r->total; i++) {
+    if (!render_step(j, x, p, b, r, i)) break;
+    if (srv_now() >= next_progress && i + 1 < r->total) {
+      next_progress = srv_now() + STATE_POLL;
+      if (!solo_progress(x, i + 1)) break;
+    }
+  }
+  if (*x->broken) return; /* pending: claimed after the timeout */
+  if (x->why == WHY_SHUTDOWN) {
+    hand_back(j, x->c, x->broken, b, 0);
+    return;
+  }
+  if (i == r->total) {
+    api_response res;
+    api_response_init(&res);
+    int rc = api_morph_result(p->plan, &res);
+    if (rc == 200 && res.body != NULL) {
+      if (srv__rj_finish(j, x->c, b->id, SRV_JOB_DONE, &res, 0, NULL) < 0)
+        *x->broken = true;
+      else
+        atomic_fetch_add(&j->assembled, 1);
+    } else {
+      char msg[96];
+      snprintf(msg, sizeof msg, "the result could not be assembled (%d)", rc);
+      fail_job(x, b->id, rc >= 400 ? rc : 500, msg);
+    }
+    api_response_free(&res);
+  }
+  if (!*x->broken) ack(x->c, x->broken, b);
+}
+
+/* A batch of some frames of a job shared between instances: each frame's
+ * text is stored (one script for the batch, which also acknowledges it
+ * unless the job is then complete); the batch that completes the job, or
+ * one delivered again that finds every frame stored, assembles the
+ * result from the texts. Returns the frames stored in all, -1 if the job
+ * is no longer live or unknown. */
+static long long run_shared(srv_rjobs *j, run_ctx *x, rj_plan *p,
+                            const batch *b, const record *r) {
+  size_t span = b->to - b->from, i = b->from;
+  long long done = r->done;
+  api_response *texts = calloc(span, sizeof *texts);
+  if (texts == NULL) return -1; /* pending: retried after the timeout */
+  for (; i < b->to && i < r->total; i++) {
+    if (!render_step(j, x, p, b, r, i)) break;
+    int rc = api_morph_frame_text(p->plan, i, &texts[i - b->from]);
+    if (rc != 200) {
+      char msg[96];
+      snprintf(msg, sizeof msg, "frame %zu could not be written (%d)", i, rc);
+      fail_job(x, b->id, rc >= 400 ? rc : 500, msg);
+      break;
+    }
+  }
+  bool last = false, acked = false;
+  if (!*x->broken && i > b->from && x->why == WHY_SHUTDOWN) {
+    /* Stored without the entry, whose rest is handed back below. */
+    batch part = *b;
+    part.eid[0] = '\0';
+    store_frames(x, &part, r->total, i - b->from, texts, &done);
+  } else if (!*x->broken && i > b->from && i == b->to) {
+    long long fresh = store_frames(x, b, r->total, span, texts, &done);
+    last = fresh > 0 && done >= 0 && (size_t)done == r->total;
+    acked = done < 0 || (size_t)done < r->total;
+  }
+  for (size_t k = 0; k < span; k++) api_response_free(&texts[k]);
+  free(texts);
+  if (*x->broken) return done; /* pending: claimed after the timeout */
+  if (x->why == WHY_SHUTDOWN && i < b->to) {
+    hand_back(j, x->c, x->broken, b, i);
+    return done;
+  }
+  /* A consumer may have died after storing the last frame and before
+   * assembling the result: a batch delivered again does it. */
+  if (done >= 0 && (size_t)done == r->total &&
+      (last || b->again || r->done == (long long)r->total))
+    assemble(x, b->id, p->plan, r->total);
+  if (!*x->broken && !acked) ack(x->c, x->broken, b);
+  return done;
+}
+
+/* Render batch b and acknowledge it, hand it back, or leave it pending
+ * (Redis went away). */
 static void run_batch(srv_rjobs *j, redisContext *c, bool *broken,
                       const batch *b) {
   run_ctx x = {.j = j,
@@ -530,88 +674,24 @@ static void run_batch(srv_rjobs *j, redisContext *c, bool *broken,
                .next_look = srv_now() + STATE_POLL};
   srv__rj_key(x.key, sizeof x.key, "job", b->id);
   rj_plan *p = NULL;
+  bool over = false;
   record r = b->from < b->to ? open_job(&x, b, &p) : (record){0};
-  bool last = false;
-  long long done = r.done;
-  size_t i = b->from;
-  size_t span = b->to > b->from ? b->to - b->from : 0;
-  api_response *texts = span ? calloc(span, sizeof *texts) : NULL;
-  if (*broken || (span && texts == NULL)) goto out;
-  for (; r.live && i < b->to && i < r.total; i++) {
-    if (atomic_load(&j->stopping)) {
-      x.why = WHY_SHUTDOWN;
-      break;
-    }
-    /* Requests waiting for a worker go first, as they do between the
-     * frames of in-memory jobs. */
-    if (i > b->from && j->yield != NULL)
-      while (j->yield(j->yield_ctx)) {
-      }
-    /* Between frames as inside them: the state is looked up at most
-     * every STATE_POLL seconds. */
-    if (srv_now() >= x.next_look) {
-      x.next_look = srv_now() + STATE_POLL;
-      if (!still_live(&x)) break;
-    }
-    int rc = api_morph_render_frame_until(p->plan, i, run_should_stop, &x);
-    if (rc != 0) {
-      if (x.why == WHY_NONE && srv__rj_wall() > r.deadline) x.why = WHY_TIME;
-      if (x.why == WHY_TIME) out_of_time(&x, b->id, done, r.total);
-      if (x.why == WHY_NONE) {
-        char msg[96];
-        snprintf(msg, sizeof msg, "frame %zu could not be built", i);
-        fail_job(&x, b->id, rc >= 400 ? rc : 422, msg);
-      }
-      break;
-    }
-    atomic_fetch_add(&j->frames, 1);
-    if (api_morph_frames_apart(p->plan)) {
-      rc = api_morph_frame_text(p->plan, i, &texts[i - b->from]);
-      if (rc != 200) {
-        char msg[96];
-        snprintf(msg, sizeof msg, "frame %zu could not be written (%d)", i,
-                 rc);
-        fail_job(&x, b->id, rc >= 400 ? rc : 500, msg);
-        break;
-      }
-    }
-  }
-  /* The frames rendered (all of them, or those before a stop) are
-   * stored; a failed or cancelled job stores nothing more. */
-  bool whole = i == b->to || x.why == WHY_SHUTDOWN, acked = false;
-  if (!*broken && r.live && i > b->from && whole) {
-    if (x.why == WHY_SHUTDOWN) {
-      /* Stored without the entry (its rest is handed back below). */
-      batch part = *b;
-      part.eid[0] = '\0';
-      long long fresh = store_frames(&x, &part, r.total, i - b->from, texts,
-                                     &done);
-      (void)fresh;
-    } else {
-      long long fresh = store_frames(&x, b, r.total, i - b->from, texts,
-                                     &done);
-      if (fresh > 0 && done >= 0 && (size_t)done == r.total) last = true;
-      acked = done < 0 || (size_t)done < r.total;
-    }
-  }
-  if (*broken) goto out; /* pending: reclaimed after the timeout */
-  if (x.why == WHY_SHUTDOWN && r.live && i < b->to) {
-    hand_back(j, c, broken, b, i);
+  if (*broken) goto out;
+  if (!r.live) {
+    ack(c, broken, b); /* final, unknown or empty: nothing to render */
     goto out;
   }
-  /* A batch delivered again may find every frame stored by a consumer
-   * that died before it assembled the result. */
-  if (r.live && done >= 0 && (size_t)done == r.total &&
-      (last || b->again || r.done == (long long)r.total))
-    assemble(&x, b->id, p->plan, r.total);
-  if (!*broken && !acked) ack(c, broken, b);
+  if (b->from == 0 && b->to >= r.total) {
+    run_solo(j, &x, p, b, &r);
+    over = x.why != WHY_SHUTDOWN;
+  } else {
+    long long done = run_shared(j, &x, p, b, &r);
+    over = done < 0 || (size_t)done == r.total || x.why == WHY_FINAL;
+  }
 out:
-  for (size_t k = 0; texts && k < span; k++) api_response_free(&texts[k]);
-  free(texts);
   if (p) {
     cache_release(j, p);
-    if (!r.live || (done >= 0 && (size_t)done == r.total) || x.why == WHY_FINAL)
-      srv__rj_cache_drop(j, b->id);
+    if (over && !*broken) srv__rj_cache_drop(j, b->id);
   }
 }
 
