@@ -61,8 +61,8 @@ static bool frames_span(const char *text, size_t len, size_t *open,
 /* The "intersections" member's crossing list and reason in the answer's
  * tail: where "crossing_frames":[ ends (just after '[') and the reason's
  * value [*rs, *re); false when the answer has no such member. */
-static bool crossings_span(const char *tail, const char **list,
-                           const char **rs, const char **re) {
+static bool crossings_span(const char *tail, const char **list, const char **rs,
+                           const char **re) {
   static const char key[] = "\"intersections\":{\"crossing_frames\":[";
   const char *a = strstr(tail, key);
   if (a == NULL) return false;

@@ -10,9 +10,6 @@
 #include "jobs_redis_internal.h"
 #include "util.h"
 
-/* Plans kept per instance; unused ones beyond this are freed, oldest
- * first (a later batch of the job prepares it again). */
-#define PLANS_MAX 16
 /* Seconds between two looks at a job's state from inside a frame. */
 static const double STATE_POLL = 0.2;
 /* Seconds between two XAUTOCLAIM tries of this instance. */
@@ -38,114 +35,6 @@ srv_rjobs *srv_rjobs_create(srv_redis *rd, const srv_rjobs_config *cfg) {
   atomic_init(&j->assembled, 0);
   atomic_init(&j->next_claim, 0.0);
   return j;
-}
-
-/* ------------------------------------------------------- plan cache */
-
-/* Free unused plans beyond PLANS_MAX, least recently used first (mu
- * held). */
-static void evict_locked(srv_rjobs *j) {
-  while (j->nplans > PLANS_MAX) {
-    rj_plan **victim = NULL;
-    for (rj_plan **pp = &j->plans; *pp; pp = &(*pp)->next)
-      if ((*pp)->refs == 0 && (victim == NULL || (*pp)->used < (*victim)->used))
-        victim = pp;
-    if (victim == NULL) return;
-    rj_plan *v = *victim;
-    *victim = v->next;
-    j->nplans--;
-    api_morph_plan_free(v->plan);
-    free(v);
-  }
-}
-
-void srv__rj_cache_put(srv_rjobs *j, const char *id, api_morph_plan *plan) {
-  rj_plan *e = calloc(1, sizeof *e);
-  if (e == NULL) {
-    api_morph_plan_free(plan);
-    return;
-  }
-  memcpy(e->id, id, SRV_JOB_ID_LEN + 1);
-  e->plan = plan;
-  e->used = srv_now();
-  pthread_mutex_lock(&j->mu);
-  e->next = j->plans;
-  j->plans = e;
-  j->nplans++;
-  evict_locked(j);
-  pthread_mutex_unlock(&j->mu);
-}
-
-void srv__rj_cache_drop(srv_rjobs *j, const char *id) {
-  rj_plan *v = NULL;
-  pthread_mutex_lock(&j->mu);
-  for (rj_plan **pp = &j->plans; *pp; pp = &(*pp)->next)
-    if (strcmp((*pp)->id, id) == 0) {
-      if ((*pp)->refs == 0) {
-        v = *pp;
-        *pp = v->next;
-        j->nplans--;
-      }
-      break;
-    }
-  pthread_mutex_unlock(&j->mu);
-  if (v) {
-    api_morph_plan_free(v->plan);
-    free(v);
-  }
-}
-
-static rj_plan *cache_find_locked(srv_rjobs *j, const char *id) {
-  for (rj_plan *p = j->plans; p; p = p->next)
-    if (strcmp(p->id, id) == 0) return p;
-  return NULL;
-}
-
-/* Job id's cached plan with a reference held, or NULL. */
-static rj_plan *cache_ref(srv_rjobs *j, const char *id) {
-  pthread_mutex_lock(&j->mu);
-  rj_plan *p = cache_find_locked(j, id);
-  if (p) {
-    p->refs++;
-    p->used = srv_now();
-  }
-  pthread_mutex_unlock(&j->mu);
-  return p;
-}
-
-/* Job id's plan prepared from its stored request (body of len bytes,
- * accept "" for none), cached, with a reference held. NULL with the
- * problem's status in *status and the reason in why if it cannot be
- * prepared. */
-static rj_plan *cache_prepare(srv_rjobs *j, const char *id, const char *body,
-                              size_t len, const char *accept, int *status,
-                              char *why, size_t whycap) {
-  api_request req = {.route = API_ROUTE_MORPH,
-                     .body = body,
-                     .length = len,
-                     .accept = accept[0] ? accept : NULL};
-  api_morph_plan *plan = NULL;
-  api_response err;
-  int rc = api_morph_prepare(&j->cfg.api, &req, j->cfg.max_job_frames, &plan,
-                             &err);
-  api_response_free(&err);
-  if (rc != 0 || plan == NULL) {
-    *status = rc >= 400 ? rc : 500;
-    snprintf(why, whycap,
-             "the stored request could not be prepared again (%d)", rc);
-    return NULL;
-  }
-  srv__rj_cache_put(j, id, plan);
-  rj_plan *p = cache_ref(j, id);
-  if (p == NULL) *status = 503, snprintf(why, whycap, "out of memory");
-  return p;
-}
-
-static void cache_release(srv_rjobs *j, rj_plan *p) {
-  pthread_mutex_lock(&j->mu);
-  p->refs--;
-  evict_locked(j);
-  pthread_mutex_unlock(&j->mu);
 }
 
 /* ---------------------------------------------------------- batches */
@@ -186,8 +75,9 @@ static bool parse_entry(const redisReply *e, batch *b) {
 static void ensure_group(srv_rjobs *j, redisContext *c, bool *broken) {
   redisReply *rep = srv__rj_cmd(c, broken, "XGROUP CREATE %s %s 0 MKSTREAM",
                                 RJ_STREAM, RJ_GROUP);
-  if (rep && (rep->type == REDIS_REPLY_STATUS ||
-              (rep->type == REDIS_REPLY_ERROR && strstr(rep->str, "BUSYGROUP"))))
+  if (rep &&
+      (rep->type == REDIS_REPLY_STATUS ||
+       (rep->type == REDIS_REPLY_ERROR && strstr(rep->str, "BUSYGROUP"))))
     atomic_store(&j->group_ok, true);
   if (rep) freeReplyObject(rep);
 }
@@ -201,9 +91,9 @@ static void check_error(srv_rjobs *j, const redisReply *rep) {
 
 /* One new batch for this consumer; false if none. */
 static bool read_one(srv_rjobs *j, redisContext *c, bool *broken, batch *b) {
-  redisReply *rep = srv__rj_cmd(c, broken,
-                                "XREADGROUP GROUP %s %s COUNT 1 STREAMS %s >",
-                                RJ_GROUP, j->consumer, RJ_STREAM);
+  redisReply *rep =
+      srv__rj_cmd(c, broken, "XREADGROUP GROUP %s %s COUNT 1 STREAMS %s >",
+                  RJ_GROUP, j->consumer, RJ_STREAM);
   if (rep == NULL) return false;
   bool got = false;
   if (rep->type == REDIS_REPLY_ARRAY && rep->elements == 1) {
@@ -223,9 +113,9 @@ static bool read_one(srv_rjobs *j, redisContext *c, bool *broken, batch *b) {
  * timeout, claimed for this one; false if none. */
 static bool claim_one(srv_rjobs *j, redisContext *c, bool *broken, batch *b) {
   long long idle_ms = (long long)(j->cfg.visibility * 1000.0);
-  redisReply *rep = srv__rj_cmd(c, broken,
-                                "XAUTOCLAIM %s %s %s %lld 0-0 COUNT 1",
-                                RJ_STREAM, RJ_GROUP, j->consumer, idle_ms);
+  redisReply *rep =
+      srv__rj_cmd(c, broken, "XAUTOCLAIM %s %s %s %lld 0-0 COUNT 1", RJ_STREAM,
+                  RJ_GROUP, j->consumer, idle_ms);
   if (rep == NULL) return false;
   bool got = false;
   if (rep->type == REDIS_REPLY_ARRAY && rep->elements >= 2 &&
@@ -240,9 +130,8 @@ static bool claim_one(srv_rjobs *j, redisContext *c, bool *broken, batch *b) {
   return got;
 }
 
-static const char ACK_LUA[] =
-    "redis.call('XACK', KEYS[1], ARGV[1], ARGV[2]) "
-    "redis.call('XDEL', KEYS[1], ARGV[2]) return 0";
+static const char ACK_LUA[] = "redis.call('XACK', KEYS[1], ARGV[1], ARGV[2]) "
+                              "redis.call('XDEL', KEYS[1], ARGV[2]) return 0";
 
 static void ack(redisContext *c, bool *broken, const batch *b) {
   redisReply *rep = srv__rj_cmd(c, broken, "EVAL %s 1 %s %s %s", ACK_LUA,
@@ -261,10 +150,10 @@ static const char HAND_BACK_LUA[] =
 
 static void hand_back(srv_rjobs *j, redisContext *c, bool *broken,
                       const batch *b, size_t from) {
-  redisReply *rep = srv__rj_cmd(
-      c, broken, "EVAL %s 1 %s %s %s %s %llu %llu", HAND_BACK_LUA, RJ_STREAM,
-      RJ_GROUP, b->eid, b->id, (unsigned long long)from,
-      (unsigned long long)b->to);
+  redisReply *rep =
+      srv__rj_cmd(c, broken, "EVAL %s 1 %s %s %s %s %llu %llu", HAND_BACK_LUA,
+                  RJ_STREAM, RJ_GROUP, b->eid, b->id, (unsigned long long)from,
+                  (unsigned long long)b->to);
   if (rep) freeReplyObject(rep);
   if (!*broken) atomic_fetch_add(&j->handed, 1);
 }
@@ -289,9 +178,9 @@ static bool still_live(run_ctx *x) {
     x->why = WHY_BROKEN;
     return false;
   }
-  bool live = rep->type == REDIS_REPLY_STRING &&
-              (strcmp(rep->str, "queued") == 0 ||
-               strcmp(rep->str, "running") == 0);
+  bool live =
+      rep->type == REDIS_REPLY_STRING &&
+      (strcmp(rep->str, "queued") == 0 || strcmp(rep->str, "running") == 0);
   freeReplyObject(rep);
   if (!live) x->why = WHY_FINAL;
   return live;
@@ -353,8 +242,8 @@ static long long store_frames(run_ctx *x, const batch *b, size_t total,
     *x->broken = true; /* the batch stays pending and is retried */
     return 0;
   }
-  const char *head[9] = {"EVAL",  FRAMES_LUA, script_keys, x->key, kf,
-                         RJ_STREAM, RJ_GROUP,  b->eid,      tot};
+  const char *head[9] = {"EVAL",    FRAMES_LUA, script_keys, x->key, kf,
+                         RJ_STREAM, RJ_GROUP,   b->eid,      tot};
   for (size_t k = 0; k < 9; k++) {
     argv[k] = head[k];
     lens[k] = strlen(head[k]);
@@ -460,7 +349,7 @@ typedef struct record {
  * the record (read only then: it is the record's largest part). NULL,
  * with the job recorded as failed, if it cannot be prepared. */
 static rj_plan *job_plan(run_ctx *x, const char *id) {
-  rj_plan *p = cache_ref(x->j, id);
+  rj_plan *p = srv__rj_cache_ref(x->j, id);
   if (p != NULL) return p;
   redisReply *rep = srv__rj_cmd(x->c, x->broken, "HMGET %s b a", x->key);
   if (rep == NULL) return NULL;
@@ -469,8 +358,9 @@ static rj_plan *job_plan(run_ctx *x, const char *id) {
   if (rep->type == REDIS_REPLY_ARRAY && rep->elements == 2 &&
       rep->element[0]->type == REDIS_REPLY_STRING) {
     const char *acc = rep->element[1]->str ? rep->element[1]->str : "";
-    p = cache_prepare(x->j, id, rep->element[0]->str, rep->element[0]->len,
-                      acc, &status, why, sizeof why);
+    p = srv__rj_cache_prepare(x->j, id, rep->element[0]->str,
+                              rep->element[0]->len, acc, &status, why,
+                              sizeof why);
   }
   freeReplyObject(rep);
   if (p == NULL && !*x->broken) fail_job(x, id, status, why);
@@ -482,8 +372,7 @@ static rj_plan *job_plan(run_ctx *x, const char *id) {
 static record open_job(run_ctx *x, const batch *b, rj_plan **p) {
   record r = {false, 0, 0, 0};
   *p = NULL;
-  redisReply *rep =
-      srv__rj_cmd(x->c, x->broken, "HMGET %s st n dl d", x->key);
+  redisReply *rep = srv__rj_cmd(x->c, x->broken, "HMGET %s st n dl d", x->key);
   if (rep == NULL) return r;
   const char *st = NULL;
   if (rep->type == REDIS_REPLY_ARRAY && rep->elements == 4 &&
@@ -491,12 +380,12 @@ static record open_job(run_ctx *x, const batch *b, rj_plan **p) {
     st = rep->element[0]->str;
   if (st && (strcmp(st, "queued") == 0 || strcmp(st, "running") == 0)) {
     r.live = true;
-    r.total = strtoull(rep->element[1]->str ? rep->element[1]->str : "0",
-                       NULL, 10);
-    r.deadline = strtod(rep->element[2]->str ? rep->element[2]->str : "0",
-                        NULL);
-    r.done = strtoll(rep->element[3]->str ? rep->element[3]->str : "0", NULL,
-                     10);
+    r.total =
+        strtoull(rep->element[1]->str ? rep->element[1]->str : "0", NULL, 10);
+    r.deadline =
+        strtod(rep->element[2]->str ? rep->element[2]->str : "0", NULL);
+    r.done =
+        strtoll(rep->element[3]->str ? rep->element[3]->str : "0", NULL, 10);
   }
   freeReplyObject(rep);
   if (!r.live) return r;
@@ -510,10 +399,11 @@ static record open_job(run_ctx *x, const batch *b, rj_plan **p) {
   if (*p == NULL) {
     r.live = false;
   } else if (api_morph_frame_count((*p)->plan) != r.total) {
-    cache_release(x->j, *p);
+    srv__rj_cache_release(x->j, *p);
     *p = NULL;
-    fail_job(x, b->id, 500, "the stored request plans another count of "
-                            "frames");
+    fail_job(x, b->id, 500,
+             "the stored request plans another count of "
+             "frames");
     r.live = false;
   }
   return r;
@@ -543,8 +433,8 @@ static bool render_step(srv_rjobs *j, run_ctx *x, rj_plan *p, const batch *b,
     return true;
   }
   if (x->why == WHY_NONE && srv__rj_wall() > r->deadline) x->why = WHY_TIME;
-  if (x->why == WHY_TIME) out_of_time(x, b->id, (long long)(i - b->from),
-                                      r->total);
+  if (x->why == WHY_TIME)
+    out_of_time(x, b->id, (long long)(i - b->from), r->total);
   if (x->why == WHY_NONE) {
     char msg[96];
     snprintf(msg, sizeof msg, "frame %zu could not be built", i);
@@ -690,7 +580,7 @@ static void run_batch(srv_rjobs *j, redisContext *c, bool *broken,
   }
 out:
   if (p) {
-    cache_release(j, p);
+    srv__rj_cache_release(j, p);
     if (over && !*broken) srv__rj_cache_drop(j, b->id);
   }
 }
@@ -706,7 +596,8 @@ bool srv_rjobs_work(void *ctx) {
   double now = srv_now();
   double next = atomic_load(&j->next_claim);
   if (!broken && now >= next &&
-      atomic_compare_exchange_strong(&j->next_claim, &next, now + CLAIM_EVERY)) {
+      atomic_compare_exchange_strong(&j->next_claim, &next,
+                                     now + CLAIM_EVERY)) {
     got = claim_one(j, c, &broken, &b);
     if (got) atomic_fetch_add(&j->reclaimed, 1);
   }
@@ -745,9 +636,9 @@ size_t srv_rjobs_hand_back_all(srv_rjobs *j) {
     for (size_t k = 0; k < rep->elements && !broken; k++) {
       const redisReply *e = rep->element[k];
       if (e->type != REDIS_REPLY_ARRAY || e->elements < 1) continue;
-      redisReply *cl = srv__rj_cmd(c, &broken, "XCLAIM %s %s %s 0 %s",
-                                   RJ_STREAM, RJ_GROUP, j->consumer,
-                                   e->element[0]->str);
+      redisReply *cl =
+          srv__rj_cmd(c, &broken, "XCLAIM %s %s %s 0 %s", RJ_STREAM, RJ_GROUP,
+                      j->consumer, e->element[0]->str);
       batch b;
       if (cl && cl->type == REDIS_REPLY_ARRAY && cl->elements == 1 &&
           parse_entry(cl->element[0], &b)) {
@@ -771,76 +662,6 @@ bool srv_rjobs_ready(srv_rjobs *j) {
 
 bool srv_rjobs_up(srv_rjobs *j) {
   return srv_redis_up(j->rd);
-}
-
-/* The group's pending count and this consumer's, and the stream's
- * length; false if Redis did not answer. */
-static bool stream_counts(srv_rjobs *j, long long *len, long long *pending,
-                          long long *mine) {
-  redisContext *c = srv_redis_acquire(j->rd);
-  if (c == NULL) return false;
-  bool broken = false;
-  *len = *pending = *mine = 0;
-  redisReply *rep = srv__rj_cmd(c, &broken, "XLEN %s", RJ_STREAM);
-  if (rep && rep->type == REDIS_REPLY_INTEGER) *len = rep->integer;
-  if (rep) freeReplyObject(rep);
-  rep = broken ? NULL
-               : srv__rj_cmd(c, &broken, "XPENDING %s %s", RJ_STREAM, RJ_GROUP);
-  if (rep && rep->type == REDIS_REPLY_ARRAY && rep->elements == 4) {
-    *pending = rep->element[0]->integer;
-    const redisReply *per = rep->element[3];
-    if (per->type == REDIS_REPLY_ARRAY)
-      for (size_t k = 0; k < per->elements; k++) {
-        const redisReply *e = per->element[k];
-        if (e->type == REDIS_REPLY_ARRAY && e->elements == 2 &&
-            strcmp(e->element[0]->str, j->consumer) == 0)
-          *mine = strtoll(e->element[1]->str, NULL, 10);
-      }
-  }
-  if (rep) freeReplyObject(rep);
-  srv_redis_release(j->rd, c, broken);
-  return !broken;
-}
-
-void srv_rjobs_metrics(srv_rjobs *j, char *buf, size_t cap) {
-  long long len = 0, pending = 0, mine = 0;
-  bool up = stream_counts(j, &len, &pending, &mine);
-  /* Acknowledged batches are deleted, so the stream holds the batches
-   * not yet delivered plus the pending ones. */
-  long long lag = len - pending > 0 ? len - pending : 0;
-  snprintf(
-      buf, cap,
-      "# HELP kmorph_job_frames_rendered_total Frames of jobs rendered by "
-      "this instance.\n"
-      "# TYPE kmorph_job_frames_rendered_total counter\n"
-      "kmorph_job_frames_rendered_total %zu\n"
-      "# HELP kmorph_redis_up Whether Redis (--jobs) answered now.\n"
-      "# TYPE kmorph_redis_up gauge\n"
-      "kmorph_redis_up %d\n"
-      "# HELP kmorph_jobs_stream_lag Batches in the work stream not yet "
-      "delivered to any instance.\n"
-      "# TYPE kmorph_jobs_stream_lag gauge\n"
-      "kmorph_jobs_stream_lag %lld\n"
-      "# HELP kmorph_jobs_pending_batches Batches delivered and not yet "
-      "acknowledged: by every instance, by this one.\n"
-      "# TYPE kmorph_jobs_pending_batches gauge\n"
-      "kmorph_jobs_pending_batches{consumer=\"all\"} %lld\n"
-      "kmorph_jobs_pending_batches{consumer=\"self\"} %lld\n"
-      "# HELP kmorph_jobs_reclaimed_batches_total Batches this instance "
-      "claimed from an instance silent past the visibility timeout.\n"
-      "# TYPE kmorph_jobs_reclaimed_batches_total counter\n"
-      "kmorph_jobs_reclaimed_batches_total %zu\n"
-      "# HELP kmorph_jobs_handed_back_batches_total Batches this instance "
-      "handed back unfinished when stopping.\n"
-      "# TYPE kmorph_jobs_handed_back_batches_total counter\n"
-      "kmorph_jobs_handed_back_batches_total %zu\n"
-      "# HELP kmorph_jobs_assembled_total Job results this instance "
-      "assembled.\n"
-      "# TYPE kmorph_jobs_assembled_total counter\n"
-      "kmorph_jobs_assembled_total %zu\n",
-      (size_t)atomic_load(&j->frames), up ? 1 : 0, lag, pending, mine,
-      (size_t)atomic_load(&j->reclaimed), (size_t)atomic_load(&j->handed),
-      (size_t)atomic_load(&j->assembled));
 }
 
 void srv_rjobs_destroy(srv_rjobs *j) {

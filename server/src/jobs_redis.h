@@ -14,19 +14,28 @@
  * from, to), so the idle workers of every instance take batches of one
  * long job at once (XREADGROUP, one entry per read). A worker prepares
  * the job's plan from the stored request (kept per job id in the
- * instance, so one instance prepares a job once), renders its frames,
- * stores each one with HSETNX (a frame written twice counts once) and
- * bumps the done count in the same script; the worker whose frame makes
- * the count reach the total assembles the result in frame order. A batch
- * is acknowledged (XACK, XDEL) after its frames are stored, so delivery
- * is at least once: the batches of an instance that dies stay pending
- * and are claimed by another after the visibility timeout (XAUTOCLAIM,
- * tried once a second per instance). An instance that stops gracefully
- * hands the rest of its batches back at once: it adds their unrendered
- * frames as a new entry and acknowledges the old one, in one MULTI, so
- * the frames are delivered to another consumer immediately rather than
- * after the timeout, and never both ways. Results that need every frame
- * of one plan (SVG, animate_d, crossing avoidance) are one batch.
+ * instance, so one instance prepares a job once), renders its frames
+ * and stores their texts in one script that writes each with HSETNX (a
+ * frame written twice counts once), bumps the done count and
+ * acknowledges the entry (XACK, XDEL); the worker whose frames make the
+ * count reach the total assembles the result in frame order and only
+ * then acknowledges its entry. So delivery is at least once: the batches
+ * of an instance that dies stay pending and are claimed by another after
+ * the visibility timeout (XAUTOCLAIM, tried once a second per instance).
+ * An instance that stops gracefully hands the rest of its batches back
+ * at once: it adds their unrendered frames as a new entry and
+ * acknowledges the old one in one script, so the frames are delivered to
+ * another consumer immediately rather than after the timeout (XCLAIM to
+ * another consumer would need one that is alive and idle), and never
+ * both ways.
+ *
+ * A job of at most 64 frames, and one whose answer needs every frame of
+ * one plan (SVG, animate_d), is a single "solo" batch: one instance
+ * renders it and assembles the result from its own plan, storing no
+ * frame texts (its progress is written every 0.2 s); stopped gracefully
+ * it is handed back whole. Splitting a mid-size job would cost more in
+ * preparing it on several instances and moving its frames through Redis
+ * than the parallel rendering saves.
  *
  * Cancellation is the record's state: workers read it between frames and
  * at most every 0.2 s from inside a frame (its stop callback), so a

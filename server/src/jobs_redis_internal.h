@@ -1,6 +1,7 @@
-/* jobs_redis_internal.h - what the two halves of the Redis job runner
- * share: jobstore_redis.c (records: create, read, cancel, finish) and
- * jobs_redis.c (batches: take, render, reclaim, hand back). */
+/* jobs_redis_internal.h - what the files of the Redis job runner share:
+ * jobstore_redis.c (records: create, read, cancel, finish), jobs_redis.c
+ * (batches: take, render, reclaim, hand back), jobs_plans.c (prepared
+ * plans per instance) and jobs_redis_metrics.c (/metrics lines). */
 #ifndef SRV_JOBS_REDIS_INTERNAL_H
 #define SRV_JOBS_REDIS_INTERNAL_H
 
@@ -30,12 +31,12 @@ struct srv_rjobs {
   rj_plan *plans; /* guarded by mu */
   size_t nplans;
   atomic_bool stopping;
-  atomic_bool group_ok;     /* the consumer group is known to exist */
-  atomic_size_t busy;       /* batches being rendered now */
-  atomic_size_t frames;     /* frames rendered by this instance */
-  atomic_size_t reclaimed;  /* batches claimed from a silent consumer */
-  atomic_size_t handed;     /* batches handed back on stopping */
-  atomic_size_t assembled;  /* results assembled by this instance */
+  atomic_bool group_ok;      /* the consumer group is known to exist */
+  atomic_size_t busy;        /* batches being rendered now */
+  atomic_size_t frames;      /* frames rendered by this instance */
+  atomic_size_t reclaimed;   /* batches claimed from a silent consumer */
+  atomic_size_t handed;      /* batches handed back on stopping */
+  atomic_size_t assembled;   /* results assembled by this instance */
   _Atomic double next_claim; /* srv_now(): next XAUTOCLAIM */
   bool (*yield)(void *ctx);  /* run waiting requests between frames */
   void *yield_ctx;
@@ -63,5 +64,16 @@ int srv__rj_finish(srv_rjobs *j, redisContext *c, const char *id,
 void srv__rj_cache_put(srv_rjobs *j, const char *id, api_morph_plan *plan);
 /* Drop job id's cached plan, if it is not in use. */
 void srv__rj_cache_drop(srv_rjobs *j, const char *id);
+/* Job id's cached plan with a reference held, or NULL. */
+rj_plan *srv__rj_cache_ref(srv_rjobs *j, const char *id);
+/* Job id's plan prepared from its stored request (body of len bytes,
+ * accept "" for none), cached, with a reference held. NULL with the
+ * problem's status in *status and the reason in why if it cannot be
+ * prepared. */
+rj_plan *srv__rj_cache_prepare(srv_rjobs *j, const char *id, const char *body,
+                               size_t len, const char *accept, int *status,
+                               char *why, size_t whycap);
+/* Drop a reference from srv__rj_cache_ref or _prepare. */
+void srv__rj_cache_release(srv_rjobs *j, rj_plan *p);
 
 #endif

@@ -116,8 +116,7 @@ static int read_record(srv_rjobs *j, redisContext *c, bool *broken,
                        size_t ctcap) {
   char key[80];
   srv__rj_key(key, sizeof key, "job", id);
-  redisReply *rep =
-      srv__rj_cmd(c, broken, "HMGET %s st n d es e c ct", key);
+  redisReply *rep = srv__rj_cmd(c, broken, "HMGET %s st n d es e c ct", key);
   (void)j;
   if (rep == NULL) return SRV_RJOBS_DOWN;
   int rc = SRV_STORE_UNKNOWN;
@@ -271,8 +270,8 @@ int srv_rjobs_delete(srv_rjobs *j, const char *id) {
     srv__rj_key(kj, sizeof kj, "job", id);
     srv__rj_key(kf, sizeof kf, "frames", id);
     srv__rj_key(kr, sizeof kr, "result", id);
-    redisReply *rep = srv__rj_cmd(c, &broken, "EVAL %s 3 %s %s %s", FORGET_LUA,
-                                  kj, kf, kr);
+    redisReply *rep =
+        srv__rj_cmd(c, &broken, "EVAL %s 3 %s %s %s", FORGET_LUA, kj, kf, kr);
     rc = rep && rep->type == REDIS_REPLY_INTEGER && rep->integer == 1 ? 1 : 0;
     if (rep) freeReplyObject(rep);
   }

@@ -30,12 +30,10 @@ struct srv_redis {
   atomic_bool up;
 };
 
-static bool parse_url(srv_redis *r, const char *url, char *err,
-                      size_t errlen) {
+static bool parse_url(srv_redis *r, const char *url, char *err, size_t errlen) {
   static const char scheme[] = "redis://";
   if (strncmp(url, scheme, sizeof scheme - 1) != 0) {
-    snprintf(err, errlen, "--jobs wants redis://HOST:PORT/DB, not \"%s\"",
-             url);
+    snprintf(err, errlen, "--jobs wants redis://HOST:PORT/DB, not \"%s\"", url);
     return false;
   }
   const char *h = url + sizeof scheme - 1;
@@ -98,8 +96,8 @@ static struct timeval tv_of(double s) {
 /* A new context, connected, timed and on the right database; NULL if
  * any step failed. */
 static redisContext *connect_one(const srv_redis *r) {
-  redisContext *c = redisConnectWithTimeout(r->host, r->port,
-                                            tv_of(CONNECT_TIMEOUT));
+  redisContext *c =
+      redisConnectWithTimeout(r->host, r->port, tv_of(CONNECT_TIMEOUT));
   if (c == NULL || c->err) goto fail;
   if (redisSetTimeout(c, tv_of(COMMAND_TIMEOUT)) != REDIS_OK) goto fail;
   if (r->db != 0) {
