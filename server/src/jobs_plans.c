@@ -105,6 +105,7 @@ rj_plan *srv__rj_cache_prepare(srv_rjobs *j, const char *id, const char *body,
              rc);
     return NULL;
   }
+  atomic_fetch_add(&j->prepared, 1);
   srv__rj_cache_put(j, id, plan);
   rj_plan *p = srv__rj_cache_ref(j, id);
   if (p == NULL) *status = 503, snprintf(why, whycap, "out of memory");

@@ -33,6 +33,7 @@ srv_rjobs *srv_rjobs_create(srv_redis *rd, const srv_rjobs_config *cfg) {
   atomic_init(&j->reclaimed, 0);
   atomic_init(&j->handed, 0);
   atomic_init(&j->assembled, 0);
+  atomic_init(&j->prepared, 0);
   atomic_init(&j->next_claim, 0.0);
   return j;
 }

@@ -37,6 +37,7 @@ struct srv_rjobs {
   atomic_size_t reclaimed;   /* batches claimed from a silent consumer */
   atomic_size_t handed;      /* batches handed back on stopping */
   atomic_size_t assembled;   /* results assembled by this instance */
+  atomic_size_t prepared;    /* plans prepared from a stored request */
   _Atomic double next_claim; /* srv_now(): next XAUTOCLAIM */
   bool (*yield)(void *ctx);  /* run waiting requests between frames */
   void *yield_ctx;

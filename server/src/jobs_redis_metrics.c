@@ -69,8 +69,13 @@ void srv_rjobs_metrics(srv_rjobs *j, char *buf, size_t cap) {
            "# HELP kmorph_jobs_assembled_total Job results this instance "
            "assembled.\n"
            "# TYPE kmorph_jobs_assembled_total counter\n"
-           "kmorph_jobs_assembled_total %zu\n",
+           "kmorph_jobs_assembled_total %zu\n"
+           "# HELP kmorph_jobs_plans_prepared_total Plans this instance "
+           "prepared again from a job's stored request (it had none).\n"
+           "# TYPE kmorph_jobs_plans_prepared_total counter\n"
+           "kmorph_jobs_plans_prepared_total %zu\n",
            (size_t)atomic_load(&j->frames), up ? 1 : 0, lag, pending, mine,
            (size_t)atomic_load(&j->reclaimed), (size_t)atomic_load(&j->handed),
-           (size_t)atomic_load(&j->assembled));
+           (size_t)atomic_load(&j->assembled),
+           (size_t)atomic_load(&j->prepared));
 }
