@@ -28,9 +28,9 @@ import hlib  # noqa: E402
 
 # scenario: (peak RSS bound in MiB, time bound in s, what the bound is)
 BOUNDS = {
-    "s1": (64, 5, "a 59 MB answer refused before work"),
-    "s2": (160, 10, "the same as a job: a 59 MB result assembled part by "
-                    "part and kept once"),
+    "s1": (64, 5, "a 116 MB answer refused before work"),
+    "s2": (200, 10, "the same as a job: a 116 MB result (1,000 planned "
+                    "frames at 1e-9) assembled part by part and kept once"),
     "s4": (400, 30, "a 110 MB signature answer refused before printing"),
     "s6": (256 + 64, 30, "bodies within --body-memory 256 MiB; "
                          "--request-time 20"),

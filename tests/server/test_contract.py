@@ -13,7 +13,7 @@ import yaml
 from kmtest import (DAEMON, ROOT, SPEC, ContractCase, Daemon, circle_svg,
                     close_to, heavy_morph_body, metric, morph_body, open_arc,
                     raw_exchange, raw_status, schema_errors, component,
-                    run_job, wait_for)
+                    ring_morph_body, run_job, wait_for)
 
 TWO_PI = 2 * math.pi
 
@@ -369,22 +369,22 @@ class GeometryEndpoints(ContractCase):
         self.assertEqual(len(doc["frames"]), 1000)
 
 
-def tight_heavy_morph_body(**extra):
-    """1,000 frames of the heavy morph at a tolerance 6,000 times finer
-    than the default: its size, not the path a frame takes, makes the
-    work (some 20 MB of answer, 0.4 s on one core on the planned path, 8
-    times the limit below; a twentieth of that at the default
-    tolerance)."""
-    body = heavy_morph_body(1000)
-    body["tolerance"] = 1e-7
+def long_ring_morph_body(**extra):
+    """1,000 frames of the ring morph (two contours a frame): some 7 s of
+    frames on one core, prepared in about 0.06 s (0.15 s under ASan), so a
+    limit between the two stops it in its frames, named /frames."""
+    body = ring_morph_body(1000)
     body.update(extra)
     return body
 
 
 class MorphTimeLimit(ContractCase):
     """A synchronous morph stops at --morph-time: a 422 naming the frames,
-    never a 5xx, and the daemon goes on serving."""
-    LIMIT = 0.05
+    never a 5xx, and the daemon goes on serving. The limit leaves the
+    preparation five times its time (more under ASan or a loaded machine:
+    a preparation past it is refused naming /tolerance, which is another
+    test's) and the frames fourteen times the limit."""
+    LIMIT = 0.5
 
     @classmethod
     def setUpClass(cls):
@@ -410,19 +410,20 @@ class MorphTimeLimit(ContractCase):
         done, total = int(m.group(1)), int(m.group(2))
         self.assertEqual(total, 1000)
         self.assertLess(done, total, "the work stopped before its end")
-        self.assertLess(dt, 1.0, "the answer does not wait for every frame")
+        self.assertLess(dt, self.LIMIT + 2.0,
+                        "the answer does not wait for every frame")
         return doc
 
     def test_long_morph_is_422_naming_frames_with_the_numbers(self):
-        self.refused(tight_heavy_morph_body(), "/frames")
+        self.refused(long_ring_morph_body(), "/frames")
 
     def test_long_morph_given_times_is_422_naming_times(self):
-        body = tight_heavy_morph_body(times=[i / 999 for i in range(1000)])
+        body = long_ring_morph_body(times=[i / 999 for i in range(1000)])
         del body["frames"]
         self.refused(body, "/times")
 
     def test_daemon_serves_normally_after_a_refusal(self):
-        self.refused(tight_heavy_morph_body(), "/frames")
+        self.refused(long_ring_morph_body(), "/frames")
         self.assertEqual(self.d.request("GET", "/healthz").status, 200)
         r = self.d.request("POST", "/v1/morph", body=morph_body(3))
         doc = self.assertDocumented(r, "/v1/morph", "post")
@@ -435,7 +436,7 @@ class MorphTimeLimit(ContractCase):
             return metric(text, "kmorph_rejected_total",
                           {"reason": "morph_time"})
         before = count()
-        self.refused(tight_heavy_morph_body(), "/frames")
+        self.refused(long_ring_morph_body(), "/frames")
         self.assertEqual(count(), before + 1)
 
     def test_the_same_morph_as_a_job_is_not_held_to_it(self):
