@@ -184,6 +184,10 @@ http {{
       proxy_set_header Connection "";
       proxy_set_header X-Forwarded-For $remote_addr;
       proxy_read_timeout 120s;
+      # Answers larger than the buffers are passed on as they come, not
+      # spooled: nginx's worker runs as another user than the one that
+      # made the private temp folder, and could not write there.
+      proxy_max_temp_file_size 0;
       # An instance that is down (refused, reset) is passed over; a
       # request it already received is not sent twice.
       proxy_next_upstream error timeout;
