@@ -9,8 +9,13 @@
 #include "util.h"
 
 /* Plans kept per instance; unused ones beyond this are freed, oldest
- * first (a later batch of the job prepares it again). */
-#define PLANS_MAX 16
+ * first (a later batch of the job prepares it again). An instance keeps
+ * the plan of every job it accepted until it renders it (the job's solo
+ * batch waits in its own stream), so this is about the backlog of jobs
+ * one instance holds: 16 made 3 in 4 of 200 queued jobs be prepared
+ * twice. A plan not rendered yet is small; rendered frames are freed
+ * with the plan when this instance sees its job end. */
+#define PLANS_MAX 256
 
 /* Free unused plans beyond PLANS_MAX, least recently used first (mu
  * held). */

@@ -25,6 +25,7 @@ srv_rjobs *srv_rjobs_create(srv_redis *rd, const srv_rjobs_config *cfg) {
   srv_random_hex(hex, 8);
   snprintf(j->consumer, sizeof j->consumer, "%s-%ld-%s", host, (long)getpid(),
            hex);
+  snprintf(j->local, sizeof j->local, "%s:%s", RJ_STREAM, j->consumer);
   pthread_mutex_init(&j->mu, NULL);
   atomic_init(&j->stopping, false);
   atomic_init(&j->group_ok, false);
@@ -41,6 +42,7 @@ srv_rjobs *srv_rjobs_create(srv_redis *rd, const srv_rjobs_config *cfg) {
 /* ---------------------------------------------------------- batches */
 
 typedef struct batch {
+  char stream[RJ_KEY_MAX];     /* where it was read */
   char eid[64];                /* the stream entry */
   char id[SRV_JOB_ID_LEN + 1]; /* the job */
   size_t from, to;             /* frames [from, to) */
@@ -48,11 +50,12 @@ typedef struct batch {
 } batch;
 
 /* An entry [eid, [field, value, ...]] into *b; false if malformed. */
-static bool parse_entry(const redisReply *e, batch *b) {
+static bool parse_entry(const redisReply *e, const char *stream, batch *b) {
   if (e->type != REDIS_REPLY_ARRAY || e->elements != 2 ||
       e->element[0]->type != REDIS_REPLY_STRING)
     return false;
   memset(b, 0, sizeof *b);
+  snprintf(b->stream, sizeof b->stream, "%s", stream);
   snprintf(b->eid, sizeof b->eid, "%s", e->element[0]->str);
   const redisReply *f = e->element[1];
   if (f->type != REDIS_REPLY_ARRAY) return true; /* deleted: acked below */
@@ -73,28 +76,61 @@ static bool parse_entry(const redisReply *e, batch *b) {
   return true;
 }
 
-static void ensure_group(srv_rjobs *j, redisContext *c, bool *broken) {
+/* The group on stream (made with it if need be), the stream listed. */
+static bool make_group(redisContext *c, bool *broken, const char *stream) {
   redisReply *rep = srv__rj_cmd(c, broken, "XGROUP CREATE %s %s 0 MKSTREAM",
-                                RJ_STREAM, RJ_GROUP);
-  if (rep &&
-      (rep->type == REDIS_REPLY_STATUS ||
-       (rep->type == REDIS_REPLY_ERROR && strstr(rep->str, "BUSYGROUP"))))
+                                stream, RJ_GROUP);
+  bool ok = rep &&
+            (rep->type == REDIS_REPLY_STATUS ||
+             (rep->type == REDIS_REPLY_ERROR && strstr(rep->str, "BUSYGROUP")));
+  if (rep) freeReplyObject(rep);
+  rep =
+      *broken ? NULL : srv__rj_cmd(c, broken, "SADD %s %s", RJ_STREAMS, stream);
+  if (rep) freeReplyObject(rep);
+  return ok && !*broken;
+}
+
+static void ensure_group(srv_rjobs *j, redisContext *c, bool *broken) {
+  if (make_group(c, broken, RJ_STREAM) && make_group(c, broken, j->local))
     atomic_store(&j->group_ok, true);
+}
+
+/* Read RJ_STREAMS into j->streams (the shared and the local stream
+ * always among them). */
+static void refresh_streams(srv_rjobs *j, redisContext *c, bool *broken) {
+  redisReply *rep = srv__rj_cmd(c, broken, "SMEMBERS %s", RJ_STREAMS);
+  pthread_mutex_lock(&j->mu);
+  size_t n = 0;
+  snprintf(j->streams[n++], RJ_KEY_MAX, "%s", j->local);
+  snprintf(j->streams[n++], RJ_KEY_MAX, "%s", RJ_STREAM);
+  if (rep && rep->type == REDIS_REPLY_ARRAY)
+    for (size_t k = 0; k < rep->elements && n < RJ_STREAMS_MAX; k++) {
+      const char *name = rep->element[k]->str;
+      if (name == NULL || strcmp(name, j->local) == 0 ||
+          strcmp(name, RJ_STREAM) == 0 || strlen(name) >= RJ_KEY_MAX)
+        continue;
+      snprintf(j->streams[n++], RJ_KEY_MAX, "%s", name);
+    }
+  j->nstreams = n;
+  pthread_mutex_unlock(&j->mu);
   if (rep) freeReplyObject(rep);
 }
 
-/* After an error reply: a Redis that lost the group (restarted without
- * its data) gets it again on the next try. */
-static void check_error(srv_rjobs *j, const redisReply *rep) {
-  if (rep->type == REDIS_REPLY_ERROR && strstr(rep->str, "NOGROUP"))
-    atomic_store(&j->group_ok, false);
+/* A copy of the streams known (out holds RJ_STREAMS_MAX). */
+static size_t known_streams(srv_rjobs *j, char (*out)[RJ_KEY_MAX]) {
+  pthread_mutex_lock(&j->mu);
+  size_t n = j->nstreams;
+  memcpy(out, j->streams, n * sizeof *out);
+  pthread_mutex_unlock(&j->mu);
+  return n;
 }
 
-/* One new batch for this consumer; false if none. */
-static bool read_one(srv_rjobs *j, redisContext *c, bool *broken, batch *b) {
+/* One new batch of stream for this consumer; false if none. */
+static bool read_from(srv_rjobs *j, redisContext *c, bool *broken,
+                      const char *stream, batch *b) {
   redisReply *rep =
       srv__rj_cmd(c, broken, "XREADGROUP GROUP %s %s COUNT 1 STREAMS %s >",
-                  RJ_GROUP, j->consumer, RJ_STREAM);
+                  RJ_GROUP, j->consumer, stream);
   if (rep == NULL) return false;
   bool got = false;
   if (rep->type == REDIS_REPLY_ARRAY && rep->elements == 1) {
@@ -102,32 +138,79 @@ static bool read_one(srv_rjobs *j, redisContext *c, bool *broken, batch *b) {
     if (s->type == REDIS_REPLY_ARRAY && s->elements == 2 &&
         s->element[1]->type == REDIS_REPLY_ARRAY &&
         s->element[1]->elements == 1)
-      got = parse_entry(s->element[1]->element[0], b);
-  } else {
-    check_error(j, rep);
+      got = parse_entry(s->element[1]->element[0], stream, b);
+  } else if (rep->type == REDIS_REPLY_ERROR && strstr(rep->str, "NOGROUP")) {
+    /* A Redis restarted without its data, or a stream made again by
+     * XADD after it was dropped empty: the group is made again. */
+    if (strcmp(stream, RJ_STREAM) == 0 || strcmp(stream, j->local) == 0)
+      atomic_store(&j->group_ok, false);
+    else
+      make_group(c, broken, stream);
   }
   freeReplyObject(rep);
   return got;
 }
 
+/* The next batch: this instance's own first (the jobs it accepted and
+ * prepared), then the shared stream, then, being idle, another
+ * instance's own. */
+static bool read_one(srv_rjobs *j, redisContext *c, bool *broken, batch *b) {
+  if (read_from(j, c, broken, j->local, b)) return true;
+  if (*broken || read_from(j, c, broken, RJ_STREAM, b)) return !*broken;
+  char(*names)[RJ_KEY_MAX] = malloc(RJ_STREAMS_MAX * sizeof *names);
+  if (names == NULL) return false;
+  size_t n = known_streams(j, names);
+  bool got = false;
+  for (size_t k = 2; k < n && !got && !*broken; k++)
+    got = read_from(j, c, broken, names[k], b);
+  free(names);
+  return got;
+}
+
+/* After an error reply on the shared or the local stream: a Redis that
+ * lost the group (restarted without its data) gets it on the next try. */
+static void check_error(srv_rjobs *j, const redisReply *rep) {
+  if (rep->type == REDIS_REPLY_ERROR && strstr(rep->str, "NOGROUP"))
+    atomic_store(&j->group_ok, false);
+}
+
+/* KEYS: a stream of another instance, RJ_STREAMS. Drop it if empty:
+ * an instance that is gone leaves nothing to read there, and one that is
+ * alive makes it again with its next job. */
+static const char DROP_EMPTY_LUA[] =
+    "if redis.call('XLEN', KEYS[1]) > 0 then return 0 end "
+    "redis.call('DEL', KEYS[1]) redis.call('SREM', KEYS[2], KEYS[1]) "
+    "return 1";
+
 /* One batch left pending by a consumer silent for the visibility
- * timeout, claimed for this one; false if none. */
+ * timeout, on any stream, claimed for this one; false if none. Empty
+ * streams of other instances are dropped on the way. */
 static bool claim_one(srv_rjobs *j, redisContext *c, bool *broken, batch *b) {
   long long idle_ms = (long long)(j->cfg.visibility * 1000.0);
-  redisReply *rep =
-      srv__rj_cmd(c, broken, "XAUTOCLAIM %s %s %s %lld 0-0 COUNT 1", RJ_STREAM,
-                  RJ_GROUP, j->consumer, idle_ms);
-  if (rep == NULL) return false;
+  refresh_streams(j, c, broken);
+  char(*names)[RJ_KEY_MAX] = malloc(RJ_STREAMS_MAX * sizeof *names);
+  if (names == NULL) return false;
+  size_t n = known_streams(j, names);
   bool got = false;
-  if (rep->type == REDIS_REPLY_ARRAY && rep->elements >= 2 &&
-      rep->element[1]->type == REDIS_REPLY_ARRAY &&
-      rep->element[1]->elements >= 1) {
-    got = parse_entry(rep->element[1]->element[0], b);
-    b->again = true;
-  } else if (rep->type == REDIS_REPLY_ERROR) {
-    check_error(j, rep);
+  for (size_t k = 0; k < n && !got && !*broken; k++) {
+    redisReply *rep =
+        srv__rj_cmd(c, broken, "XAUTOCLAIM %s %s %s %lld 0-0 COUNT 1", names[k],
+                    RJ_GROUP, j->consumer, idle_ms);
+    if (rep && rep->type == REDIS_REPLY_ARRAY && rep->elements >= 2 &&
+        rep->element[1]->type == REDIS_REPLY_ARRAY &&
+        rep->element[1]->elements >= 1) {
+      got = parse_entry(rep->element[1]->element[0], names[k], b);
+      b->again = true;
+    } else if (rep && rep->type == REDIS_REPLY_ERROR) {
+      if (k < 2) check_error(j, rep);
+    } else if (rep && k >= 2) {
+      redisReply *d = srv__rj_cmd(c, broken, "EVAL %s 2 %s %s", DROP_EMPTY_LUA,
+                                  names[k], RJ_STREAMS);
+      if (d) freeReplyObject(d);
+    }
+    if (rep) freeReplyObject(rep);
   }
-  freeReplyObject(rep);
+  free(names);
   return got;
 }
 
@@ -136,15 +219,16 @@ static const char ACK_LUA[] = "redis.call('XACK', KEYS[1], ARGV[1], ARGV[2]) "
 
 static void ack(redisContext *c, bool *broken, const batch *b) {
   redisReply *rep = srv__rj_cmd(c, broken, "EVAL %s 1 %s %s %s", ACK_LUA,
-                                RJ_STREAM, RJ_GROUP, b->eid);
+                                b->stream, RJ_GROUP, b->eid);
   if (rep) freeReplyObject(rep);
 }
 
-/* The frames [from, to) of b as a new entry, delivered at once to any
- * consumer, and b acknowledged: in one script, so that the frames are
- * neither lost nor pending twice. */
+/* The frames [from, to) of b as a new entry of the shared stream,
+ * delivered at once to any consumer, and b acknowledged where it was
+ * read: in one script, so that the frames are neither lost nor pending
+ * twice. KEYS: b's stream, the shared stream. */
 static const char HAND_BACK_LUA[] =
-    "redis.call('XADD', KEYS[1], '*', 'id', ARGV[3], 'from', ARGV[4], "
+    "redis.call('XADD', KEYS[2], '*', 'id', ARGV[3], 'from', ARGV[4], "
     "'to', ARGV[5]) "
     "redis.call('XACK', KEYS[1], ARGV[1], ARGV[2]) "
     "redis.call('XDEL', KEYS[1], ARGV[2]) return 0";
@@ -152,9 +236,9 @@ static const char HAND_BACK_LUA[] =
 static void hand_back(srv_rjobs *j, redisContext *c, bool *broken,
                       const batch *b, size_t from) {
   redisReply *rep =
-      srv__rj_cmd(c, broken, "EVAL %s 1 %s %s %s %s %llu %llu", HAND_BACK_LUA,
-                  RJ_STREAM, RJ_GROUP, b->eid, b->id, (unsigned long long)from,
-                  (unsigned long long)b->to);
+      srv__rj_cmd(c, broken, "EVAL %s 2 %s %s %s %s %s %llu %llu",
+                  HAND_BACK_LUA, b->stream, RJ_STREAM, RJ_GROUP, b->eid, b->id,
+                  (unsigned long long)from, (unsigned long long)b->to);
   if (rep) freeReplyObject(rep);
   if (!*broken) atomic_fetch_add(&j->handed, 1);
 }
@@ -244,7 +328,7 @@ static long long store_frames(run_ctx *x, const batch *b, size_t total,
     return 0;
   }
   const char *head[9] = {"EVAL",    FRAMES_LUA, script_keys, x->key, kf,
-                         RJ_STREAM, RJ_GROUP,   b->eid,      tot};
+                         b->stream, RJ_GROUP,   b->eid,      tot};
   for (size_t k = 0; k < 9; k++) {
     argv[k] = head[k];
     lens[k] = strlen(head[k]);
@@ -625,34 +709,56 @@ size_t srv_rjobs_busy(srv_rjobs *j) {
   return atomic_load(&j->busy);
 }
 
+/* Hand back every batch of stream pending for this consumer; how many. */
+static size_t hand_back_stream(srv_rjobs *j, redisContext *c, bool *broken,
+                               const char *stream) {
+  size_t n = 0;
+  redisReply *rep = srv__rj_cmd(c, broken, "XPENDING %s %s - + 100 %s", stream,
+                                RJ_GROUP, j->consumer);
+  for (size_t k = 0;
+       rep && rep->type == REDIS_REPLY_ARRAY && k < rep->elements && !*broken;
+       k++) {
+    const redisReply *e = rep->element[k];
+    if (e->type != REDIS_REPLY_ARRAY || e->elements < 1) continue;
+    /* Claimed by this consumer (idle 0) so that XCLAIM gives the fields. */
+    redisReply *cl = srv__rj_cmd(c, broken, "XCLAIM %s %s %s 0 %s", stream,
+                                 RJ_GROUP, j->consumer, e->element[0]->str);
+    batch b;
+    if (cl && cl->type == REDIS_REPLY_ARRAY && cl->elements == 1 &&
+        parse_entry(cl->element[0], stream, &b)) {
+      if (b.from < b.to)
+        hand_back(j, c, broken, &b, b.from);
+      else
+        ack(c, broken, &b);
+      n++;
+    }
+    if (cl) freeReplyObject(cl);
+  }
+  if (rep) freeReplyObject(rep);
+  return n;
+}
+
 size_t srv_rjobs_hand_back_all(srv_rjobs *j) {
   redisContext *c = srv_redis_acquire(j->rd);
   if (c == NULL) return 0;
   bool broken = false;
   size_t n = 0;
-  /* Claimed by this consumer (idle 0) so that XCLAIM returns the fields. */
-  redisReply *rep = srv__rj_cmd(c, &broken, "XPENDING %s %s - + 100 %s",
-                                RJ_STREAM, RJ_GROUP, j->consumer);
-  if (rep && rep->type == REDIS_REPLY_ARRAY) {
-    for (size_t k = 0; k < rep->elements && !broken; k++) {
-      const redisReply *e = rep->element[k];
-      if (e->type != REDIS_REPLY_ARRAY || e->elements < 1) continue;
-      redisReply *cl =
-          srv__rj_cmd(c, &broken, "XCLAIM %s %s %s 0 %s", RJ_STREAM, RJ_GROUP,
-                      j->consumer, e->element[0]->str);
-      batch b;
-      if (cl && cl->type == REDIS_REPLY_ARRAY && cl->elements == 1 &&
-          parse_entry(cl->element[0], &b)) {
-        if (b.from < b.to)
-          hand_back(j, c, &broken, &b, b.from);
-        else
-          ack(c, &broken, &b);
-        n++;
-      }
-      if (cl) freeReplyObject(cl);
-    }
+  refresh_streams(j, c, &broken);
+  char(*names)[RJ_KEY_MAX] = malloc(RJ_STREAMS_MAX * sizeof *names);
+  size_t ns = names ? known_streams(j, names) : 0;
+  for (size_t k = 0; k < ns && !broken; k++)
+    n += hand_back_stream(j, c, &broken, names[k]);
+  free(names);
+  /* Batches left in this instance's own stream go to the shared one, so
+   * that no instance has to be idle to see them. */
+  batch b;
+  while (!broken && read_from(j, c, &broken, j->local, &b)) {
+    if (b.from < b.to)
+      hand_back(j, c, &broken, &b, b.from);
+    else
+      ack(c, &broken, &b);
+    n++;
   }
-  if (rep) freeReplyObject(rep);
   srv_redis_release(j->rd, c, broken);
   return n;
 }

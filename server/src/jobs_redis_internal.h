@@ -13,6 +13,10 @@
 #define RJ_STREAM "kmorph:work"
 #define RJ_GROUP "workers"
 #define RJ_LIVE "kmorph:live"
+/* Every work stream: the shared one and each instance's own. */
+#define RJ_STREAMS "kmorph:streams"
+#define RJ_STREAMS_MAX 64
+#define RJ_KEY_MAX 128
 
 /* A prepared plan cached per job id in this instance. */
 typedef struct rj_plan {
@@ -26,7 +30,12 @@ typedef struct rj_plan {
 struct srv_rjobs {
   srv_redis *rd;
   srv_rjobs_config cfg;
-  char consumer[96]; /* this instance in the consumer group */
+  char consumer[96];      /* this instance in the consumer group */
+  char local[RJ_KEY_MAX]; /* this instance's own stream: the solo batches
+                           * of the jobs it accepted, which it takes
+                           * first and the others only when idle */
+  char streams[RJ_STREAMS_MAX][RJ_KEY_MAX]; /* RJ_STREAMS as last read */
+  size_t nstreams;                          /* guarded by mu */
   pthread_mutex_t mu;
   rj_plan *plans; /* guarded by mu */
   size_t nplans;

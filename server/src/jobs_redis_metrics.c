@@ -2,36 +2,58 @@
  * (see jobs_redis.h): frames rendered, Redis reachable, stream lag,
  * pending, reclaimed and handed-back batches. */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "jobs_redis_internal.h"
 
-/* The group's pending count and this consumer's, and the stream's
- * length; false if Redis did not answer. */
-static bool stream_counts(srv_rjobs *j, long long *len, long long *pending,
-                          long long *mine) {
-  redisContext *c = srv_redis_acquire(j->rd);
-  if (c == NULL) return false;
-  bool broken = false;
-  *len = *pending = *mine = 0;
-  redisReply *rep = srv__rj_cmd(c, &broken, "XLEN %s", RJ_STREAM);
-  if (rep && rep->type == REDIS_REPLY_INTEGER) *len = rep->integer;
+/* Add stream's length, its group's pending count and this consumer's
+ * to the sums. */
+static void count_stream(srv_rjobs *j, redisContext *c, bool *broken,
+                         const char *stream, long long *len, long long *pending,
+                         long long *mine) {
+  redisReply *rep = srv__rj_cmd(c, broken, "XLEN %s", stream);
+  if (rep && rep->type == REDIS_REPLY_INTEGER) *len += rep->integer;
   if (rep) freeReplyObject(rep);
-  rep = broken ? NULL
-               : srv__rj_cmd(c, &broken, "XPENDING %s %s", RJ_STREAM, RJ_GROUP);
+  rep = *broken ? NULL
+                : srv__rj_cmd(c, broken, "XPENDING %s %s", stream, RJ_GROUP);
   if (rep && rep->type == REDIS_REPLY_ARRAY && rep->elements == 4) {
-    *pending = rep->element[0]->integer;
+    *pending += rep->element[0]->integer;
     const redisReply *per = rep->element[3];
     if (per->type == REDIS_REPLY_ARRAY)
       for (size_t k = 0; k < per->elements; k++) {
         const redisReply *e = per->element[k];
         if (e->type == REDIS_REPLY_ARRAY && e->elements == 2 &&
             strcmp(e->element[0]->str, j->consumer) == 0)
-          *mine = strtoll(e->element[1]->str, NULL, 10);
+          *mine += strtoll(e->element[1]->str, NULL, 10);
       }
   }
   if (rep) freeReplyObject(rep);
+}
+
+/* Over every work stream known (the shared one and each instance's):
+ * entries, pending ones, pending for this consumer. False if Redis did
+ * not answer. */
+static bool stream_counts(srv_rjobs *j, long long *len, long long *pending,
+                          long long *mine) {
+  char(*names)[RJ_KEY_MAX] = malloc(RJ_STREAMS_MAX * sizeof *names);
+  if (names == NULL) return false;
+  pthread_mutex_lock(&j->mu);
+  size_t n = j->nstreams;
+  memcpy(names, j->streams, n * sizeof *names);
+  pthread_mutex_unlock(&j->mu);
+  if (n == 0) {
+    snprintf(names[0], RJ_KEY_MAX, "%s", RJ_STREAM);
+    snprintf(names[1], RJ_KEY_MAX, "%s", j->local);
+    n = 2;
+  }
+  redisContext *c = srv_redis_acquire(j->rd);
+  bool broken = c == NULL;
+  *len = *pending = *mine = 0;
+  for (size_t k = 0; k < n && !broken; k++)
+    count_stream(j, c, &broken, names[k], len, pending, mine);
   srv_redis_release(j->rd, c, broken);
+  free(names);
   return !broken;
 }
 

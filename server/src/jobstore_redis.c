@@ -34,13 +34,14 @@ redisReply *srv__rj_cmd(redisContext *c, bool *broken, const char *fmt, ...) {
   return rep;
 }
 
-/* KEYS: job, live, stream. ARGV: id, max live, total, created, deadline,
- * body, accept, batch frames. -1 when max live jobs exist. */
+/* KEYS: job, live, stream, the set of streams. ARGV: id, max live,
+ * total, created, deadline, body, accept, batch frames. -1 when max live
+ * jobs exist. */
 static const char CREATE_LUA[] =
     "if redis.call('SCARD', KEYS[2]) >= tonumber(ARGV[2]) then return -1 end "
     "redis.call('HSET', KEYS[1], 'st', 'queued', 'n', ARGV[3], 'd', 0, "
     "'c', ARGV[4], 'dl', ARGV[5], 'b', ARGV[6], 'a', ARGV[7]) "
-    "redis.call('SADD', KEYS[2], ARGV[1]) "
+    "redis.call('SADD', KEYS[2], ARGV[1]) redis.call('SADD', KEYS[4], KEYS[3]) "
     "local n, b, i = tonumber(ARGV[3]), tonumber(ARGV[8]), 0 "
     "while i < n do local k = math.min(n, i + b) "
     "redis.call('XADD', KEYS[3], '*', 'id', ARGV[1], 'from', i, 'to', k) "
@@ -75,14 +76,17 @@ int srv_rjobs_start(srv_rjobs *j, const char *body, size_t len,
     return SRV_RJOBS_DOWN;
   }
   bool broken = false;
-  /* Cached first: a worker may take the first batch before we return. */
+  /* Cached first: a worker may take the first batch before we return.
+   * A solo batch goes to this instance's own stream, so that the plan
+   * prepared here is the one that renders it unless another instance is
+   * idle. */
   srv__rj_cache_put(j, nid, plan);
   redisReply *rep = srv__rj_cmd(
-      c, &broken, "EVAL %s 3 %s %s %s %s %llu %llu %.3f %.3f %b %s %llu",
-      CREATE_LUA, key, RJ_LIVE, RJ_STREAM, nid,
-      (unsigned long long)j->cfg.max_jobs, (unsigned long long)total, now,
-      now + j->cfg.job_time, body, len, accept ? accept : "",
-      (unsigned long long)batch);
+      c, &broken, "EVAL %s 4 %s %s %s %s %s %llu %llu %.3f %.3f %b %s %llu",
+      CREATE_LUA, key, RJ_LIVE, batch >= total ? j->local : RJ_STREAM,
+      RJ_STREAMS, nid, (unsigned long long)j->cfg.max_jobs,
+      (unsigned long long)total, now, now + j->cfg.job_time, body, len,
+      accept ? accept : "", (unsigned long long)batch);
   int rc = SRV_RJOBS_DOWN;
   if (rep != NULL && rep->type == REDIS_REPLY_INTEGER)
     rc = rep->integer == 0 ? 0 : SRV_RJOBS_FULL;
