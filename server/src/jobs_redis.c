@@ -244,7 +244,7 @@ static void hand_back(srv_rjobs *j, redisContext *c, bool *broken,
 }
 
 /* Why a frame's computation was stopped. */
-enum { WHY_NONE, WHY_SHUTDOWN, WHY_TIME, WHY_FINAL, WHY_BROKEN };
+enum { WHY_NONE, WHY_SHUTDOWN, WHY_TIME, WHY_FINAL, WHY_BROKEN, WHY_TAKEN };
 
 typedef struct run_ctx {
   srv_rjobs *j;
@@ -253,12 +253,43 @@ typedef struct run_ctx {
   char key[80];    /* the job's record */
   double deadline; /* Unix seconds */
   double next_look;
+  const batch *b;   /* the batch being rendered */
+  double next_keep; /* srv_now(): when to claim it again */
   int why;
 } run_ctx;
 
+/* KEYS: stream. ARGV: group, entry, consumer. Claim the entry again
+ * (its idle time back to 0) if it is still this consumer's: 1, else 0. */
+static const char KEEP_LUA[] =
+    "local p = redis.call('XPENDING', KEYS[1], ARGV[1], ARGV[2], ARGV[2], 1) "
+    "if #p == 0 or p[1][2] ~= ARGV[3] then return 0 end "
+    "redis.call('XCLAIM', KEYS[1], ARGV[1], ARGV[3], 0, ARGV[2], 'JUSTID') "
+    "return 1";
+
+/* Claim x's batch again, so that a batch of slow frames (or one whose
+ * plan took long to prepare) is not taken over while this instance still
+ * renders it: the visibility timeout counts from the last claim. False,
+ * with x->why = WHY_TAKEN, if another instance has taken it over
+ * meanwhile: then it renders the batch, and this one lets it go. */
+static bool keep_batch(run_ctx *x) {
+  double now = srv_now();
+  if (now < x->next_keep) return true;
+  x->next_keep = now + x->j->cfg.visibility / 4;
+  redisReply *rep =
+      srv__rj_cmd(x->c, x->broken, "EVAL %s 1 %s %s %s %s", KEEP_LUA,
+                  x->b->stream, RJ_GROUP, x->b->eid, x->j->consumer);
+  bool ours =
+      rep == NULL || rep->type != REDIS_REPLY_INTEGER || rep->integer == 1;
+  if (rep) freeReplyObject(rep);
+  if (!ours) x->why = WHY_TAKEN;
+  return ours;
+}
+
 /* The job is still queued or running (false on a broken connection). */
 static bool still_live(run_ctx *x) {
-  redisReply *rep = srv__rj_cmd(x->c, x->broken, "HGET %s st", x->key);
+  if (!keep_batch(x)) return false;
+  redisReply *rep =
+      *x->broken ? NULL : srv__rj_cmd(x->c, x->broken, "HGET %s st", x->key);
   if (rep == NULL) {
     x->why = WHY_BROKEN;
     return false;
@@ -565,7 +596,9 @@ static void run_solo(srv_rjobs *j, run_ctx *x, rj_plan *p, const batch *b,
       if (!solo_progress(x, i + 1)) break;
     }
   }
-  if (*x->broken) return; /* pending: claimed after the timeout */
+  /* Broken: pending, claimed after the timeout; taken: another renders
+   * it. */
+  if (*x->broken || x->why == WHY_TAKEN) return;
   if (x->why == WHY_SHUTDOWN) {
     hand_back(j, x->c, x->broken, b, 0);
     return;
@@ -624,7 +657,7 @@ static long long run_shared(srv_rjobs *j, run_ctx *x, rj_plan *p,
   }
   for (size_t k = 0; k < span; k++) api_response_free(&texts[k]);
   free(texts);
-  if (*x->broken) return done; /* pending: claimed after the timeout */
+  if (*x->broken || x->why == WHY_TAKEN) return done;
   if (x->why == WHY_SHUTDOWN && i < b->to) {
     hand_back(j, x->c, x->broken, b, i);
     return done;
@@ -646,11 +679,15 @@ static void run_batch(srv_rjobs *j, redisContext *c, bool *broken,
                .c = c,
                .broken = broken,
                .why = WHY_NONE,
-               .next_look = srv_now() + STATE_POLL};
+               .next_look = srv_now() + STATE_POLL,
+               .b = b,
+               .next_keep = srv_now() + j->cfg.visibility / 4};
   srv__rj_key(x.key, sizeof x.key, "job", b->id);
   rj_plan *p = NULL;
   bool over = false;
   record r = b->from < b->to ? open_job(&x, b, &p) : (record){0};
+  /* Preparing the plan may have taken a while: claimed again if so. */
+  if (r.live && !keep_batch(&x)) goto out;
   if (*broken) goto out;
   if (!r.live) {
     ack(c, broken, b); /* final, unknown or empty: nothing to render */
