@@ -141,11 +141,16 @@ static bool read_from(srv_rjobs *j, redisContext *c, bool *broken,
       got = parse_entry(s->element[1]->element[0], stream, b);
   } else if (rep->type == REDIS_REPLY_ERROR && strstr(rep->str, "NOGROUP")) {
     /* A Redis restarted without its data, or a stream made again by
-     * XADD after it was dropped empty: the group is made again. */
-    if (strcmp(stream, RJ_STREAM) == 0 || strcmp(stream, j->local) == 0)
+     * XADD after it was dropped empty: the group is made again - on
+     * another instance's stream only if the stream exists (no
+     * MKSTREAM: one just dropped is not made again from here). */
+    if (strcmp(stream, RJ_STREAM) == 0 || strcmp(stream, j->local) == 0) {
       atomic_store(&j->group_ok, false);
-    else
-      make_group(c, broken, stream);
+    } else {
+      redisReply *g =
+          srv__rj_cmd(c, broken, "XGROUP CREATE %s %s 0", stream, RJ_GROUP);
+      if (g) freeReplyObject(g);
+    }
   }
   freeReplyObject(rep);
   return got;
@@ -174,19 +179,35 @@ static void check_error(srv_rjobs *j, const redisReply *rep) {
     atomic_store(&j->group_ok, false);
 }
 
-/* KEYS: a stream of another instance, RJ_STREAMS. Drop it if empty:
- * an instance that is gone leaves nothing to read there, and one that is
- * alive makes it again with its next job. */
+/* KEYS: a stream of another instance, RJ_STREAMS, that instance's
+ * "alive" key. Drop the stream if it is empty and its instance has not
+ * said it is alive for two visibility timeouts: it is gone and left
+ * nothing to read there (an instance wrongly taken for gone makes the
+ * stream and its group again with its next job). */
 static const char DROP_EMPTY_LUA[] =
+    "if redis.call('EXISTS', KEYS[3]) == 1 then return 0 end "
     "if redis.call('XLEN', KEYS[1]) > 0 then return 0 end "
     "redis.call('DEL', KEYS[1]) redis.call('SREM', KEYS[2], KEYS[1]) "
     "return 1";
+
+/* The "alive" key of the instance whose own stream is stream. */
+static void alive_key(char *buf, size_t cap, const char *stream) {
+  size_t skip = strlen(RJ_STREAM) + 1;
+  const char *consumer = strlen(stream) > skip ? stream + skip : stream;
+  snprintf(buf, cap, "kmorph:alive:%s", consumer);
+}
 
 /* One batch left pending by a consumer silent for the visibility
  * timeout, on any stream, claimed for this one; false if none. Empty
  * streams of other instances are dropped on the way. */
 static bool claim_one(srv_rjobs *j, redisContext *c, bool *broken, batch *b) {
   long long idle_ms = (long long)(j->cfg.visibility * 1000.0);
+  /* This instance is alive (its own stream is not dropped). */
+  char alive[RJ_KEY_MAX + 16];
+  alive_key(alive, sizeof alive, j->local);
+  long long ttl_ms = (long long)(2000.0 * j->cfg.visibility);
+  redisReply *a = srv__rj_cmd(c, broken, "SET %s 1 PX %lld", alive, ttl_ms);
+  if (a) freeReplyObject(a);
   refresh_streams(j, c, broken);
   char(*names)[RJ_KEY_MAX] = malloc(RJ_STREAMS_MAX * sizeof *names);
   if (names == NULL) return false;
@@ -204,8 +225,10 @@ static bool claim_one(srv_rjobs *j, redisContext *c, bool *broken, batch *b) {
     } else if (rep && rep->type == REDIS_REPLY_ERROR) {
       if (k < 2) check_error(j, rep);
     } else if (rep && k >= 2) {
-      redisReply *d = srv__rj_cmd(c, broken, "EVAL %s 2 %s %s", DROP_EMPTY_LUA,
-                                  names[k], RJ_STREAMS);
+      char theirs[RJ_KEY_MAX + 16];
+      alive_key(theirs, sizeof theirs, names[k]);
+      redisReply *d = srv__rj_cmd(c, broken, "EVAL %s 3 %s %s %s",
+                                  DROP_EMPTY_LUA, names[k], RJ_STREAMS, theirs);
       if (d) freeReplyObject(d);
     }
     if (rep) freeReplyObject(rep);
