@@ -26,6 +26,7 @@
 #include <unistd.h>
 
 #include "config.h"
+#include "cpus.h"
 #include "healthcheck.h"
 #include "log.h"
 #include "server.h"
@@ -148,10 +149,7 @@ int main(int argc, char **argv) {
   srv_config_default(&cfg);
   int rc = srv_config_load(&cfg, argc, argv, stdout, stderr);
   if (rc != 0) return rc > 0 ? 0 : 2;
-  if (cfg.workers == 0) {
-    long n = sysconf(_SC_NPROCESSORS_ONLN);
-    cfg.workers = n > 0 ? (unsigned)n : 1;
-  }
+  if (cfg.workers == 0) cfg.workers = srv_usable_cpus();
 
   sigset_t set;
   setup_signals(&set);

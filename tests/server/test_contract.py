@@ -21,7 +21,9 @@ TWO_PI = 2 * math.pi
 class OperationsEndpoints(ContractCase):
     @classmethod
     def setUpClass(cls):
-        cls.d = Daemon("--threads", "2", "--max-body", "4096")
+        # CORS is off by default: the CORS tests here configure any origin.
+        cls.d = Daemon("--threads", "2", "--max-body", "4096",
+                       "--cors-origins", "*")
 
     @classmethod
     def tearDownClass(cls):
