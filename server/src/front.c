@@ -206,8 +206,9 @@ static void queue_refusal(relay *r, conn *c) {
   char body[1024];
   int bn = snprintf(body, sizeof body,
                     "{\"type\":\"%s\",\"title\":\"%s\",\"status\":%d,"
-                    "\"detail\":\"%s\",\"request_id\":\"%s\"}",
-                    type, title, fr->status, detail, rid);
+                    "\"detail\":\"%s\",\"request_id\":\"%s\","
+                    "\"instance\":\"urn:kmorph:request:%s\"}",
+                    type, title, fr->status, detail, rid, rid);
   if (bn < 0 || (size_t)bn >= sizeof body) bn = (int)strlen(body);
   char date[64], when[32];
   time_t now = time(NULL);

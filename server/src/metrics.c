@@ -22,7 +22,7 @@
 static const char *const ROUTE_NAMES[SRV_R_COUNT] = {
     "index",      "healthz",     "readyz", "metrics", "openapi",
     "signature",  "reconstruct", "morph",  "jobs",    "job",
-    "job_result", "static",      "other"};
+    "job_result", "static",      "problem", "other"};
 
 static const int STATUSES[] = {200, 202, 204, 400, 404, 405, 406, 409,
                                413, 415, 422, 429, 500, 503, 0};

@@ -24,6 +24,7 @@ typedef enum srv_route {
   SRV_R_JOB,
   SRV_R_JOB_RESULT,
   SRV_R_STATIC,
+  SRV_R_PROBLEM,
   SRV_R_OTHER,
   SRV_R_COUNT
 } srv_route;

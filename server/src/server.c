@@ -96,6 +96,8 @@ srv_server *srv_server_create(const srv_config *cfg, srv_log *logger) {
   s->api.max_samples = cfg->max_samples;
   s->api.max_output_bytes = cfg->max_output;
   s->metrics = srv_metrics_create();
+  s->statics = srv_static_cache_create();
+  atomic_init(&s->gzip_streams, 0);
   srv_watch_limits wl = {.header_time = cfg->header_time,
                          .request_time = cfg->request_time,
                          .send_time = cfg->send_time,
@@ -112,7 +114,8 @@ srv_server *srv_server_create(const srv_config *cfg, srv_log *logger) {
   s->pool = s->jobs ? srv_pool_create(cfg->workers, cfg->queue, srv_jobs_work,
                                       s->jobs)
                     : NULL;
-  if (s->metrics == NULL || s->pool == NULL || s->watch == NULL) {
+  if (s->metrics == NULL || s->pool == NULL || s->watch == NULL ||
+      s->statics == NULL) {
     fprintf(s->log, "kmorphd: cannot create the compute pool (%u workers)\n",
             cfg->workers);
     srv_server_destroy(s);
@@ -237,6 +240,7 @@ void srv_server_destroy(srv_server *s) {
   srv_jobs_destroy(s->jobs);
   if (s->store) s->store->ops->destroy(s->store);
   srv_metrics_destroy(s->metrics);
+  srv_static_cache_destroy(s->statics);
   srv_watch_destroy(s->watch); /* after the HTTP daemon: it closes records */
   free(s);
 }

@@ -13,7 +13,23 @@ import time
 import unittest
 
 from kmtest import (DAEMON, HOST, ROOT, ContractCase, Daemon, component,
-                    metric, morph_body, run_job, schema_errors, wait_for)
+                    metric, morph_body, raw_exchange, ring_morph_body,
+                    run_job, schema_errors, wait_for)
+
+WEB_ROOT = os.path.join(ROOT, "clients", "web")
+WEB = os.path.exists(os.path.join(WEB_ROOT, "index.html"))
+
+
+def problem_types_in_sources():
+    """Every /problems/<name> the C sources of the daemon name."""
+    names = set()
+    for folder in ("server/src", "api/src"):
+        for f in os.listdir(os.path.join(ROOT, folder)):
+            if f.endswith((".c", ".h")) and f != "openapi.c":
+                with open(os.path.join(ROOT, folder, f)) as fh:
+                    names |= set(re.findall(r'"/problems/([a-z-]+)"',
+                                            fh.read()))
+    return sorted(names)
 
 
 def free_port():
@@ -33,6 +49,252 @@ def listening_port(proc, log, timeout=20):
             break
         time.sleep(0.02)
     return None
+
+
+class Problems(ContractCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.d = Daemon("--threads", "1")
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.d.stop()
+
+    def test_every_problem_type_in_the_sources_resolves_as_json(self):
+        names = problem_types_in_sources()
+        self.assertIn("invalid-request", names)
+        self.assertIn("not-acceptable", names)
+        for name in names:
+            r = self.d.request("GET", "/problems/" + name)
+            self.assertEqual(r.status, 200, name)
+            self.assertEqual(r.ctype, "application/json", name)
+            doc = r.json()
+            self.assertEqual(doc["type"], "/problems/" + name)
+            self.assertTrue(doc["title"] and doc["description"], name)
+            self.assertTrue(400 <= doc["status"] <= 599, name)
+            self.assertIn("Accept", r.header("Vary"))
+            self.assertDocumented(r, "/problems/{name}", "get")
+
+    def test_problem_type_is_html_when_the_client_prefers_it(self):
+        r = self.d.request("GET", "/problems/job-gone", headers={
+            "Accept": "text/html,application/xhtml+xml,*/*;q=0.8"})
+        self.assertEqual(r.status, 200)
+        self.assertEqual(r.ctype, "text/html")
+        self.assertIn(b"/problems/job-gone", r.body)
+        self.assertIn(b"410", r.body)
+
+    def test_unknown_problem_type_is_404(self):
+        r = self.d.request("GET", "/problems/no-such-thing")
+        self.assertEqual(r.status, 404)
+        self.assertEqual(r.ctype, "application/problem+json")
+
+    def test_problems_carry_instance_as_the_request_id_urn(self):
+        cases = [self.d.request("GET", "/v1/nowhere"),
+                 self.d.request("POST", "/v1/morph", body={"frames": 3}),
+                 self.d.request("GET", "/v1/jobs/0123abcd"),
+                 self.d.request("GET", "/healthz",
+                                headers={"X-Request-Id": "trace-42"})]
+        cases[-1] = self.d.request("PUT", "/healthz",
+                                   headers={"X-Request-Id": "trace-42"})
+        for r in cases:
+            self.assertEqual(r.ctype, "application/problem+json")
+            doc = r.json()
+            self.assertEqual(doc["instance"],
+                             "urn:kmorph:request:" + doc["request_id"])
+            self.assertEqual(doc["request_id"], r.header("X-Request-Id"))
+            self.assertEqual(schema_errors(doc, component("Problem")), [])
+        self.assertEqual(cases[-1].json()["instance"],
+                         "urn:kmorph:request:trace-42")
+
+    def test_a_framing_refusal_carries_instance_too(self):
+        raw = raw_exchange(self.d.port, [b"GET / HTTP/1.1\r\nHost: x\r\n"
+                                         b"Content-Length: 1\r\n"
+                                         b"Content-Length: 2\r\n\r\n"])
+        doc = json.loads(raw.split(b"\r\n\r\n", 1)[1])
+        self.assertTrue(doc["instance"].startswith("urn:kmorph:request:"))
+
+
+class Negotiation(ContractCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.d = Daemon("--threads", "2", "--web-root", WEB_ROOT)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.d.stop()
+
+    def test_accept_the_route_cannot_produce_is_406_problem(self):
+        for method, path, body, accept in [
+                ("POST", "/v1/morph", morph_body(3), "image/png"),
+                ("POST", "/v1/signature", {}, "text/html"),
+                ("GET", "/healthz", None, "text/html"),
+                ("GET", "/openapi.json", None, "application/yaml"),
+                ("GET", "/metrics", None, "application/json"),
+                ("POST", "/v1/morph", morph_body(3),
+                 "application/json;q=0, image/svg+xml;q=0, */*;q=0")]:
+            r = self.d.request(method, path, body=body,
+                               headers={"Accept": accept})
+            self.assertEqual(r.status, 406, (path, accept))
+            self.assertEqual(r.ctype, "application/problem+json")
+            self.assertEqual(r.json()["type"], "/problems/not-acceptable")
+            self.assertIn("Accept", r.header("Vary"))
+
+    def test_wildcards_and_q_values_are_honoured(self):
+        ok = [("GET", "/healthz", None, "*/*"),
+              ("GET", "/healthz", None, "application/*;q=0.1"),
+              ("GET", "/healthz", None, "text/html, application/json;q=0.5"),
+              ("GET", "/metrics", None, "text/plain;version=0.0.4"),
+              ("POST", "/v1/morph", morph_body(3), "image/*")]
+        for method, path, body, accept in ok:
+            r = self.d.request(method, path, body=body,
+                               headers={"Accept": accept})
+            self.assertEqual(r.status, 200, (path, accept))
+        r = self.d.request("POST", "/v1/morph", body=morph_body(3), headers={
+            "Accept": "application/json;q=0, image/svg+xml"})
+        self.assertEqual(r.ctype, "image/svg+xml")
+
+    def test_vary_accept_on_answers_that_depend_on_it(self):
+        for method, path, body in [("POST", "/v1/morph", morph_body(3)),
+                                   ("GET", "/openapi.json", None),
+                                   ("GET", "/", None),
+                                   ("GET", "/problems/not-found", None)]:
+            r = self.d.request(method, path, body=body)
+            vary = [v.strip() for v in (r.header("Vary") or "").split(",")]
+            self.assertIn("Accept", vary, path)
+        for path in ("/", "/openapi.json"):
+            r = self.d.request("GET", path)
+            self.assertIn("Accept-Encoding", r.header("Vary"), path)
+
+
+class Caching(ContractCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.d = Daemon("--threads", "1", "--web-root", WEB_ROOT)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.d.stop()
+
+    def paths(self):
+        return ["/openapi.json", "/"] + (["/app.js"] if WEB else [])
+
+    def test_static_answers_have_a_strong_etag_and_cache_control(self):
+        for path in self.paths():
+            r = self.d.request("GET", path)
+            self.assertEqual(r.status, 200, path)
+            etag = r.header("ETag")
+            self.assertRegex(etag, r'^"[^"]+"$', path)  # strong: no W/
+            self.assertTrue(r.header("Cache-Control"), path)
+            again = self.d.request("GET", path)
+            self.assertEqual(again.header("ETag"), etag, "stable " + path)
+            r304 = self.d.request("GET", path,
+                                  headers={"If-None-Match": etag})
+            self.assertEqual(r304.status, 304, path)
+            self.assertEqual(r304.body, b"")
+            self.assertEqual(r304.header("ETag"), etag)
+            other = self.d.request("GET", path,
+                                   headers={"If-None-Match": '"nope", ' +
+                                            'W/' + etag})
+            self.assertEqual(other.status, 304, "weak comparison " + path)
+            miss = self.d.request("GET", path,
+                                  headers={"If-None-Match": '"nope"'})
+            self.assertEqual(miss.status, 200)
+
+    def test_finished_job_result_is_immutable_with_etag_and_304(self):
+        r, jid, final = run_job(self.d, morph_body(5))
+        self.assertEqual(r.status, 202)
+        self.assertEqual(final["state"], "done")
+        res = self.d.request("GET", "/v1/jobs/%s/result" % jid)
+        self.assertEqual(res.status, 200)
+        cc = res.header("Cache-Control")
+        self.assertIn("immutable", cc)
+        self.assertIn("private", cc)
+        etag = res.header("ETag")
+        self.assertTrue(etag)
+        r304 = self.d.request("GET", "/v1/jobs/%s/result" % jid,
+                              headers={"If-None-Match": etag})
+        self.assertEqual(r304.status, 304)
+        self.assertEqual(r304.body, b"")
+        # The job's state is not cacheable: it changes.
+        st = self.d.request("GET", "/v1/jobs/" + jid)
+        self.assertEqual(st.header("Cache-Control"), "no-store")
+
+    def test_retry_after_hints_polling_on_202_and_on_unfinished_jobs(self):
+        r = self.d.request("POST", "/v1/jobs", body=ring_morph_body(400))
+        self.assertEqual(r.status, 202)
+        self.assertTrue(int(r.header("Retry-After")) >= 1)
+        jid = r.json()["id"]
+        st = self.d.request("GET", "/v1/jobs/" + jid)
+        self.assertIn(st.json()["state"], ("queued", "running"))
+        self.assertTrue(int(st.header("Retry-After")) >= 1)
+        self.d.request("DELETE", "/v1/jobs/" + jid)
+        done = wait_for(lambda: self.d.request("GET", "/v1/jobs/" + jid)
+                        .json()["state"] == "cancelled" or None, 30)
+        self.assertTrue(done)
+        st = self.d.request("GET", "/v1/jobs/" + jid)
+        self.assertIsNone(st.header("Retry-After"))
+
+
+class Compression(ContractCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.d = Daemon("--threads", "2", "--web-root", WEB_ROOT)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.d.stop()
+
+    def test_static_files_are_gzip_when_accepted_with_a_correct_length(self):
+        for path in ["/openapi.json", "/"] + (["/app.js"] if WEB else []):
+            plain = self.d.request("GET", path)
+            gz = self.d.request("GET", path,
+                                headers={"Accept-Encoding": "br, gzip"})
+            self.assertEqual(gz.header("Content-Encoding"), "gzip", path)
+            self.assertEqual(int(gz.header("Content-Length")), len(gz.body))
+            self.assertEqual(gzip.decompress(gz.body), plain.body, path)
+            self.assertLess(len(gz.body), len(plain.body))
+            self.assertNotEqual(gz.header("ETag"), plain.header("ETag"))
+            head = self.d.request("HEAD", path,
+                                  headers={"Accept-Encoding": "gzip"})
+            self.assertEqual(head.header("Content-Length"),
+                             gz.header("Content-Length"), "HEAD " + path)
+            self.assertIsNone(plain.header("Content-Encoding"))
+
+    def test_q_zero_and_small_bodies_are_sent_as_they_are(self):
+        r = self.d.request("GET", "/openapi.json",
+                           headers={"Accept-Encoding": "gzip;q=0, br"})
+        self.assertIsNone(r.header("Content-Encoding"))
+        r = self.d.request("GET", "/openapi.json",
+                           headers={"Accept-Encoding": "*;q=0.5"})
+        self.assertEqual(r.header("Content-Encoding"), "gzip")
+        r = self.d.request("GET", "/healthz",
+                           headers={"Accept-Encoding": "gzip"})
+        self.assertIsNone(r.header("Content-Encoding"))
+        r = self.d.request("POST", "/v1/morph", body=morph_body(1),
+                           headers={"Accept-Encoding": "gzip"})
+        self.assertIsNone(r.header("Content-Encoding"), "under 1 KiB")
+
+    def test_large_morph_and_job_results_are_gzip_streamed(self):
+        body = morph_body(400)
+        plain = self.d.request("POST", "/v1/morph", body=body)
+        gz = self.d.request("POST", "/v1/morph", body=body,
+                            headers={"Accept-Encoding": "gzip"})
+        self.assertEqual(plain.status, 200)
+        self.assertEqual(gz.header("Content-Encoding"), "gzip")
+        self.assertEqual(gzip.decompress(gz.body), plain.body)
+        self.assertLess(len(gz.body), len(plain.body) / 2)
+        r, jid, final = run_job(self.d, morph_body(1000), timeout=60)
+        self.assertEqual(final["state"], "done")
+        url = "/v1/jobs/%s/result" % jid
+        plain = self.d.request("GET", url)
+        gz = self.d.request("GET", url, headers={"Accept-Encoding": "gzip"})
+        self.assertGreater(len(plain.body), 1 << 20, "megabytes")
+        self.assertEqual(gz.header("Content-Encoding"), "gzip")
+        self.assertEqual(gzip.decompress(gz.body), plain.body)
+        self.assertLess(len(gz.body), len(plain.body) / 2)
+        r304 = self.d.request("GET", url, headers={
+            "Accept-Encoding": "gzip", "If-None-Match": gz.header("ETag")})
+        self.assertEqual(r304.status, 304)
 
 
 class SafeDefaults(unittest.TestCase):
