@@ -53,7 +53,8 @@ void srv__on_completed(void *cls, struct MHD_Connection *c, void **req_cls,
   srv_watch_request_done(srv__req_conn(r), srv_now());
   double dt = srv_now() - r->t0;
   const char *why = closed_why(r, toe);
-  srv_metrics_observe(s->metrics, r->route, r->status ? r->status : 0, dt);
+  srv_metrics_observe(s->metrics, r->route, r->method,
+                      r->status ? r->status : 0, dt);
   if (s->cfg.access_log) log_access(s, r, dt, why);
   api_response_free(&r->resp);
   srv__body_release(r);

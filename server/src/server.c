@@ -22,6 +22,7 @@
 #include <unistd.h>
 
 #include "request.h"
+#include "route.h"
 #include "server_internal.h"
 #include "util.h"
 
@@ -95,7 +96,7 @@ srv_server *srv_server_create(const srv_config *cfg, srv_log *logger) {
   s->api.max_frames_job = cfg->max_job_frames;
   s->api.max_samples = cfg->max_samples;
   s->api.max_output_bytes = cfg->max_output;
-  s->metrics = srv_metrics_create();
+  s->metrics = srv_metrics_create(srv__route_method_allowed);
   s->statics = srv_static_cache_create();
   atomic_init(&s->gzip_streams, 0);
   srv_watch_limits wl = {.header_time = cfg->header_time,

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "process_metrics.h"
 #include "reply.h"
 #include "util.h"
 
@@ -130,6 +131,16 @@ enum MHD_Result srv__serve_metrics(srv_req *r) {
   size_t len = 0;
   char *text = srv_metrics_render(s->metrics, &g, &len);
   if (text == NULL) return MHD_NO;
+  char proc[2048];
+  size_t plen = srv_process_metrics(proc, sizeof proc);
+  char *all = realloc(text, len + plen + 1);
+  if (all == NULL) {
+    free(text);
+    return MHD_NO;
+  }
+  memcpy(all + len, proc, plen + 1);
+  text = all;
+  len += plen;
   return srv__answer(r, 200, "text/plain; version=0.0.4; charset=utf-8", text,
                      len, true);
 }

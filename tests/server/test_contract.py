@@ -75,10 +75,12 @@ class OperationsEndpoints(ContractCase):
             self.assertIn("# TYPE %s %s" % (family, kind), text)
         self.assertGreaterEqual(metric(text, "kmorph_http_requests_total",
                                        {"route": "healthz",
-                                        "status": "200"}), 1)
+                                        "method": "GET",
+                                        "code": "200"}), 1)
         self.assertGreaterEqual(metric(text, "kmorph_http_requests_total",
                                        {"route": "other",
-                                        "status": "404"}), 1)
+                                        "method": "GET",
+                                        "code": "404"}), 1)
         self.assertEqual(metric(text, "kmorph_workers"), 2)
         # A histogram's buckets are cumulative and end with the count.
         inf = metric(text, "kmorph_http_request_duration_seconds_bucket",

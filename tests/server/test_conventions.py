@@ -297,6 +297,60 @@ class Compression(ContractCase):
         self.assertEqual(r304.status, 304)
 
 
+class Metrics(ContractCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.d = Daemon("--threads", "1")
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.d.stop()
+
+    def test_request_counters_have_code_and_method_and_start_at_zero(self):
+        text = self.d.request("GET", "/metrics").body.decode()
+        for route, method in [("morph", "POST"), ("jobs", "POST"),
+                              ("job", "DELETE"), ("job_result", "GET"),
+                              ("healthz", "GET"), ("static", "HEAD")]:
+            for code in ("200", "404", "422", "503"):
+                self.assertEqual(metric(text, "kmorph_http_requests_total",
+                                        {"route": route, "method": method,
+                                         "code": code}), 0,
+                                 (route, method, code))
+        self.assertNotIn('status="', text)
+        self.d.request("GET", "/healthz")
+        self.d.request("POST", "/healthz")
+        self.d.request("BREW", "/healthz")
+        text = self.d.request("GET", "/metrics").body.decode()
+        self.assertEqual(metric(text, "kmorph_http_requests_total",
+                                {"route": "healthz", "method": "GET",
+                                 "code": "200"}), 1)
+        self.assertEqual(metric(text, "kmorph_http_requests_total",
+                                {"route": "healthz", "method": "POST",
+                                 "code": "405"}), 1)
+        self.assertGreaterEqual(metric(text, "kmorph_http_requests_total",
+                                       {"route": "healthz",
+                                        "method": "other",
+                                        "code": "405"}) or 0, 0)
+
+    def test_process_metrics_come_from_proc_self(self):
+        text = self.d.request("GET", "/metrics").body.decode()
+        for family, kind in [("process_cpu_seconds_total", "counter"),
+                             ("process_resident_memory_bytes", "gauge"),
+                             ("process_open_fds", "gauge"),
+                             ("process_max_fds", "gauge"),
+                             ("process_start_time_seconds", "gauge")]:
+            self.assertIn("# TYPE %s %s" % (family, kind), text)
+        rss = metric(text, "process_resident_memory_bytes")
+        self.assertAlmostEqual(rss / 1024, self.d.rss_kb(),
+                               delta=self.d.rss_kb() * 0.5 + 1024)
+        self.assertAlmostEqual(metric(text, "process_open_fds"),
+                               self.d.fds(), delta=4)
+        start = metric(text, "process_start_time_seconds")
+        self.assertLess(abs(start - time.time()), 120)
+        self.assertGreaterEqual(metric(text, "process_cpu_seconds_total"), 0)
+        self.assertGreater(metric(text, "process_max_fds"), 0)
+
+
 class SafeDefaults(unittest.TestCase):
     def test_no_cors_headers_unless_origins_are_configured(self):
         d = Daemon()
