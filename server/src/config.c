@@ -108,6 +108,9 @@ static const opt_def OPTS[] = {
     {"log-file", "KMORPH_LOG_FILE", OPT_STR, F(log_file),
      sizeof(((srv_config *)0)->log_file), 0, 0,
      "append the log here instead of stderr (reopened on SIGHUP)"},
+    {"log-format", "KMORPH_LOG_FORMAT", OPT_STR, F(log_format),
+     sizeof(((srv_config *)0)->log_format), 0, 0,
+     "log lines: kv (key=value text) or json (one object per line)"},
 };
 #undef F
 #define NOPTS (sizeof OPTS / sizeof OPTS[0])
@@ -144,6 +147,7 @@ void srv_config_default(srv_config *cfg) {
   cfg->retry_after = 1;
     srv_default_web_root(cfg->web_root, sizeof cfg->web_root);
   cfg->access_log = true;
+  snprintf(cfg->log_format, sizeof cfg->log_format, "kv");
 }
 
 static void print_default(FILE *out, const opt_def *o, const srv_config *d) {
@@ -273,6 +277,12 @@ int srv_config_load(srv_config *cfg, int argc, char **argv, FILE *out,
       return -1;
     }
     if (set_value(cfg, o, v, arg, err) != 0) return -1;
+  }
+  if (strcmp(cfg->log_format, "kv") != 0 &&
+      strcmp(cfg->log_format, "json") != 0) {
+    fprintf(err, "kmorphd: --log-format: \"%s\" is not kv or json\n",
+            cfg->log_format);
+    return -1;
   }
   return 0;
 }

@@ -45,6 +45,7 @@ typedef struct srv_config {
   char web_root[512];       /* folder of the web page served at / */
   bool access_log;          /* one line per request on stderr */
   char log_file[512];       /* log to this file (reopened on SIGHUP) */
+  char log_format[8];       /* "kv" (key=value lines) or "json" */
 } srv_config;
 
 /* Fill *cfg with the built-in defaults. */

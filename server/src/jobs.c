@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "log.h"
 #include "util.h"
 
 typedef struct job {
@@ -262,7 +263,7 @@ void srv_jobs_cancel_all(srv_jobs *j) {
     next = p->next;
     if (p->done < p->total && !p->cancelled && !p->failed && !p->finishing) {
       /* one line per job, so every accepted job is accounted for */
-      fprintf(stderr,
+      srv_log_notice(stderr,
               "kmorphd: job %s cancelled by shutdown (%zu/%zu frames)\n", p->id,
               p->done, p->total);
       cancel_locked(j, p, now);

@@ -153,6 +153,8 @@ int main(int argc, char **argv) {
 
   sigset_t set;
   setup_signals(&set);
+  srv_log_set_format(strcmp(cfg.log_format, "json") == 0 ? SRV_LOG_JSON
+                                                         : SRV_LOG_KV);
   srv_log *log = srv_log_open(cfg.log_file, stderr);
   if (log == NULL) return 2;
   srv_server *srv = fit_connections_to_fds(&cfg, log) == 0

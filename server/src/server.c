@@ -69,9 +69,9 @@ static void mhd_log(void *cls, const char *fmt, va_list ap) {
   unsigned long more = 0;
   if (srv_log_admit(s->logger, fmt, msg, &more)) {
     if (more > 0)
-      fprintf(s->log, "kmorphd: http: %s (%lu more suppressed)\n", msg, more);
+      srv_log_notice(s->log, "kmorphd: http: %s (%lu more suppressed)\n", msg, more);
     else
-      fprintf(s->log, "kmorphd: http: %s\n", msg);
+      srv_log_notice(s->log, "kmorphd: http: %s\n", msg);
   }
   if (strstr(fmt, "resource limit at FIRST") != NULL) srv_sleep(ACCEPT_PAUSE);
 }
@@ -117,7 +117,7 @@ srv_server *srv_server_create(const srv_config *cfg, srv_log *logger) {
                     : NULL;
   if (s->metrics == NULL || s->pool == NULL || s->watch == NULL ||
       s->statics == NULL) {
-    fprintf(s->log, "kmorphd: cannot create the compute pool (%u workers)\n",
+    srv_log_notice(s->log, "kmorphd: cannot create the compute pool (%u workers)\n",
             cfg->workers);
     srv_server_destroy(s);
     return NULL;
@@ -156,7 +156,7 @@ int srv_server_start(srv_server *s) {
       MHD_OPTION_NOTIFY_COMPLETED, &srv__on_completed, s,
       MHD_OPTION_URI_LOG_CALLBACK, &srv__on_uri, s, MHD_OPTION_END);
   if (s->daemon == NULL) {
-    fprintf(s->log, "kmorphd: cannot start the HTTP daemon\n");
+    srv_log_notice(s->log, "kmorphd: cannot start the HTTP daemon\n");
     return -1;
   }
   s->port = srv_front_port(s->front);
@@ -209,14 +209,14 @@ int srv_server_shutdown(srv_server *s) {
   srv_jobs_cancel_all(s->jobs);
   srv_pool_stop(s->pool);
   if (!wait_until(s, compute_idle, deadline)) {
-    fprintf(s->log,
+    srv_log_notice(s->log,
             "kmorphd: shutdown grace of %g s passed with %zu requests still "
             "computing: stopping them\n",
             s->cfg.shutdown_grace, (size_t)atomic_load(&s->suspended));
     atomic_store(&s->abort_compute, true);
     deadline = srv_now() + ABORT_WAIT;
     if (!wait_until(s, compute_idle, deadline)) {
-      fprintf(s->log,
+      srv_log_notice(s->log,
               "kmorphd: %zu requests still computing %g s after being "
               "stopped\n",
               (size_t)atomic_load(&s->suspended), ABORT_WAIT);
@@ -226,7 +226,7 @@ int srv_server_shutdown(srv_server *s) {
   /* Give answers already queued (or bodies still arriving) until the
    * deadline to complete; idle keep-alive connections do not count. */
   if (!wait_until(s, requests_done, deadline))
-    fprintf(s->log, "kmorphd: closing %zu unfinished requests\n",
+    srv_log_notice(s->log, "kmorphd: closing %zu unfinished requests\n",
             (size_t)atomic_load(&s->inflight));
   MHD_stop_daemon(s->daemon);
   s->daemon = NULL;

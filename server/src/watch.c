@@ -8,6 +8,7 @@
 #include <sys/socket.h>
 #include <time.h>
 
+#include "log.h"
 #include "util.h"
 
 typedef enum conn_phase {
@@ -87,7 +88,7 @@ static void sweep(srv_watch *w, double now) {
       sends++;
   }
   if ((requests > 0 || sends > 0) && w->log != NULL)
-    fprintf(w->log,
+    srv_log_notice(w->log,
             "kmorphd: cut %zu connections whose request was late (408) and "
             "%zu whose answer was not read in time\n",
             requests, sends);

@@ -38,6 +38,11 @@ def free_port():
         return s.getsockname()[1]
 
 
+def slurp(path):
+    with open(path, encoding="utf-8", errors="replace") as f:
+        return f.read()
+
+
 def listening_port(proc, log, timeout=20):
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
@@ -349,6 +354,62 @@ class Metrics(ContractCase):
         self.assertLess(abs(start - time.time()), 120)
         self.assertGreaterEqual(metric(text, "process_cpu_seconds_total"), 0)
         self.assertGreater(metric(text, "process_max_fds"), 0)
+
+
+class JsonLogs(unittest.TestCase):
+    def test_every_line_is_one_json_object_with_strings_escaped(self):
+        import signal
+        import tempfile
+        tmp = tempfile.mkdtemp(prefix='kmorphd-"json\\log-')
+        path = os.path.join(tmp, 'a "quoted"\\name.log')
+        e = {k: v for k, v in os.environ.items()
+             if not k.startswith("KMORPH_")}
+        e["KMORPH_LOG_FORMAT"] = "json"
+        proc = subprocess.Popen([DAEMON, "--bind", HOST, "--port", "0",
+                                 "--log-file", path],
+                                stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL, env=e)
+        try:
+            self.assertTrue(wait_for(lambda: os.path.exists(path) and
+                                     "listening" in slurp(path)
+                                     or None, 20))
+            port = int(re.search(r"http://[^ ]*:(\d+)",
+                                 slurp(path)).group(1))
+            from kmtest import request
+            request(port, "GET", "/healthz", headers={"X-Request-Id": "id-7"})
+            request(port, "GET", "/v1/nowhere")
+            raw_exchange(port, [b"GET / HTTP/1.1\r\nHost: x\r\n"
+                                b"Content-Length: 1\r\n"
+                                b"Content-Length: 2\r\n\r\n"])
+            proc.send_signal(signal.SIGHUP)
+            wait_for(lambda: "reopened" in slurp(path) or None, 10)
+        finally:
+            proc.terminate()
+            proc.wait(timeout=30)
+        lines = [json.loads(l) for l in slurp(path).splitlines() if l.strip()]
+        import shutil
+        shutil.rmtree(tmp)
+        access = [l for l in lines if l.get("event") == "access"]
+        notices = [l for l in lines if l.get("level") == "notice"]
+        ok = [l for l in access if l.get("request_id") == "id-7"][0]
+        self.assertEqual((ok["method"], ok["path"], ok["status"]),
+                         ("GET", "/healthz", 200))
+        self.assertIsInstance(ok["duration_ms"], float)
+        self.assertTrue(any(l.get("status") == 404 for l in access))
+        self.assertTrue(any(l.get("refused_framing") for l in access))
+        reopened = [n for n in notices if "reopened" in n["msg"]]
+        self.assertTrue(reopened)
+        self.assertIn(path, reopened[0]["msg"])  # quotes, backslash intact
+        self.assertTrue(any("listening on http://" in n["msg"]
+                            for n in notices))
+        for l in lines:
+            self.assertRegex(l["time"], r"^\d{4}-\d\d-\d\dT[\d:]{8}Z$")
+
+    def test_an_unknown_log_format_is_refused(self):
+        out = subprocess.run([DAEMON, "--log-format", "xml"],
+                             capture_output=True, text=True, timeout=10)
+        self.assertEqual(out.returncode, 2)
+        self.assertIn("log-format", out.stderr)
 
 
 class SafeDefaults(unittest.TestCase):
