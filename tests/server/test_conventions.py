@@ -476,6 +476,26 @@ class SafeDefaults(unittest.TestCase):
         self.assertGreater(grace, 0)
 
 
+class Documented(unittest.TestCase):
+    def test_new_settings_are_in_help_man_page_env_file_and_readme(self):
+        out = subprocess.run([DAEMON, "--help"], capture_output=True,
+                             text=True, timeout=10).stdout
+        for word in ("--log-format", "KMORPH_LOG_FORMAT", "PORT",
+                     "cgroup"):
+            self.assertIn(word, out)
+        texts = {}
+        for name in ("packaging/kmorphd.8.in", "packaging/kmorphd.env",
+                     "README.md"):
+            texts[name] = slurp(os.path.join(ROOT, name))
+        self.assertIn(".B PORT", texts["packaging/kmorphd.8.in"])
+        self.assertIn("/problems/", texts["packaging/kmorphd.8.in"])
+        for word in ("KMORPH_LOG_FORMAT", "KMORPH_SHUTDOWN_GRACE=8"):
+            self.assertIn(word, texts["packaging/kmorphd.env"])
+        for word in ("--log-format=json", "`PORT`", "cpu.max", "406",
+                     "If-None-Match", "process_open_fds", "instance"):
+            self.assertIn(word, texts["README.md"])
+
+
 class CpuQuota(unittest.TestCase):
     def test_cgroup_cpu_max_is_read_by_the_running_daemon(self):
         """The quota parser is exercised through the daemon only where a
