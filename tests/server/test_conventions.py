@@ -12,7 +12,8 @@ import subprocess
 import time
 import unittest
 
-from kmtest import (DAEMON, HOST, ROOT, ContractCase, Daemon, component,
+from kmtest import (DAEMON, HOST, ROOT, SPEC, ContractCase, Daemon, deref,
+                    component,
                     metric, morph_body, raw_exchange, ring_morph_body,
                     run_job, schema_errors, wait_for)
 
@@ -474,6 +475,80 @@ class SafeDefaults(unittest.TestCase):
         grace = float(re.search(r"\(default ([0-9.]+)\)", line).group(1))
         self.assertLess(grace, 10)
         self.assertGreater(grace, 0)
+
+
+def operations():
+    for path, ops in SPEC["paths"].items():
+        for method, op in ops.items():
+            if method in ("get", "post", "delete"):
+                yield path, method, op
+
+
+def media_types():
+    """(where, media type, its object) of every response with content."""
+    for path, method, op in operations():
+        for status, resp in op["responses"].items():
+            for mt, obj in deref(resp).get("content", {}).items():
+                yield "%s %s %s" % (method, path, status), mt, obj
+
+
+class Examples(ContractCase):
+    """Every request and response of the contract has examples; request
+    examples are the files of docs/examples, answered by the live daemon
+    with a documented status and schema."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.d = Daemon("--threads", "2")
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.d.stop()
+
+    def test_every_request_body_has_examples_from_docs_examples(self):
+        seen = 0
+        for path, method, op in operations():
+            if "requestBody" not in op:
+                continue
+            ex = op["requestBody"]["content"]["application/json"]["examples"]
+            self.assertTrue(ex, path)
+            for name, ref in ex.items():
+                e = deref(ref)
+                fname = e["description"]
+                self.assertTrue(fname.startswith("docs/examples/"), name)
+                with open(os.path.join(ROOT, fname)) as f:
+                    self.assertEqual(e["value"], json.load(f), name)
+                seen += 1
+        self.assertGreaterEqual(seen, len(os.listdir(
+            os.path.join(ROOT, "docs", "examples"))))
+
+    def test_request_examples_are_answered_as_documented(self):
+        for path, method, op in operations():
+            if "requestBody" not in op:
+                continue
+            ex = op["requestBody"]["content"]["application/json"]["examples"]
+            for name, ref in ex.items():
+                r = self.d.request(method.upper(), path,
+                                   body=deref(ref)["value"])
+                self.assertIn(r.status, (200, 202), (path, name, r.body[:300]))
+                self.assertDocumented(r, path, method)
+
+    def test_served_contract_is_the_yaml_with_its_examples(self):
+        served = self.d.request("GET", "/openapi.json").json()
+        self.assertEqual(served, json.loads(json.dumps(SPEC)))
+        self.assertIn("MorphSpirals", served["components"]["examples"])
+
+    def test_every_response_has_examples_that_fit_its_schema(self):
+        for where, mt, obj in media_types():
+            ex = obj.get("examples")
+            self.assertTrue(ex, "%s %s has no examples" % (where, mt))
+            for name, ref in ex.items():
+                value = deref(ref)["value"]
+                if mt.endswith("json"):
+                    self.assertEqual(schema_errors(value, obj["schema"]), [],
+                                     "%s %s %s" % (where, mt, name))
+                else:
+                    self.assertIsInstance(value, str, name)
 
 
 class Documented(unittest.TestCase):
