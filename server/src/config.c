@@ -93,7 +93,8 @@ static const opt_def OPTS[] = {
     {"job-keep", "KMORPH_JOB_KEEP", OPT_UINT, F(job_keep), 0, 1, 10000000,
      "finished jobs kept at most (oldest dropped)"},
     {"shutdown-grace", "KMORPH_SHUTDOWN_GRACE", OPT_SECONDS, F(shutdown_grace),
-     0, 0, 3600, "seconds to finish work on SIGTERM (below a container's 10 s stop "
+     0, 0, 3600,
+     "seconds to finish work on SIGTERM (below a container's 10 s stop "
      "timeout)"},
     {"retry-after", "KMORPH_RETRY_AFTER", OPT_UINT, F(retry_after), 0, 0, 3600,
      "Retry-After seconds sent with 429/503"},
@@ -145,7 +146,7 @@ void srv_config_default(srv_config *cfg) {
   cfg->job_keep = 1000;
   cfg->shutdown_grace = 8;
   cfg->retry_after = 1;
-    srv_default_web_root(cfg->web_root, sizeof cfg->web_root);
+  srv_default_web_root(cfg->web_root, sizeof cfg->web_root);
   cfg->access_log = true;
   snprintf(cfg->log_format, sizeof cfg->log_format, "kv");
 }

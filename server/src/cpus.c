@@ -41,7 +41,7 @@ static void read_cpu_max(char *out, size_t cap) {
     fclose(f);
   }
   line[strcspn(line, "\n")] = '\0';
-  const char *rel = strncmp(line, "0::", 3) == 0 ? line + 3 : "/";
+  const char *rel = strncmp(line, "0::", 3) == 0 && line[3] ? line + 3 : "/";
   snprintf(path, sizeof path, "/sys/fs/cgroup%s%scpu.max", rel,
            rel[strlen(rel) - 1] == '/' ? "" : "/");
   f = fopen(path, "r");

@@ -455,9 +455,10 @@ static void pause_accepting(relay *r, const char *why) {
   static const char KIND[] = "front accept";
   unsigned long more = 0;
   if (srv_log_admit(r->f->opt.logger, KIND, why, &more))
-    srv_log_notice(r->f->opt.log,
-            "kmorphd: accept failed: %s; pausing %g s (%lu more suppressed)\n",
-            why, ACCEPT_PAUSE, more);
+    srv_log_notice(
+        r->f->opt.log,
+        "kmorphd: accept failed: %s; pausing %g s (%lu more suppressed)\n", why,
+        ACCEPT_PAUSE, more);
   r->pause_until = srv_now() + ACCEPT_PAUSE;
 }
 
@@ -614,9 +615,9 @@ static int bind_listen(srv_front *f) {
     len = sizeof *v6;
   } else {
     srv_log_notice(f->opt.log,
-            "kmorphd: --bind \"%s\" is not an IPv4 or IPv6 "
-            "address\n",
-            f->opt.bind);
+                   "kmorphd: --bind \"%s\" is not an IPv4 or IPv6 "
+                   "address\n",
+                   f->opt.bind);
     return -1;
   }
   int fd = socket(ss.ss_family, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
@@ -627,7 +628,7 @@ static int bind_listen(srv_front *f) {
   if (fd < 0 || bind(fd, (struct sockaddr *)&ss, len) != 0 ||
       listen(fd, 511) != 0) {
     srv_log_notice(f->opt.log, "kmorphd: cannot listen on %s port %u (%s)\n",
-            f->opt.bind, f->opt.port, strerror(errno));
+                   f->opt.bind, f->opt.port, strerror(errno));
     if (fd >= 0) close(fd);
     return -1;
   }
@@ -668,8 +669,9 @@ int srv_front_start(srv_front *f, struct MHD_Daemon *d) {
     r->ep = epoll_create1(EPOLL_CLOEXEC);
     r->wake = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
     if (r->ep < 0 || r->wake < 0) {
-      srv_log_notice(f->opt.log, "kmorphd: cannot create the relay's epoll set (%s)\n",
-              strerror(errno));
+      srv_log_notice(f->opt.log,
+                     "kmorphd: cannot create the relay's epoll set (%s)\n",
+                     strerror(errno));
       return -1;
     }
     struct epoll_event ev = {.events = EPOLLIN, .data.u64 = TAG_WAKE};

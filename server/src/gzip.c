@@ -107,9 +107,8 @@ struct MHD_Response *srv_gzip_stream(const char *data, size_t len,
     return NULL;
   }
   gz_stream *g = calloc(1, sizeof *g);
-  if (g == NULL ||
-      deflateInit2(&g->z, GZ_LEVEL, Z_DEFLATED, GZ_WBITS, GZ_MEMLEVEL,
-                   Z_DEFAULT_STRATEGY) != Z_OK) {
+  if (g == NULL || deflateInit2(&g->z, GZ_LEVEL, Z_DEFLATED, GZ_WBITS,
+                                GZ_MEMLEVEL, Z_DEFAULT_STRATEGY) != Z_OK) {
     free(g);
     atomic_fetch_sub(streams, 1);
     return NULL;

@@ -264,8 +264,8 @@ void srv_jobs_cancel_all(srv_jobs *j) {
     if (p->done < p->total && !p->cancelled && !p->failed && !p->finishing) {
       /* one line per job, so every accepted job is accounted for */
       srv_log_notice(stderr,
-              "kmorphd: job %s cancelled by shutdown (%zu/%zu frames)\n", p->id,
-              p->done, p->total);
+                     "kmorphd: job %s cancelled by shutdown (%zu/%zu frames)\n",
+                     p->id, p->done, p->total);
       cancel_locked(j, p, now);
     }
     if (take_if_over(j, p)) {

@@ -124,8 +124,8 @@ static void notice_v(FILE *f, const char *fmt, va_list ap) {
   const char *m = strncmp(msg, "kmorphd: ", 9) == 0 ? msg + 9 : msg;
   srv_json_escape(esc, sizeof esc, m);
   srv_log_time(when, sizeof when);
-  fprintf(f, "{\"time\":\"%s\",\"level\":\"notice\",\"msg\":\"%s\"}\n",
-          when, esc);
+  fprintf(f, "{\"time\":\"%s\",\"level\":\"notice\",\"msg\":\"%s\"}\n", when,
+          esc);
 }
 
 void srv_log_notice(FILE *f, const char *fmt, ...) {
@@ -187,7 +187,7 @@ void srv_log_close(srv_log *l) {
     const rl_slot *sl = &l->slots[i];
     if (sl->kind != NULL && sl->suppressed > 0)
       srv_log_notice(l->stream, "kmorphd: %lu more suppressed like \"%s\"\n",
-              sl->suppressed, sl->sample);
+                     sl->suppressed, sl->sample);
   }
   pthread_mutex_unlock(&l->mu);
   fflush(l->stream);

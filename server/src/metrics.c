@@ -20,13 +20,12 @@
 #endif
 
 static const char *const ROUTE_NAMES[SRV_R_COUNT] = {
-    "index",      "healthz",     "readyz", "metrics", "openapi",
-    "signature",  "reconstruct", "morph",  "jobs",    "job",
+    "index",      "healthz",     "readyz",  "metrics", "openapi",
+    "signature",  "reconstruct", "morph",   "jobs",    "job",
     "job_result", "static",      "problem", "other"};
 
-static const int STATUSES[] = {200, 202, 204, 304, 400, 404, 405, 406, 408,
-                               409, 410, 413, 415, 422, 429, 431, 500, 501,
-                               503, 0};
+static const int STATUSES[] = {200, 202, 204, 304, 400, 404, 405, 406, 408, 409,
+                               410, 413, 415, 422, 429, 431, 500, 501, 503, 0};
 #define NSTATUS (sizeof STATUSES / sizeof STATUSES[0])
 
 static const double BUCKETS[] = {0.0005, 0.001, 0.0025, 0.005, 0.01,
@@ -42,8 +41,8 @@ static const char *const REASONS[] = {
 #define NREASON (sizeof REASONS / sizeof REASONS[0])
 
 /* Methods as labels; the last counts every other method. */
-static const char *const METHODS[] = {"GET",     "HEAD",  "POST",
-                                      "DELETE",  "OPTIONS", "other"};
+static const char *const METHODS[] = {"GET",    "HEAD",    "POST",
+                                      "DELETE", "OPTIONS", "other"};
 #define NMETHOD (sizeof METHODS / sizeof METHODS[0])
 
 struct srv_metrics {

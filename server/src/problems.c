@@ -11,10 +11,10 @@
 #include "util.h"
 
 typedef struct problem_doc {
-  const char *name;   /* after /problems/ */
-  const char *title;  /* as in the problem bodies */
-  int status;         /* the status it comes with */
-  const char *text;   /* what it means and what to do */
+  const char *name;  /* after /problems/ */
+  const char *title; /* as in the problem bodies */
+  int status;        /* the status it comes with */
+  const char *text;  /* what it means and what to do */
 } problem_doc;
 
 static const problem_doc DOCS[] = {

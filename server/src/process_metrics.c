@@ -34,8 +34,7 @@ static void put(out_buf *b, const char *fmt, ...) {
 
 /* Fields 14, 15 (utime, stime), 22 (starttime) and 24 (rss pages) of
  * /proc/self/stat; 0 when read. */
-static int read_stat(double *utime, double *stime, double *start,
-                     double *rss) {
+static int read_stat(double *utime, double *stime, double *start, double *rss) {
   char text[1024];
   FILE *f = fopen("/proc/self/stat", "r");
   if (f == NULL) return -1;

@@ -192,7 +192,7 @@ enum MHD_Result srv__answer(srv_req *r, int status, const char *ctype,
   if (owned && status == 200 && srv_gzip_worth(ctype, len) &&
       route_compressible(r->route) && may_stream_gzip(r)) {
     struct MHD_Response *gz =
-        srv_gzip_stream(body, len, free, body, &r->srv->gzip_streams);
+        srv_gzip_stream(body, len, free, body, &r->srv->gz_streams);
     if (gz != NULL) {
       MHD_add_response_header(gz, MHD_HTTP_HEADER_CONTENT_TYPE, ctype);
       return srv__queue(r, status, gz, len);
@@ -281,8 +281,8 @@ enum MHD_Result srv__answer_body(srv_req *r, int status, const srv_body *b) {
                srv_etag_match(header(r, MHD_HTTP_HEADER_IF_NONE_MATCH), etag);
   if (fresh) { /* RFC 9110 13.1.2: the client's copy is current */
     status = 304;
-    resp = MHD_create_response_from_buffer(0, (void *)"",
-                                           MHD_RESPMEM_PERSISTENT);
+    resp =
+        MHD_create_response_from_buffer(0, (void *)"", MHD_RESPMEM_PERSISTENT);
     if (b->release != NULL) b->release(b->cls);
   } else if (gz) {
     len = b->gz_len;
@@ -294,7 +294,7 @@ enum MHD_Result srv__answer_body(srv_req *r, int status, const srv_body *b) {
     len = b->len;
     if (stream)
       resp = srv_gzip_stream(b->data, len, b->release, b->cls,
-                             &r->srv->gzip_streams);
+                             &r->srv->gz_streams);
     if (resp == NULL) { /* too many streams: the identity form */
       etag = b->etag;
       resp = MHD_create_response_from_buffer_with_free_callback_cls(

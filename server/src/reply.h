@@ -50,10 +50,10 @@ enum MHD_Result srv__answer_json(srv_req *r, int status, const char *fmt, ...)
 /* A body the answer borrows and releases when sent, with its entity tags
  * and caching rule (srv__answer_body). */
 typedef struct srv_body {
-  const char *type;           /* Content-Type */
-  const char *data;           /* len bytes, the identity form */
+  const char *type; /* Content-Type */
+  const char *data; /* len bytes, the identity form */
   size_t len;
-  const char *gz;             /* gz_len bytes of its gzip form, or NULL */
+  const char *gz; /* gz_len bytes of its gzip form, or NULL */
   size_t gz_len;
   bool stream_gzip;           /* without gz: compress as sent if worth it */
   const char *etag;           /* strong tag of the identity form, or NULL */

@@ -69,7 +69,8 @@ static void mhd_log(void *cls, const char *fmt, va_list ap) {
   unsigned long more = 0;
   if (srv_log_admit(s->logger, fmt, msg, &more)) {
     if (more > 0)
-      srv_log_notice(s->log, "kmorphd: http: %s (%lu more suppressed)\n", msg, more);
+      srv_log_notice(s->log, "kmorphd: http: %s (%lu more suppressed)\n", msg,
+                     more);
     else
       srv_log_notice(s->log, "kmorphd: http: %s\n", msg);
   }
@@ -98,7 +99,7 @@ srv_server *srv_server_create(const srv_config *cfg, srv_log *logger) {
   s->api.max_output_bytes = cfg->max_output;
   s->metrics = srv_metrics_create(srv__route_method_allowed);
   s->statics = srv_static_cache_create();
-  atomic_init(&s->gzip_streams, 0);
+  atomic_init(&s->gz_streams, 0);
   srv_watch_limits wl = {.header_time = cfg->header_time,
                          .request_time = cfg->request_time,
                          .send_time = cfg->send_time,
@@ -117,8 +118,9 @@ srv_server *srv_server_create(const srv_config *cfg, srv_log *logger) {
                     : NULL;
   if (s->metrics == NULL || s->pool == NULL || s->watch == NULL ||
       s->statics == NULL) {
-    srv_log_notice(s->log, "kmorphd: cannot create the compute pool (%u workers)\n",
-            cfg->workers);
+    srv_log_notice(s->log,
+                   "kmorphd: cannot create the compute pool (%u workers)\n",
+                   cfg->workers);
     srv_server_destroy(s);
     return NULL;
   }
@@ -209,17 +211,18 @@ int srv_server_shutdown(srv_server *s) {
   srv_jobs_cancel_all(s->jobs);
   srv_pool_stop(s->pool);
   if (!wait_until(s, compute_idle, deadline)) {
-    srv_log_notice(s->log,
-            "kmorphd: shutdown grace of %g s passed with %zu requests still "
-            "computing: stopping them\n",
-            s->cfg.shutdown_grace, (size_t)atomic_load(&s->suspended));
+    srv_log_notice(
+        s->log,
+        "kmorphd: shutdown grace of %g s passed with %zu requests still "
+        "computing: stopping them\n",
+        s->cfg.shutdown_grace, (size_t)atomic_load(&s->suspended));
     atomic_store(&s->abort_compute, true);
     deadline = srv_now() + ABORT_WAIT;
     if (!wait_until(s, compute_idle, deadline)) {
       srv_log_notice(s->log,
-              "kmorphd: %zu requests still computing %g s after being "
-              "stopped\n",
-              (size_t)atomic_load(&s->suspended), ABORT_WAIT);
+                     "kmorphd: %zu requests still computing %g s after being "
+                     "stopped\n",
+                     (size_t)atomic_load(&s->suspended), ABORT_WAIT);
       return -1;
     }
   }
@@ -227,7 +230,7 @@ int srv_server_shutdown(srv_server *s) {
    * deadline to complete; idle keep-alive connections do not count. */
   if (!wait_until(s, requests_done, deadline))
     srv_log_notice(s->log, "kmorphd: closing %zu unfinished requests\n",
-            (size_t)atomic_load(&s->inflight));
+                   (size_t)atomic_load(&s->inflight));
   MHD_stop_daemon(s->daemon);
   s->daemon = NULL;
   return 0;

@@ -55,7 +55,7 @@ struct srv_server {
   atomic_size_t body_bytes;  /* buffers of request bodies held now */
   srv_static_cache *statics; /* the page's files and the contract, with
                               * entity tags and gzip forms (made once) */
-  atomic_size_t gzip_streams; /* answers being compressed as sent (gzip.h) */
+  atomic_size_t gz_streams;  /* answers being gzip-coded as sent (gzip.h) */
 };
 
 /* Where a request is in its life; srv_req.phase. */

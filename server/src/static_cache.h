@@ -25,13 +25,13 @@ typedef struct srv_static_cache srv_static_cache;
 /* One file's bytes, its strong entity tag and, if worth it, its gzip form
  * (gz NULL otherwise) with that form's tag. Immutable. */
 typedef struct srv_static {
-  const char *type;   /* media type (static text) */
-  const char *body;   /* len bytes */
+  const char *type; /* media type (static text) */
+  const char *body; /* len bytes */
   size_t len;
-  const char *gz;     /* gz_len bytes, or NULL */
+  const char *gz; /* gz_len bytes, or NULL */
   size_t gz_len;
-  char etag[24];      /* "\"<16 hex>\"" */
-  char gz_etag[28];   /* "\"<16 hex>-gz\"" */
+  char etag[24];    /* "\"<16 hex>\"" */
+  char gz_etag[28]; /* "\"<16 hex>-gz\"" */
 } srv_static;
 
 /* An empty cache, or NULL if memory is short. */

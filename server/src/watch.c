@@ -88,10 +88,11 @@ static void sweep(srv_watch *w, double now) {
       sends++;
   }
   if ((requests > 0 || sends > 0) && w->log != NULL)
-    srv_log_notice(w->log,
-            "kmorphd: cut %zu connections whose request was late (408) and "
-            "%zu whose answer was not read in time\n",
-            requests, sends);
+    srv_log_notice(
+        w->log,
+        "kmorphd: cut %zu connections whose request was late (408) and "
+        "%zu whose answer was not read in time\n",
+        requests, sends);
 }
 
 static void *sweeper(void *arg) {
