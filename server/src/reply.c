@@ -102,6 +102,15 @@ static void add_vary(srv_req *r, struct MHD_Response *resp, bool by_origin) {
   if (vary[0]) MHD_add_response_header(resp, MHD_HTTP_HEADER_VARY, vary);
 }
 
+/* A gzip-coded answer names its decoded length, which a client showing
+ * download progress counts (fetch hands it decoded bytes) and which
+ * neither Content-Length (the coded bytes) nor a chunked answer give. */
+static void add_uncompressed_length(struct MHD_Response *resp, size_t len) {
+  char n[24];
+  snprintf(n, sizeof n, "%zu", len);
+  MHD_add_response_header(resp, "X-Uncompressed-Length", n);
+}
+
 bool srv__wants_gzip(srv_req *r) {
   return srv_coding_q(header(r, MHD_HTTP_HEADER_ACCEPT_ENCODING), "gzip") > 0;
 }
@@ -148,7 +157,8 @@ static void add_common_headers(srv_req *r, struct MHD_Response *resp,
   if (origin != NULL) {
     MHD_add_response_header(resp, "Access-Control-Allow-Origin", origin);
     MHD_add_response_header(resp, "Access-Control-Expose-Headers",
-                            "Location, Retry-After, X-Request-Id, ETag");
+                            "Location, Retry-After, X-Request-Id, ETag, "
+                            "X-Uncompressed-Length");
   }
   add_vary(r, resp, origin != NULL && strcmp(origin, "*") != 0);
   if (status == 429 || status == 503) {
@@ -195,6 +205,7 @@ enum MHD_Result srv__answer(srv_req *r, int status, const char *ctype,
         srv_gzip_stream(body, len, free, body, &r->srv->gz_streams);
     if (gz != NULL) {
       MHD_add_response_header(gz, MHD_HTTP_HEADER_CONTENT_TYPE, ctype);
+      add_uncompressed_length(gz, len);
       return srv__queue(r, status, gz, len);
     }
   }
@@ -288,13 +299,15 @@ enum MHD_Result srv__answer_body(srv_req *r, int status, const srv_body *b) {
     len = b->gz_len;
     resp = MHD_create_response_from_buffer_with_free_callback_cls(
         len, (void *)b->gz, b->release, b->cls);
-    if (resp != NULL)
+    if (resp != NULL) {
       MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_ENCODING, "gzip");
+      add_uncompressed_length(resp, b->len);
+    }
   } else {
     len = b->len;
-    if (stream)
-      resp = srv_gzip_stream(b->data, len, b->release, b->cls,
-                             &r->srv->gz_streams);
+    if (stream && (resp = srv_gzip_stream(b->data, len, b->release, b->cls,
+                                          &r->srv->gz_streams)) != NULL)
+      add_uncompressed_length(resp, len);
     if (resp == NULL) { /* too many streams: the identity form */
       etag = b->etag;
       resp = MHD_create_response_from_buffer_with_free_callback_cls(

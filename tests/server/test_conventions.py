@@ -258,6 +258,8 @@ class Compression(ContractCase):
             self.assertEqual(gz.header("Content-Encoding"), "gzip", path)
             self.assertEqual(int(gz.header("Content-Length")), len(gz.body))
             self.assertEqual(gzip.decompress(gz.body), plain.body, path)
+            self.assertEqual(int(gz.header("X-Uncompressed-Length")),
+                             len(plain.body))
             self.assertLess(len(gz.body), len(plain.body))
             self.assertNotEqual(gz.header("ETag"), plain.header("ETag"))
             head = self.d.request("HEAD", path,
@@ -289,6 +291,8 @@ class Compression(ContractCase):
         self.assertEqual(gz.header("Content-Encoding"), "gzip")
         self.assertEqual(gzip.decompress(gz.body), plain.body)
         self.assertLess(len(gz.body), len(plain.body) / 2)
+        self.assertEqual(int(gz.header("X-Uncompressed-Length")),
+                         len(plain.body), "for download progress")
         r, jid, final = run_job(self.d, morph_body(1000), timeout=60)
         self.assertEqual(final["state"], "done")
         url = "/v1/jobs/%s/result" % jid
