@@ -120,6 +120,23 @@ class Problems(ContractCase):
         self.assertTrue(doc["instance"].startswith("urn:kmorph:request:"))
 
 
+class LateRequestProblem(unittest.TestCase):
+    def test_a_late_request_408_carries_instance_and_its_request_id(self):
+        d = Daemon("--header-time", "0.2")
+        try:
+            raw = raw_exchange(d.port, [b"GET /healthz HTTP/1.1\r\nHo"],
+                               timeout=10)
+        finally:
+            d.stop()
+        head, body = raw.split(b"\r\n\r\n", 1)
+        self.assertIn(b" 408 ", head.split(b"\r\n")[0])
+        doc = json.loads(body)
+        rid = re.search(rb"X-Request-Id: (\S+)", head).group(1).decode()
+        self.assertEqual(doc["request_id"], rid)
+        self.assertEqual(doc["instance"], "urn:kmorph:request:" + rid)
+        self.assertEqual(schema_errors(doc, component("Problem")), [])
+
+
 class Negotiation(ContractCase):
     @classmethod
     def setUpClass(cls):
