@@ -81,9 +81,11 @@ double srv_accept_q(const char *accept, const char *type) {
   size_t tlen = strlen(type);
   int best = 0;
   double q = 0;
+  size_t seen = 0;
   element el;
   const char *at = accept;
   while (next_element(&at, &el)) {
+    seen++;
     int level = 0;
     if (el.len == tlen && strncasecmp(el.tok, type, tlen) == 0)
       level = 3;
@@ -97,6 +99,7 @@ double srv_accept_q(const char *accept, const char *type) {
       q = el.q;
     }
   }
+  if (seen == 0) return 1; /* only commas and spaces: as if absent */
   return best > 0 ? q : 0;
 }
 

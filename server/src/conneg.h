@@ -15,7 +15,8 @@
 /* The quality the Accept header gives the media type `type` ("a/b", no
  * parameters): the q of the most specific range matching it (a/b, then
  * a/ *, then * / *; parameters other than q ignored), 0 if none matches,
- * 1 for an absent or empty header. q=0 excludes. */
+ * 1 for an absent or empty header (or one of commas only). q=0
+ * excludes. */
 double srv_accept_q(const char *accept, const char *type);
 
 /* Index of the type in types[0..n-1] the Accept header likes best (q >

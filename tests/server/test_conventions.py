@@ -176,6 +176,23 @@ class Negotiation(ContractCase):
             "Accept": "application/json;q=0, image/svg+xml"})
         self.assertEqual(r.ctype, "image/svg+xml")
 
+    def test_odd_headers_fall_back_to_what_they_can_mean(self):
+        # a malformed q counts as 1 (no 406 for a typo); an empty Accept
+        # accepts anything; x-gzip is gzip; q=0.0 excludes
+        for accept in ("application/json;q=abc", "", " , ,"):
+            r = self.d.request("GET", "/healthz",
+                               headers={"Accept": accept})
+            self.assertEqual(r.status, 200, repr(accept))
+        r = self.d.request("GET", "/openapi.json",
+                           headers={"Accept-Encoding": "x-gzip"})
+        self.assertEqual(r.header("Content-Encoding"), "gzip")
+        r = self.d.request("GET", "/openapi.json",
+                           headers={"Accept-Encoding": "gzip;q=0.0, *;q=0"})
+        self.assertIsNone(r.header("Content-Encoding"))
+        r = self.d.request("GET", "/openapi.json",
+                           headers={"Accept": "APPLICATION/JSON"})
+        self.assertEqual(r.status, 200, "media types are case-insensitive")
+
     def test_vary_accept_on_answers_that_depend_on_it(self):
         for method, path, body in [("POST", "/v1/morph", morph_body(3)),
                                    ("GET", "/openapi.json", None),
