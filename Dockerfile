@@ -13,7 +13,7 @@
 FROM debian:12-slim AS build
 RUN apt-get update \
  && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
-      gcc libc6-dev make pkg-config libcjson-dev libmicrohttpd-dev \
+      gcc libc6-dev make pkg-config libcjson-dev libmicrohttpd-dev zlib1g-dev \
  && rm -rf /var/lib/apt/lists/*
 WORKDIR /src
 COPY . .
@@ -35,7 +35,7 @@ LABEL org.opencontainers.image.title="kmorph" \
       org.opencontainers.image.base.name="docker.io/library/debian:12-slim"
 RUN apt-get update \
  && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
-      libcjson1 libmicrohttpd12 \
+      libcjson1 libmicrohttpd12 zlib1g \
  && rm -rf /var/lib/apt/lists/* \
  && useradd --system --uid 10001 --no-create-home --shell /usr/sbin/nologin kmorph
 # The daemon finds its page in share/kmorph/web beside its executable.

@@ -24,17 +24,18 @@ PACKAGES := gcc make pkg-config libcmocka-dev libcjson-dev libmicrohttpd-dev \
             librsvg2-bin nodejs npm wrk python3 python3-yaml python3-jsonschema \
             chromium python3-fonttools fonts-dejavu-core fonts-liberation2 \
             python3-venv python3-wheel redis-server redis-tools nginx-light \
-            libhiredis-dev
+            libhiredis-dev zlib1g-dev
 
 # The library headers a build needs, each as header:Debian package; a
 # build starts by checking them (check-deps) so that a machine without them
 # is told to run `make deps` rather than shown a compiler error.
 NEEDED_HEADERS ?= cjson/cJSON.h:libcjson-dev microhttpd.h:libmicrohttpd-dev \
-                  cmocka.h:libcmocka-dev
+                  cmocka.h:libcmocka-dev zlib.h:zlib1g-dev
 
 CJSON_CFLAGS := -I/usr/include/cjson
 CJSON_LIBS   := -lcjson
 MHD_LIBS     := -lmicrohttpd
+ZLIB_LIBS    := -lz
 
 # The one version of the tree (VERSION): the core's generated km/version.h
 # and, as -D flags, the CLI's and the daemon's --version and build_info.
@@ -162,7 +163,7 @@ $(BUILD)/server/src/config.o $(BUILD)/server/src/metrics.o: VERSION
 
 $(DAEMON): $(SRV_OBJ) $(LIBAPI) $(LIBCORE)
 	@mkdir -p $(@D)
-	$(CC) $(SRV_OBJ) -o $@ $(LIBAPI) $(LIBCORE) $(MHD_LIBS) $(CJSON_LIBS) -lhiredis -lm -lpthread $(LDFLAGS)
+	$(CC) $(SRV_OBJ) -o $@ $(LIBAPI) $(LIBCORE) $(MHD_LIBS) $(ZLIB_LIBS) $(CJSON_LIBS) -lhiredis -lm -lpthread $(LDFLAGS)
 
 $(BUILD)/tests/core/%: tests/core/%.c $(SUPPORT_SRC) $(LIBCORE) | check-deps
 	@mkdir -p $(@D)

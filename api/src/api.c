@@ -145,8 +145,15 @@ void api_problem(api_response *out, api_status status, const char *type,
                    message != NULL ? message
                                    : (detail != NULL ? detail : title)) != NULL;
   }
-  if (ok && sane_request_id(request_id))
-    ok = cJSON_AddStringToObject(root, "request_id", request_id) != NULL;
+  if (ok && sane_request_id(request_id)) {
+    /* instance (RFC 9457 3.1.5): this occurrence, as the request id in a
+     * URN, the id the daemon's log lines carry. */
+    char instance[sizeof API_INSTANCE_PREFIX + 200];
+    snprintf(instance, sizeof instance, "%s%s", API_INSTANCE_PREFIX,
+             request_id);
+    ok = cJSON_AddStringToObject(root, "request_id", request_id) != NULL &&
+         cJSON_AddStringToObject(root, "instance", instance) != NULL;
+  }
   char *text = ok ? cJSON_PrintUnformatted(root) : NULL;
   cJSON_Delete(root);
   if (text == NULL) {

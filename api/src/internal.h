@@ -36,6 +36,8 @@
 #define API_CT_SVG "image/svg+xml"
 
 /* Problem types (RFC 9457 "type" members, relative URIs). */
+/* A problem's instance: the request id as a URN (api_problem). */
+#define API_INSTANCE_PREFIX "urn:kmorph:request:"
 #define API_P_MALFORMED "/problems/malformed-json"
 #define API_P_INVALID_REQUEST "/problems/invalid-request"
 #define API_P_INVALID_CURVE "/problems/invalid-curve"

@@ -45,6 +45,7 @@ export type IntersectionsReport = Schemas["IntersectionsReport"];
 export type JobStatus = Schemas["JobStatus"];
 export type Health = Schemas["Health"];
 export type Problem = Schemas["Problem"];
+export type ProblemType = Schemas["ProblemType"];
 
 /** A curve as a request gives it (svg, points, bspline, signature, shape). */
 export type CurveIn = Curve;

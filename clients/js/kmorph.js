@@ -111,10 +111,13 @@ function sleep(ms, signal) {
  * every request), pollInterval (first job poll delay in ms, default 50,
  * growing to maxPollInterval, default 500). */
 /** The body of a response as text, calling onDownload({received, total})
- * with every chunk read. */
+ * with every chunk read. The chunks are decoded bytes: a gzip-coded body's
+ * Content-Length counts other bytes (or is absent when it is compressed as
+ * sent), so kmorphd names the decoded length in X-Uncompressed-Length. */
 async function readWithProgress(response, onDownload) {
-  const length = Number(response.headers.get("Content-Length"));
-  const total = !response.headers.get("Content-Encoding") && length > 0 ? length : null;
+  const coded = response.headers.get("Content-Encoding");
+  const length = Number(response.headers.get(coded ? "X-Uncompressed-Length" : "Content-Length"));
+  const total = length > 0 ? length : null;
   const reader = response.body.getReader(), chunks = [];
   let received = 0;
   onDownload({ received, total });

@@ -204,8 +204,8 @@ static void create_job(srv_req *r, api_request *req) {
   if (s->rjobs != NULL) {
     /* Shared: the record keeps the request, the plan stays in this
      * instance's cache for the batches it takes. */
-    int st = srv_rjobs_start(s->rjobs, r->body, r->len, r->accept, plan,
-                             r->job_id);
+    int st =
+        srv_rjobs_start(s->rjobs, r->body, r->len, r->accept, plan, r->job_id);
     if (st != 0) {
       job_refused(r, st);
       return;

@@ -38,11 +38,13 @@ static const opt_def OPTS[] = {
     {"bind", "KMORPH_BIND", OPT_STR, F(bind), sizeof(((srv_config *)0)->bind),
      0, 0, "listen address"},
     {"port", "KMORPH_PORT", OPT_UINT, F(port), 0, 0, 65535,
-     "TCP port (0: any free port, printed at start)"},
+     "TCP port (0: any free port, printed at start); PORT is read when "
+     "neither is set"},
     {"io-threads", "KMORPH_IO_THREADS", OPT_UINT, F(io_threads), 0, 1, 64,
      "HTTP I/O threads"},
     {"threads", "KMORPH_THREADS", OPT_UINT, F(workers), 0, 0, 1024,
-     "compute workers (0: number of cores)"},
+     "compute workers (0: the CPUs the process may use: affinity, cgroup "
+     "cpu.max)"},
     {"queue", "KMORPH_QUEUE", OPT_UINT, F(queue), 0, 1, 1000000,
      "compute requests waiting before 503"},
     {"max-connections", "KMORPH_MAX_CONNECTIONS", OPT_UINT, F(max_connections),
@@ -93,7 +95,9 @@ static const opt_def OPTS[] = {
     {"job-keep", "KMORPH_JOB_KEEP", OPT_UINT, F(job_keep), 0, 1, 10000000,
      "finished jobs kept at most (oldest dropped)"},
     {"shutdown-grace", "KMORPH_SHUTDOWN_GRACE", OPT_SECONDS, F(shutdown_grace),
-     0, 0, 3600, "seconds to finish work on SIGTERM"},
+     0, 0, 3600,
+     "seconds to finish work on SIGTERM (below a container's 10 s stop "
+     "timeout)"},
     {"retry-after", "KMORPH_RETRY_AFTER", OPT_UINT, F(retry_after), 0, 0, 3600,
      "Retry-After seconds sent with 429/503"},
     {"cors-origins", "KMORPH_CORS_ORIGINS", OPT_STR, F(cors_origins),
@@ -115,6 +119,9 @@ static const opt_def OPTS[] = {
      3600,
      "with --jobs: seconds before the frames another instance took and did "
      "not finish are rendered here"},
+    {"log-format", "KMORPH_LOG_FORMAT", OPT_STR, F(log_format),
+     sizeof(((srv_config *)0)->log_format), 0, 0,
+     "log lines: kv (key=value text) or json (one object per line)"},
 };
 #undef F
 #define NOPTS (sizeof OPTS / sizeof OPTS[0])
@@ -148,12 +155,12 @@ void srv_config_default(srv_config *cfg) {
   cfg->job_time = 300;
   cfg->job_ttl = 600;
   cfg->job_keep = 1000;
-  cfg->shutdown_grace = 10;
+  cfg->shutdown_grace = 8;
   cfg->job_reclaim = 5;
   cfg->retry_after = 1;
-  snprintf(cfg->cors_origins, sizeof cfg->cors_origins, "*");
   srv_default_web_root(cfg->web_root, sizeof cfg->web_root);
   cfg->access_log = true;
+  snprintf(cfg->log_format, sizeof cfg->log_format, "kv");
 }
 
 static void print_default(FILE *out, const opt_def *o, const srv_config *d) {
@@ -230,8 +237,22 @@ static int set_value(srv_config *cfg, const opt_def *o, const char *v,
   return 0;
 }
 
+/* The setting whose flag is name[0..nlen-1], or NULL. */
+static const opt_def *find_opt(const char *name, size_t nlen) {
+  for (size_t i = 0; i < NOPTS; i++)
+    if (strlen(OPTS[i].flag) == nlen && strncmp(OPTS[i].flag, name, nlen) == 0)
+      return &OPTS[i];
+  return NULL;
+}
+
 int srv_config_load(srv_config *cfg, int argc, char **argv, FILE *out,
                     FILE *err) {
+  /* PORT, the generic variable platforms set (Heroku, Cloud Run), is the
+   * fallback under KMORPH_PORT and --port. */
+  const char *generic_port = getenv("PORT");
+  if (generic_port != NULL && generic_port[0] != '\0' &&
+      set_value(cfg, find_opt("port", 4), generic_port, "PORT", err) != 0)
+    return -1;
   for (size_t i = 0; i < NOPTS; i++) {
     const char *v = getenv(OPTS[i].env);
     if (v != NULL && set_value(cfg, &OPTS[i], v, OPTS[i].env, err) != 0)
@@ -254,11 +275,7 @@ int srv_config_load(srv_config *cfg, int argc, char **argv, FILE *out,
     const char *name = arg + 2;
     const char *eq = strchr(name, '=');
     size_t nlen = eq ? (size_t)(eq - name) : strlen(name);
-    const opt_def *o = NULL;
-    for (size_t i = 0; i < NOPTS; i++)
-      if (strlen(OPTS[i].flag) == nlen &&
-          strncmp(OPTS[i].flag, name, nlen) == 0)
-        o = &OPTS[i];
+    const opt_def *o = find_opt(name, nlen);
     if (o == NULL) {
       fprintf(err, "kmorphd: unknown flag \"%s\" (see --help)\n", arg);
       return -1;
@@ -273,6 +290,12 @@ int srv_config_load(srv_config *cfg, int argc, char **argv, FILE *out,
       return -1;
     }
     if (set_value(cfg, o, v, arg, err) != 0) return -1;
+  }
+  if (strcmp(cfg->log_format, "kv") != 0 &&
+      strcmp(cfg->log_format, "json") != 0) {
+    fprintf(err, "kmorphd: --log-format: \"%s\" is not kv or json\n",
+            cfg->log_format);
+    return -1;
   }
   return 0;
 }

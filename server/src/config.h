@@ -50,6 +50,7 @@ typedef struct srv_config {
                              * "" = in this process's memory */
   double job_reclaim;       /* seconds before a silent instance's batch
                              * of a shared job is taken over */
+  char log_format[8];       /* "kv" (key=value lines) or "json" */
 } srv_config;
 
 /* Fill *cfg with the built-in defaults. */

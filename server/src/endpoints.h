@@ -17,6 +17,10 @@
  * page when the web root has none; else 404. */
 enum MHD_Result srv__serve_file(srv_req *r, const char *name);
 
+/* GET /openapi.json: the contract, with its entity tag and gzip form made
+ * once. */
+enum MHD_Result srv__serve_openapi(srv_req *r);
+
 /* GET /metrics: the Prometheus text of the metrics and of the gauges read
  * now (queue, workers, connections, jobs, memory held, late clients). */
 enum MHD_Result srv__serve_metrics(srv_req *r);

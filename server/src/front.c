@@ -206,8 +206,9 @@ static void queue_refusal(relay *r, conn *c) {
   char body[1024];
   int bn = snprintf(body, sizeof body,
                     "{\"type\":\"%s\",\"title\":\"%s\",\"status\":%d,"
-                    "\"detail\":\"%s\",\"request_id\":\"%s\"}",
-                    type, title, fr->status, detail, rid);
+                    "\"detail\":\"%s\",\"request_id\":\"%s\","
+                    "\"instance\":\"urn:kmorph:request:%s\"}",
+                    type, title, fr->status, detail, rid, rid);
   if (bn < 0 || (size_t)bn >= sizeof body) bn = (int)strlen(body);
   char date[64], when[32];
   time_t now = time(NULL);
@@ -231,7 +232,13 @@ static void queue_refusal(relay *r, conn *c) {
   c->out_sent = 0;
   c->answered = true;
   atomic_fetch_add(&r->f->refused, 1);
-  if (r->f->opt.access_log)
+  if (r->f->opt.access_log && srv_log_json())
+    fprintf(r->f->opt.log,
+            "{\"time\":\"%s\",\"event\":\"access\",\"refused_framing\":"
+            "true,\"status\":%d,\"peer\":\"%s\",\"request_id\":\"%s\","
+            "\"detail\":\"%s\"}\n",
+            when, fr->status, c->peer, rid, detail);
+  else if (r->f->opt.access_log)
     fprintf(r->f->opt.log,
             "%s access refused_framing status=%d peer=%s request_id=%s "
             "detail=\"%s\"\n",
@@ -448,9 +455,10 @@ static void pause_accepting(relay *r, const char *why) {
   static const char KIND[] = "front accept";
   unsigned long more = 0;
   if (srv_log_admit(r->f->opt.logger, KIND, why, &more))
-    fprintf(r->f->opt.log,
-            "kmorphd: accept failed: %s; pausing %g s (%lu more suppressed)\n",
-            why, ACCEPT_PAUSE, more);
+    srv_log_notice(
+        r->f->opt.log,
+        "kmorphd: accept failed: %s; pausing %g s (%lu more suppressed)\n", why,
+        ACCEPT_PAUSE, more);
   r->pause_until = srv_now() + ACCEPT_PAUSE;
 }
 
@@ -606,10 +614,10 @@ static int bind_listen(srv_front *f) {
     v6->sin6_port = htons((uint16_t)f->opt.port);
     len = sizeof *v6;
   } else {
-    fprintf(f->opt.log,
-            "kmorphd: --bind \"%s\" is not an IPv4 or IPv6 "
-            "address\n",
-            f->opt.bind);
+    srv_log_notice(f->opt.log,
+                   "kmorphd: --bind \"%s\" is not an IPv4 or IPv6 "
+                   "address\n",
+                   f->opt.bind);
     return -1;
   }
   int fd = socket(ss.ss_family, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
@@ -619,8 +627,8 @@ static int bind_listen(srv_front *f) {
     setsockopt(fd, IPPROTO_IPV6, IPV6_V6ONLY, &one, sizeof one);
   if (fd < 0 || bind(fd, (struct sockaddr *)&ss, len) != 0 ||
       listen(fd, 511) != 0) {
-    fprintf(f->opt.log, "kmorphd: cannot listen on %s port %u (%s)\n",
-            f->opt.bind, f->opt.port, strerror(errno));
+    srv_log_notice(f->opt.log, "kmorphd: cannot listen on %s port %u (%s)\n",
+                   f->opt.bind, f->opt.port, strerror(errno));
     if (fd >= 0) close(fd);
     return -1;
   }
@@ -661,14 +669,15 @@ int srv_front_start(srv_front *f, struct MHD_Daemon *d) {
     r->ep = epoll_create1(EPOLL_CLOEXEC);
     r->wake = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
     if (r->ep < 0 || r->wake < 0) {
-      fprintf(f->opt.log, "kmorphd: cannot create the relay's epoll set (%s)\n",
-              strerror(errno));
+      srv_log_notice(f->opt.log,
+                     "kmorphd: cannot create the relay's epoll set (%s)\n",
+                     strerror(errno));
       return -1;
     }
     struct epoll_event ev = {.events = EPOLLIN, .data.u64 = TAG_WAKE};
     epoll_ctl(r->ep, EPOLL_CTL_ADD, r->wake, &ev);
     if (pthread_create(&r->thread, NULL, relay_main, r) != 0) {
-      fprintf(f->opt.log, "kmorphd: cannot start a relay thread\n");
+      srv_log_notice(f->opt.log, "kmorphd: cannot start a relay thread\n");
       return -1;
     }
     r->started = true;

@@ -75,6 +75,7 @@ enum MHD_Result srv__serve_job(srv_req *r) {
   double progress =
       v.frames_total ? (double)v.frames_done / (double)v.frames_total : 0.0;
   if (v.state == SRV_JOB_DONE) progress = 1.0;
+  r->poll_hint = !srv_job_state_final(v.state);
   char err[600] = "";
   if (v.state == SRV_JOB_FAILED) {
     char esc[520];
@@ -92,6 +93,11 @@ enum MHD_Result srv__serve_job(srv_req *r) {
       v.frames_total, v.age, v.id, v.id, err);
 }
 
+/* A finished job's result is immutable: a client (a browser) may keep it
+ * a day without asking again; private, since only whoever holds the job
+ * id should see it. */
+#define RESULT_CACHE_CONTROL "private, max-age=86400, immutable"
+
 static void drop_result_ref(void *cls) {
   srv_result_unref(cls);
 }
@@ -100,29 +106,35 @@ static void drop_result_ref(void *cls) {
  * reference until libmicrohttpd has sent it, so a slow reader costs no
  * memory of its own and an eviction meanwhile frees nothing under it. */
 static enum MHD_Result answer_result(srv_req *r, srv_result *res) {
-  size_t len = srv_result_length(res);
-  struct MHD_Response *resp =
-      MHD_create_response_from_buffer_with_free_callback_cls(
-          len, (void *)srv_result_body(res), drop_result_ref, res);
-  if (resp == NULL) {
+  const char *type = srv_result_type(res);
+  if (!srv__accepts_type(r, type)) {
     srv_result_unref(res);
-    r->cut = "out of memory";
-    return MHD_NO;
+    return srv__not_acceptable(r, type);
   }
-  MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE,
-                          srv_result_type(res));
-  int status = srv_result_status(res);
-  return srv__queue(r, status, resp, len);
+  /* A job's result never changes: its id names the content, so the tag
+   * is the id (and the gzip form's another), with no hash of megabytes. */
+  char etag[SRV_JOB_ID_LEN + 3], gz_etag[SRV_JOB_ID_LEN + 6];
+  snprintf(etag, sizeof etag, "\"%s\"", r->job_id);
+  snprintf(gz_etag, sizeof gz_etag, "\"%s-gz\"", r->job_id);
+  srv_body b = {.type = type,
+                .data = srv_result_body(res),
+                .len = srv_result_length(res),
+                .stream_gzip = true,
+                .etag = etag,
+                .gz_etag = gz_etag,
+                .cache_control = RESULT_CACHE_CONTROL,
+                .release = drop_result_ref,
+                .cls = res};
+  return srv__answer_body(r, srv_result_status(res), &b);
 }
 
 enum MHD_Result srv__serve_result(srv_req *r) {
   srv_server *s = r->srv;
   srv_job_view v;
   srv_result *res = NULL;
-  int rc = s->rjobs != NULL
-               ? srv_rjobs_result(s->rjobs, r->job_id, &v, &res)
-               : s->store->ops->result(s->store, r->job_id, srv_now(), &v,
-                                       &res);
+  int rc = s->rjobs != NULL ? srv_rjobs_result(s->rjobs, r->job_id, &v, &res)
+                            : s->store->ops->result(s->store, r->job_id,
+                                                    srv_now(), &v, &res);
   if (rc == SRV_RJOBS_DOWN) return store_down(r);
   if (rc == SRV_RJOBS_NOMEM) {
     r->cut = "out of memory";

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "log.h"
 #include "util.h"
 
 typedef struct job {
@@ -28,7 +29,7 @@ struct srv_jobs {
   size_t live;
   size_t max_active;
   double job_time;
-  bool closed; /* shutting down: no new jobs */
+  bool closed;          /* shutting down: no new jobs */
   atomic_size_t frames; /* frames rendered, for /metrics */
   srv_jobstore *store;
 };
@@ -265,9 +266,9 @@ void srv_jobs_cancel_all(srv_jobs *j) {
     next = p->next;
     if (p->done < p->total && !p->cancelled && !p->failed && !p->finishing) {
       /* one line per job, so every accepted job is accounted for */
-      fprintf(stderr,
-              "kmorphd: job %s cancelled by shutdown (%zu/%zu frames)\n", p->id,
-              p->done, p->total);
+      srv_log_notice(stderr,
+                     "kmorphd: job %s cancelled by shutdown (%zu/%zu frames)\n",
+                     p->id, p->done, p->total);
       cancel_locked(j, p, now);
     }
     if (take_if_over(j, p)) {

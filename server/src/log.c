@@ -17,6 +17,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "util.h"
@@ -93,10 +94,51 @@ int srv_log_reopen(srv_log *l) {
   return rc;
 }
 
+/* Written once before threads start (srv_log_set_format), read after. */
+static srv_log_format log_format = SRV_LOG_KV;
+
+void srv_log_set_format(srv_log_format f) {
+  log_format = f;
+}
+
+bool srv_log_json(void) {
+  return log_format == SRV_LOG_JSON;
+}
+
+void srv_log_time(char *out, size_t cap) {
+  time_t now = time(NULL);
+  struct tm tm;
+  gmtime_r(&now, &tm);
+  strftime(out, cap, "%Y-%m-%dT%H:%M:%SZ", &tm);
+}
+
+static void notice_v(FILE *f, const char *fmt, va_list ap) {
+  if (log_format == SRV_LOG_KV) {
+    vfprintf(f, fmt, ap);
+    return;
+  }
+  char msg[1024], esc[2100], when[32];
+  vsnprintf(msg, sizeof msg, fmt, ap);
+  size_t n = strlen(msg);
+  while (n > 0 && msg[n - 1] == '\n') msg[--n] = '\0';
+  const char *m = strncmp(msg, "kmorphd: ", 9) == 0 ? msg + 9 : msg;
+  srv_json_escape(esc, sizeof esc, m);
+  srv_log_time(when, sizeof when);
+  fprintf(f, "{\"time\":\"%s\",\"level\":\"notice\",\"msg\":\"%s\"}\n", when,
+          esc);
+}
+
+void srv_log_notice(FILE *f, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  notice_v(f, fmt, ap);
+  va_end(ap);
+}
+
 void srv_log_printf(srv_log *l, const char *fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
-  vfprintf(l->stream, fmt, ap);
+  notice_v(l->stream, fmt, ap);
   va_end(ap);
 }
 
@@ -144,8 +186,8 @@ void srv_log_close(srv_log *l) {
   for (size_t i = 0; i < SRV_LOG_KINDS; i++) {
     const rl_slot *sl = &l->slots[i];
     if (sl->kind != NULL && sl->suppressed > 0)
-      fprintf(l->stream, "kmorphd: %lu more suppressed like \"%s\"\n",
-              sl->suppressed, sl->sample);
+      srv_log_notice(l->stream, "kmorphd: %lu more suppressed like \"%s\"\n",
+                     sl->suppressed, sl->sample);
   }
   pthread_mutex_unlock(&l->mu);
   fflush(l->stream);

@@ -47,9 +47,34 @@ const char *srv_log_path(const srv_log *l);
  * Thread-safe: concurrent writers are held off for the swap alone. */
 int srv_log_reopen(srv_log *l);
 
-/* printf one line (the caller supplies the newline) to the log. */
+/* printf one notice line (the caller supplies the newline) to the log,
+ * as srv_log_notice does. */
 void srv_log_printf(srv_log *l, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
+
+/* The shape of log lines: "key=value" text (the default) or one JSON
+ * object per line (--log-format=json, for log shippers). */
+typedef enum srv_log_format { SRV_LOG_KV, SRV_LOG_JSON } srv_log_format;
+
+/* Choose the shape of every log line of the process. The log is the
+ * process's stderr, so its shape is the process's too: call once at
+ * start-up, before any thread starts (threads only read it). */
+void srv_log_set_format(srv_log_format f);
+
+/* True when lines are JSON objects (for writers of structured lines: the
+ * access log). */
+bool srv_log_json(void);
+
+/* Write one notice (fmt formats a line ending in a newline, starting
+ * "kmorphd: " by custom) to f: as it is, or as {"time": ..., "level":
+ * "notice", "msg": ...} with the message JSON-escaped and the prefix and
+ * newline dropped. One fprintf, so lines from threads never interleave. */
+void srv_log_notice(FILE *f, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+
+/* The current UTC time as RFC 3339 ("2026-12-04T16:41:15Z") into out
+ * (at least 21 bytes). */
+void srv_log_time(char *out, size_t cap);
 
 /* Rate limit: may a message of this kind be written now? kind is any
  * stable pointer naming the kind (a format string). At most one message

@@ -26,6 +26,7 @@
 #include <unistd.h>
 
 #include "config.h"
+#include "cpus.h"
 #include "healthcheck.h"
 #include "log.h"
 #include "server.h"
@@ -148,13 +149,12 @@ int main(int argc, char **argv) {
   srv_config_default(&cfg);
   int rc = srv_config_load(&cfg, argc, argv, stdout, stderr);
   if (rc != 0) return rc > 0 ? 0 : 2;
-  if (cfg.workers == 0) {
-    long n = sysconf(_SC_NPROCESSORS_ONLN);
-    cfg.workers = n > 0 ? (unsigned)n : 1;
-  }
+  if (cfg.workers == 0) cfg.workers = srv_usable_cpus();
 
   sigset_t set;
   setup_signals(&set);
+  srv_log_set_format(strcmp(cfg.log_format, "json") == 0 ? SRV_LOG_JSON
+                                                         : SRV_LOG_KV);
   srv_log *log = srv_log_open(cfg.log_file, stderr);
   if (log == NULL) return 2;
   srv_server *srv = fit_connections_to_fds(&cfg, log) == 0

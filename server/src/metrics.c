@@ -20,12 +20,12 @@
 #endif
 
 static const char *const ROUTE_NAMES[SRV_R_COUNT] = {
-    "index",      "healthz",     "readyz", "metrics", "openapi",
-    "signature",  "reconstruct", "morph",  "jobs",    "job",
-    "job_result", "static",      "other"};
+    "index",      "healthz",     "readyz",  "metrics", "openapi",
+    "signature",  "reconstruct", "morph",   "jobs",    "job",
+    "job_result", "static",      "problem", "other"};
 
-static const int STATUSES[] = {200, 202, 204, 400, 404, 405, 406, 409,
-                               413, 415, 422, 429, 500, 503, 0};
+static const int STATUSES[] = {200, 202, 204, 304, 400, 404, 405, 406, 408, 409,
+                               410, 413, 415, 422, 429, 431, 500, 501, 503, 0};
 #define NSTATUS (sizeof STATUSES / sizeof STATUSES[0])
 
 static const double BUCKETS[] = {0.0005, 0.001, 0.0025, 0.005, 0.01,
@@ -40,9 +40,15 @@ static const char *const REASONS[] = {
     "body_memory", "result_memory", "connections_full"};
 #define NREASON (sizeof REASONS / sizeof REASONS[0])
 
+/* Methods as labels; the last counts every other method. */
+static const char *const METHODS[] = {"GET",    "HEAD",    "POST",
+                                      "DELETE", "OPTIONS", "other"};
+#define NMETHOD (sizeof METHODS / sizeof METHODS[0])
+
 struct srv_metrics {
   pthread_mutex_t mu;
-  unsigned long long count[SRV_R_COUNT][NSTATUS];
+  bool (*is_allowed)(srv_route route, const char *method);
+  unsigned long long count[SRV_R_COUNT][NMETHOD][NSTATUS];
   unsigned long long bucket[SRV_R_COUNT][NBUCKET];
   unsigned long long observed[SRV_R_COUNT];
   double sum[SRV_R_COUNT];
@@ -53,9 +59,12 @@ const char *srv_route_name(srv_route r) {
   return (unsigned)r < SRV_R_COUNT ? ROUTE_NAMES[r] : "other";
 }
 
-srv_metrics *srv_metrics_create(void) {
+srv_metrics *srv_metrics_create(bool (*is_allowed)(srv_route route,
+                                                   const char *method)) {
   srv_metrics *m = calloc(1, sizeof *m);
-  if (m) pthread_mutex_init(&m->mu, NULL);
+  if (m == NULL) return NULL;
+  pthread_mutex_init(&m->mu, NULL);
+  m->is_allowed = is_allowed;
   return m;
 }
 
@@ -65,14 +74,17 @@ void srv_metrics_destroy(srv_metrics *m) {
   free(m);
 }
 
-void srv_metrics_observe(srv_metrics *m, srv_route route, int status,
-                         double seconds) {
+void srv_metrics_observe(srv_metrics *m, srv_route route, const char *method,
+                         int status, double seconds) {
   if ((unsigned)route >= SRV_R_COUNT) route = SRV_R_OTHER;
+  size_t k = NMETHOD - 1;
+  for (size_t i = 0; i + 1 < NMETHOD; i++)
+    if (method != NULL && strcmp(method, METHODS[i]) == 0) k = i;
   size_t s = NSTATUS - 1;
   for (size_t i = 0; i + 1 < NSTATUS; i++)
     if (STATUSES[i] == status) s = i;
   pthread_mutex_lock(&m->mu);
-  m->count[route][s]++;
+  m->count[route][k][s]++;
   for (size_t b = 0; b < NBUCKET; b++)
     if (seconds <= BUCKETS[b]) m->bucket[route][b]++;
   m->observed[route]++;
@@ -121,25 +133,32 @@ static void put(buf *b, const char *fmt, ...) {
   }
 }
 
-/* Requests answered, by route and status (m->mu held). */
+/* Requests answered, by route, method and status code, with
+ * Prometheus' own label names (code, method); a route's allowed methods
+ * are rendered at zero from the start, so rate() and absent() work
+ * before the first request (m->mu held). */
 static void put_requests(buf *b, const srv_metrics *m) {
   put(b, "# HELP kmorph_http_requests_total HTTP requests answered, by "
-         "route and status.\n"
+         "route, method and status code.\n"
          "# TYPE kmorph_http_requests_total counter\n");
   for (int r = 0; r < SRV_R_COUNT; r++)
-    for (size_t s = 0; s < NSTATUS; s++)
-      if (m->count[r][s] > 0) {
+    for (size_t k = 0; k < NMETHOD; k++) {
+      bool known = r != SRV_R_OTHER && k + 1 < NMETHOD &&
+                   m->is_allowed != NULL &&
+                   m->is_allowed((srv_route)r, METHODS[k]);
+      for (size_t s = 0; s < NSTATUS; s++) {
+        if (m->count[r][k][s] == 0 && !(known && STATUSES[s] != 0)) continue;
+        char code[8];
         if (STATUSES[s] == 0)
-          put(b,
-              "kmorph_http_requests_total{route=\"%s\",status=\"other\"} "
-              "%llu\n",
-              ROUTE_NAMES[r], m->count[r][s]);
+          snprintf(code, sizeof code, "other");
         else
-          put(b,
-              "kmorph_http_requests_total{route=\"%s\",status=\"%d\"} "
-              "%llu\n",
-              ROUTE_NAMES[r], STATUSES[s], m->count[r][s]);
+          snprintf(code, sizeof code, "%d", STATUSES[s]);
+        put(b,
+            "kmorph_http_requests_total{route=\"%s\",method=\"%s\","
+            "code=\"%s\"} %llu\n",
+            ROUTE_NAMES[r], METHODS[k], code, m->count[r][k][s]);
       }
+    }
 }
 
 /* The duration histogram of every route seen (m->mu held). */

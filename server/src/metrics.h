@@ -7,6 +7,7 @@
 #ifndef SRV_METRICS_H
 #define SRV_METRICS_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 /* Routes as metric labels; a fixed set keeps label cardinality bounded
@@ -24,6 +25,7 @@ typedef enum srv_route {
   SRV_R_JOB,
   SRV_R_JOB_RESULT,
   SRV_R_STATIC,
+  SRV_R_PROBLEM,
   SRV_R_OTHER,
   SRV_R_COUNT
 } srv_route;
@@ -32,12 +34,17 @@ const char *srv_route_name(srv_route r);
 
 typedef struct srv_metrics srv_metrics;
 
-srv_metrics *srv_metrics_create(void);
+/* is_allowed(route, method) says which methods a route answers; their
+ * request counters are rendered from the start, at zero, for every
+ * status in the table (others appear once counted). */
+srv_metrics *srv_metrics_create(bool (*is_allowed)(srv_route route,
+                                                   const char *method));
 void srv_metrics_destroy(srv_metrics *m);
 
-/* Count one answered request. */
-void srv_metrics_observe(srv_metrics *m, srv_route route, int status,
-                         double seconds);
+/* Count one answered request: its route, method (GET, HEAD, POST,
+ * DELETE, OPTIONS; any other counts as "other") and status. */
+void srv_metrics_observe(srv_metrics *m, srv_route route, const char *method,
+                         int status, double seconds);
 
 /* Count a request refused to protect the daemon. reason is one of
  * "queue_full", "jobs_full", "body_memory", "result_memory",

@@ -10,6 +10,7 @@
 #include "compute.h"
 #include "endpoints.h"
 #include "framing.h"
+#include "problems.h"
 #include "reply.h"
 #include "route.h"
 #include "util.h"
@@ -77,10 +78,8 @@ static enum MHD_Result dispatch(srv_req *r) {
     return srv__answer(r, 200, SRV_JSON_TYPE, (char *)"{\"status\":\"ready\"}",
                        18, false);
   case SRV_R_METRICS: return srv__serve_metrics(r);
-  case SRV_R_OPENAPI: {
-    const char *doc = api_openapi_json();
-    return srv__answer(r, 200, SRV_JSON_TYPE, (char *)doc, strlen(doc), false);
-  }
+  case SRV_R_OPENAPI: return srv__serve_openapi(r);
+  case SRV_R_PROBLEM: return srv__serve_problem(r);
   case SRV_R_JOB: return srv__serve_job(r);
   case SRV_R_JOB_RESULT: return srv__serve_result(r);
   case SRV_R_SIGNATURE:
@@ -120,6 +119,7 @@ static enum MHD_Result on_headers(srv_req *r) {
     return srv__problem(r, 405, "/problems/method-not-allowed",
                         "Method not allowed", detail, NULL, NULL);
   }
+  if (!srv__acceptable(r)) return srv__not_acceptable(r, NULL);
   if (srv__route_is_compute(r->route)) {
     const char *ct = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND,
                                                  MHD_HTTP_HEADER_CONTENT_TYPE);

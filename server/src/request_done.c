@@ -29,6 +29,25 @@ static void log_access(srv_server *s, const srv_req *r, double dt,
   strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", &tm);
   char method[sizeof r->method];
   srv_http_log_token(method, sizeof method, r->method);
+  if (srv_log_json()) {
+    /* The path and method are printable already; escaped all the same,
+     * so a line is always one valid JSON object. */
+    char path[2 * sizeof r->path], m[2 * sizeof method];
+    srv_json_escape(path, sizeof path, r->path);
+    srv_json_escape(m, sizeof m, method);
+    char closed[160] = "";
+    if (why != NULL) {
+      char esc[120];
+      srv_json_escape(esc, sizeof esc, why);
+      snprintf(closed, sizeof closed, ",\"closed\":\"%s\"", esc);
+    }
+    fprintf(s->log,
+            "{\"time\":\"%s\",\"event\":\"access\",\"method\":\"%s\","
+            "\"path\":\"%s\",\"status\":%d,\"bytes\":%zu,"
+            "\"duration_ms\":%.3f,\"request_id\":\"%s\"%s}\n",
+            when, m, path, r->status, r->bytes, dt * 1e3, r->rid, closed);
+    return;
+  }
   fprintf(s->log,
           "%s access method=%s path=\"%s\" status=%d bytes=%zu "
           "duration_ms=%.3f request_id=%s%s%s%s\n",
@@ -53,7 +72,8 @@ void srv__on_completed(void *cls, struct MHD_Connection *c, void **req_cls,
   srv_watch_request_done(srv__req_conn(r), srv_now());
   double dt = srv_now() - r->t0;
   const char *why = closed_why(r, toe);
-  srv_metrics_observe(s->metrics, r->route, r->status ? r->status : 0, dt);
+  srv_metrics_observe(s->metrics, r->route, r->method,
+                      r->status ? r->status : 0, dt);
   if (s->cfg.access_log) log_access(s, r, dt, why);
   api_response_free(&r->resp);
   srv__body_release(r);

@@ -58,6 +58,13 @@ srv_route srv__route_parse(srv_req *r, const char *url) {
     if (strcmp(slash, "/result") == 0) return SRV_R_JOB_RESULT;
     return SRV_R_OTHER;
   }
+  const char *problems = "/problems/";
+  if (strncmp(url, problems, strlen(problems)) == 0) {
+    const char *name = url + strlen(problems);
+    if (!static_name_ok(name)) return SRV_R_OTHER;
+    snprintf(r->static_name, sizeof r->static_name, "%s", name);
+    return SRV_R_PROBLEM;
+  }
   if (url[0] == '/' && strchr(url + 1, '/') == NULL &&
       static_name_ok(url + 1)) {
     snprintf(r->static_name, sizeof r->static_name, "%s", url + 1);

@@ -11,7 +11,8 @@
 
 /* The route url names (origin form, or absolute form whose authority is
  * skipped). For /v1/jobs/{id}[/result] fills r->job_id; for a single
- * safe file name under "/" fills r->static_name. SRV_R_OTHER (a plain
+ * safe file name under "/", or a name under /problems/, fills
+ * r->static_name. SRV_R_OTHER (a plain
  * 404) for everything else, including job ids longer than
  * SRV_JOB_ID_LEN. */
 srv_route srv__route_parse(srv_req *r, const char *url);

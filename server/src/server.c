@@ -22,6 +22,7 @@
 #include <unistd.h>
 
 #include "request.h"
+#include "route.h"
 #include "server_internal.h"
 #include "util.h"
 
@@ -68,9 +69,10 @@ static void mhd_log(void *cls, const char *fmt, va_list ap) {
   unsigned long more = 0;
   if (srv_log_admit(s->logger, fmt, msg, &more)) {
     if (more > 0)
-      fprintf(s->log, "kmorphd: http: %s (%lu more suppressed)\n", msg, more);
+      srv_log_notice(s->log, "kmorphd: http: %s (%lu more suppressed)\n", msg,
+                     more);
     else
-      fprintf(s->log, "kmorphd: http: %s\n", msg);
+      srv_log_notice(s->log, "kmorphd: http: %s\n", msg);
   }
   if (strstr(fmt, "resource limit at FIRST") != NULL) srv_sleep(ACCEPT_PAUSE);
 }
@@ -88,7 +90,7 @@ static bool shared_jobs(srv_server *s) {
   char err[600];
   s->redis = srv_redis_create(s->cfg.jobs, err, sizeof err);
   if (s->redis == NULL) {
-    fprintf(s->log, "kmorphd: %s\n", err);
+    srv_log_notice(s->log, "kmorphd: %s\n", err);
     return false;
   }
   srv_rjobs_config rc = {.api = s->api,
@@ -102,8 +104,10 @@ static bool shared_jobs(srv_server *s) {
   s->rjobs = srv_rjobs_create(s->redis, &rc);
   if (s->rjobs == NULL) return false;
   if (!srv_redis_ping(s->redis))
-    fprintf(s->log, "kmorphd: jobs in Redis at %s, not reachable yet: "
-                    "retrying\n", srv_redis_name(s->redis));
+    srv_log_notice(s->log,
+                   "kmorphd: jobs in Redis at %s, not reachable yet: "
+                   "retrying\n",
+                   srv_redis_name(s->redis));
   return true;
 }
 
@@ -126,7 +130,9 @@ srv_server *srv_server_create(const srv_config *cfg, srv_log *logger) {
   s->api.max_frames_job = cfg->max_job_frames;
   s->api.max_samples = cfg->max_samples;
   s->api.max_output_bytes = cfg->max_output;
-  s->metrics = srv_metrics_create();
+  s->metrics = srv_metrics_create(srv__route_method_allowed);
+  s->statics = srv_static_cache_create();
+  atomic_init(&s->gz_streams, 0);
   srv_watch_limits wl = {.header_time = cfg->header_time,
                          .request_time = cfg->request_time,
                          .send_time = cfg->send_time,
@@ -145,20 +151,22 @@ srv_server *srv_server_create(const srv_config *cfg, srv_log *logger) {
     return NULL;
   }
   if (s->rjobs != NULL)
-    s->pool = srv_pool_create(cfg->workers, cfg->queue, srv_rjobs_work,
-                              s->rjobs);
+    s->pool =
+        srv_pool_create(cfg->workers, cfg->queue, srv_rjobs_work, s->rjobs);
   else
-    s->pool = s->jobs ? srv_pool_create(cfg->workers, cfg->queue,
-                                        srv_jobs_work, s->jobs)
+    s->pool = s->jobs ? srv_pool_create(cfg->workers, cfg->queue, srv_jobs_work,
+                                        s->jobs)
                       : NULL;
   /* Batches of shared jobs appear without a kick from this process. */
   if (s->pool != NULL && s->rjobs != NULL) {
     srv_pool_set_poll(s->pool, 0.02);
     srv_rjobs_set_yield(s->rjobs, yield_to_requests, s->pool);
   }
-  if (s->metrics == NULL || s->pool == NULL || s->watch == NULL) {
-    fprintf(s->log, "kmorphd: cannot create the compute pool (%u workers)\n",
-            cfg->workers);
+  if (s->metrics == NULL || s->pool == NULL || s->watch == NULL ||
+      s->statics == NULL) {
+    srv_log_notice(s->log,
+                   "kmorphd: cannot create the compute pool (%u workers)\n",
+                   cfg->workers);
     srv_server_destroy(s);
     return NULL;
   }
@@ -196,7 +204,7 @@ int srv_server_start(srv_server *s) {
       MHD_OPTION_NOTIFY_COMPLETED, &srv__on_completed, s,
       MHD_OPTION_URI_LOG_CALLBACK, &srv__on_uri, s, MHD_OPTION_END);
   if (s->daemon == NULL) {
-    fprintf(s->log, "kmorphd: cannot start the HTTP daemon\n");
+    srv_log_notice(s->log, "kmorphd: cannot start the HTTP daemon\n");
     return -1;
   }
   s->port = srv_front_port(s->front);
@@ -253,25 +261,26 @@ int srv_server_shutdown(srv_server *s) {
   if (s->rjobs != NULL) srv_rjobs_stop(s->rjobs);
   srv_pool_stop(s->pool);
   if (!wait_until(s, compute_idle, deadline)) {
-    fprintf(s->log,
-            "kmorphd: shutdown grace of %g s passed with %zu requests still "
-            "computing: stopping them\n",
-            s->cfg.shutdown_grace, (size_t)atomic_load(&s->suspended));
+    srv_log_notice(
+        s->log,
+        "kmorphd: shutdown grace of %g s passed with %zu requests still "
+        "computing: stopping them\n",
+        s->cfg.shutdown_grace, (size_t)atomic_load(&s->suspended));
     atomic_store(&s->abort_compute, true);
     deadline = srv_now() + ABORT_WAIT;
     if (!wait_until(s, compute_idle, deadline)) {
-      fprintf(s->log,
-              "kmorphd: %zu requests still computing %g s after being "
-              "stopped\n",
-              (size_t)atomic_load(&s->suspended), ABORT_WAIT);
+      srv_log_notice(s->log,
+                     "kmorphd: %zu requests still computing %g s after being "
+                     "stopped\n",
+                     (size_t)atomic_load(&s->suspended), ABORT_WAIT);
       return -1;
     }
   }
   /* Give answers already queued (or bodies still arriving) until the
    * deadline to complete; idle keep-alive connections do not count. */
   if (!wait_until(s, requests_done, deadline))
-    fprintf(s->log, "kmorphd: closing %zu unfinished requests\n",
-            (size_t)atomic_load(&s->inflight));
+    srv_log_notice(s->log, "kmorphd: closing %zu unfinished requests\n",
+                   (size_t)atomic_load(&s->inflight));
   MHD_stop_daemon(s->daemon);
   s->daemon = NULL;
   return 0;
@@ -285,13 +294,15 @@ void srv_server_destroy(srv_server *s) {
   if (s->rjobs != NULL) {
     size_t n = srv_rjobs_hand_back_all(s->rjobs);
     if (n > 0)
-      fprintf(s->log, "kmorphd: handed %zu batches of shared jobs back\n", n);
+      srv_log_notice(s->log,
+                     "kmorphd: handed %zu batches of shared jobs back\n", n);
   }
   srv_rjobs_destroy(s->rjobs);
   srv_redis_destroy(s->redis);
   srv_jobs_destroy(s->jobs);
   if (s->store) s->store->ops->destroy(s->store);
   srv_metrics_destroy(s->metrics);
+  srv_static_cache_destroy(s->statics);
   srv_watch_destroy(s->watch); /* after the HTTP daemon: it closes records */
   free(s);
 }

@@ -31,6 +31,7 @@
 #include "log.h"
 #include "metrics.h"
 #include "pool.h"
+#include "static_cache.h"
 #include "server.h"
 #include "watch.h"
 
@@ -57,6 +58,9 @@ struct srv_server {
   atomic_size_t suspended;   /* connections waiting for a worker */
   atomic_size_t inflight;    /* requests begun and not yet completed */
   atomic_size_t body_bytes;  /* buffers of request bodies held now */
+  srv_static_cache *statics; /* the page's files and the contract, with
+                              * entity tags and gzip forms (made once) */
+  atomic_size_t gz_streams;  /* answers being gzip-coded as sent (gzip.h) */
 };
 
 /* Where a request is in its life; srv_req.phase. */
@@ -113,6 +117,7 @@ typedef struct srv_req {
   bool must_close;        /* the framing was refused: no keep-alive */
   bool http11;            /* the client may be sent an interim 1xx */
   bool probed;            /* a FIN was seen and answered with a probe */
+  bool poll_hint;         /* a job not final: Retry-After says when to poll */
 } srv_req;
 
 /* The watch record of r's connection (NULL if it is not watched). */

@@ -7,25 +7,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "process_metrics.h"
 #include "reply.h"
 #include "util.h"
 
 /* ------------------------------------------------------------- files */
-
-static char *read_file(const char *path, size_t max, size_t *len) {
-  FILE *f = fopen(path, "rb");
-  if (f == NULL) return NULL;
-  char *buf = malloc(max + 1);
-  size_t n = buf ? fread(buf, 1, max + 1, f) : 0;
-  fclose(f);
-  if (buf == NULL || n > max) {
-    free(buf);
-    return NULL;
-  }
-  buf[n] = '\0';
-  *len = n;
-  return buf;
-}
 
 static const char *type_of(const char *name) {
   static const struct {
@@ -66,21 +52,55 @@ static const char INDEX_HTML[] =
     "<a href=\"/metrics\"><code>/metrics</code></a></li>\n"
     "</ul>\n</body></html>\n";
 
+/* The page's files and the contract carry no version in their names, so
+ * a cached copy is revalidated on every use: its entity tag makes that a
+ * 304 without a body. */
+#define STATIC_CACHE_CONTROL "no-cache"
+
+/* Answer with a cache entry (its reference is taken over). */
+static enum MHD_Result answer_static(srv_req *r, const srv_static *st) {
+  if (!srv__accepts_type(r, st->type)) {
+    srv_static_unref((void *)st);
+    return srv__not_acceptable(r, st->type);
+  }
+  srv_body b = {.type = st->type,
+                .data = st->body,
+                .len = st->len,
+                .gz = st->gz,
+                .gz_len = st->gz_len,
+                .etag = st->etag,
+                .gz_etag = st->gz ? st->gz_etag : NULL,
+                .cache_control = STATIC_CACHE_CONTROL,
+                .release = srv_static_unref,
+                .cls = (void *)st};
+  return srv__answer_body(r, 200, &b);
+}
+
 enum MHD_Result srv__serve_file(srv_req *r, const char *name) {
   const char *type = type_of(name);
   char path[1024];
-  size_t len = 0;
-  char *body = NULL;
+  const srv_static *st = NULL;
   if (type != NULL &&
       (size_t)snprintf(path, sizeof path, "%s/%s", r->srv->cfg.web_root, name) <
           sizeof path)
-    body = read_file(path, (size_t)16 << 20, &len);
-  if (body != NULL) return srv__answer(r, 200, type, body, len, true);
-  if (r->route == SRV_R_INDEX)
-    return srv__answer(r, 200, "text/html; charset=utf-8", (char *)INDEX_HTML,
-                       sizeof INDEX_HTML - 1, false);
+    st = srv_static_get(r->srv->statics, path, type, (size_t)16 << 20);
+  if (st == NULL && r->route == SRV_R_INDEX)
+    st = srv_static_get_const(r->srv->statics, ":index", type, INDEX_HTML,
+                              sizeof INDEX_HTML - 1);
+  if (st != NULL) return answer_static(r, st);
   return srv__problem(r, 404, "/problems/not-found", "Not found",
                       "no such resource", NULL, NULL);
+}
+
+enum MHD_Result srv__serve_openapi(srv_req *r) {
+  const char *doc = api_openapi_json();
+  const srv_static *st = srv_static_get_const(r->srv->statics, ":openapi",
+                                              SRV_JSON_TYPE, doc, strlen(doc));
+  if (st == NULL) {
+    r->cut = "out of memory";
+    return MHD_NO;
+  }
+  return answer_static(r, st);
 }
 
 /* ----------------------------------------------------------- metrics */
@@ -118,6 +138,16 @@ enum MHD_Result srv__serve_metrics(srv_req *r) {
   size_t len = 0;
   char *text = srv_metrics_render(s->metrics, &g, &len);
   if (text == NULL) return MHD_NO;
+  char proc[2048];
+  size_t plen = srv_process_metrics(proc, sizeof proc);
+  char *all = realloc(text, len + plen + 1);
+  if (all == NULL) {
+    free(text);
+    return MHD_NO;
+  }
+  memcpy(all + len, proc, plen + 1);
+  text = all;
+  len += plen;
   return srv__answer(r, 200, "text/plain; version=0.0.4; charset=utf-8", text,
                      len, true);
 }

@@ -8,6 +8,7 @@
 #include <sys/socket.h>
 #include <time.h>
 
+#include "log.h"
 #include "util.h"
 
 typedef enum conn_phase {
@@ -38,32 +39,44 @@ struct srv_watch {
   FILE *log;
   bool stopping;
   size_t late_request, late_send;
-  char late[512];
-  size_t late_len;
   pthread_t thread;
 };
 
-/* The 408 written on a socket whose request is late: made once, since it
- * is written from the sweep with nothing of the request known. */
+/* The 408 written on a socket whose request is late, with a request id
+ * of its own (nothing of the request is known): also in X-Request-Id and
+ * the problem's instance, as for every other problem. */
 static int late_text(char *out, size_t cap) {
-  static const char body[] =
-      "{\"type\":\"/problems/request-timeout\",\"title\":\"Request timeout\","
-      "\"status\":408,\"detail\":\"the request did not arrive within the "
-      "time allowed to send it (KMORPH_HEADER_TIME for the header, "
-      "KMORPH_REQUEST_TIME for the whole request)\"}";
+  char rid[17];
+  srv_random_hex(rid, 16);
+  char body[400];
+  int bn = snprintf(
+      body, sizeof body,
+      "{\"type\":\"/problems/request-timeout\",\"title\":\"Request "
+      "timeout\",\"status\":408,\"detail\":\"the request did not arrive "
+      "within the time allowed to send it (KMORPH_HEADER_TIME for the "
+      "header, KMORPH_REQUEST_TIME for the whole request)\",\"request_id\":"
+      "\"%s\",\"instance\":\"urn:kmorph:request:%s\"}",
+      rid, rid);
+  if (bn < 0 || (size_t)bn >= sizeof body) return 0;
   return snprintf(out, cap,
                   "HTTP/1.1 408 Request Timeout\r\n"
                   "Content-Type: application/problem+json\r\n"
                   "Connection: close\r\n"
                   "Cache-Control: no-store\r\n"
-                  "Content-Length: %zu\r\n"
+                  "X-Request-Id: %s\r\n"
+                  "Content-Length: %d\r\n"
                   "\r\n%s",
-                  sizeof body - 1, body);
+                  rid, bn, body);
 }
 
 static void cut(srv_watch *w, srv_conn *c, bool answer) {
   if (answer) {
-    ssize_t n = send(c->fd, w->late, w->late_len, MSG_NOSIGNAL | MSG_DONTWAIT);
+    char late[640];
+    int len = late_text(late, sizeof late);
+    ssize_t n =
+        len > 0 && (size_t)len < sizeof late
+            ? send(c->fd, late, (size_t)len, MSG_NOSIGNAL | MSG_DONTWAIT)
+            : 0;
     (void)n; /* a full send buffer: the client is not reading anyway */
     w->late_request++;
   } else {
@@ -87,10 +100,11 @@ static void sweep(srv_watch *w, double now) {
       sends++;
   }
   if ((requests > 0 || sends > 0) && w->log != NULL)
-    fprintf(w->log,
-            "kmorphd: cut %zu connections whose request was late (408) and "
-            "%zu whose answer was not read in time\n",
-            requests, sends);
+    srv_log_notice(
+        w->log,
+        "kmorphd: cut %zu connections whose request was late (408) and "
+        "%zu whose answer was not read in time\n",
+        requests, sends);
 }
 
 static void *sweeper(void *arg) {
@@ -116,7 +130,6 @@ srv_watch *srv_watch_create(const srv_watch_limits *limits, FILE *log) {
   if (w == NULL) return NULL;
   w->lim = *limits;
   w->log = log;
-  w->late_len = (size_t)late_text(w->late, sizeof w->late);
   pthread_mutex_init(&w->mu, NULL);
   pthread_cond_init(&w->cv, NULL);
   if (pthread_create(&w->thread, NULL, sweeper, w) != 0) {

@@ -21,7 +21,9 @@ TWO_PI = 2 * math.pi
 class OperationsEndpoints(ContractCase):
     @classmethod
     def setUpClass(cls):
-        cls.d = Daemon("--threads", "2", "--max-body", "4096")
+        # CORS is off by default: the CORS tests here configure any origin.
+        cls.d = Daemon("--threads", "2", "--max-body", "4096",
+                       "--cors-origins", "*")
 
     @classmethod
     def tearDownClass(cls):
@@ -73,10 +75,12 @@ class OperationsEndpoints(ContractCase):
             self.assertIn("# TYPE %s %s" % (family, kind), text)
         self.assertGreaterEqual(metric(text, "kmorph_http_requests_total",
                                        {"route": "healthz",
-                                        "status": "200"}), 1)
+                                        "method": "GET",
+                                        "code": "200"}), 1)
         self.assertGreaterEqual(metric(text, "kmorph_http_requests_total",
                                        {"route": "other",
-                                        "status": "404"}), 1)
+                                        "method": "GET",
+                                        "code": "404"}), 1)
         self.assertEqual(metric(text, "kmorph_workers"), 2)
         # A histogram's buckets are cumulative and end with the count.
         inf = metric(text, "kmorph_http_request_duration_seconds_bucket",

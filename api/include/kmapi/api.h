@@ -168,7 +168,6 @@ void api_morph_plan_free(api_morph_plan *plan);
 /* The contract itself, as JSON (GET /openapi.json); static string. */
 const char *api_openapi_json(void);
 
-
 /* ---- a prepared morph's frames apart (for daemons sharing one job's
  * frames between processes; api/src/morph_frames.c). */
 
