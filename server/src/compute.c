@@ -348,12 +348,7 @@ enum MHD_Result srv__hand_off(srv_req *r) {
                         NULL, NULL);
   if (r->route == SRV_R_JOBS && s->rjobs != NULL && !srv_rjobs_up(s->rjobs) &&
       !srv_rjobs_ready(s->rjobs))
-    return srv__problem(r, 503, "/problems/job-store-unavailable",
-                        "Job store unavailable",
-                        "the job store (Redis, KMORPH_JOBS) cannot be reached "
-                        "now; synchronous routes still answer; retry after "
-                        "the time in Retry-After",
-                        NULL, NULL);
+    return srv__answer_store_down(r);
   if (r->route == SRV_R_JOBS && srv_jobs_full(s->jobs)) {
     srv_metrics_reject(s->metrics, "jobs_full");
     return srv__problem(r, 429, "/problems/too-many-jobs", "Too many jobs",

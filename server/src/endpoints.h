@@ -38,5 +38,7 @@ enum MHD_Result srv__serve_result(srv_req *r);
 /* The 503 problem (into *out; the caller frees) of a job route while the
  * shared job store (--jobs, Redis) cannot be reached; rid may be NULL. */
 void srv__store_unavailable(api_response *out, const char *rid);
+/* The same problem as the answer to r. */
+enum MHD_Result srv__answer_store_down(srv_req *r);
 
 #endif

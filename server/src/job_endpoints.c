@@ -23,29 +23,27 @@ static enum MHD_Result job_missing(srv_req *r, int rc, const srv_job_view *v) {
                       "no such job", NULL, NULL);
 }
 
+#define STORE_DOWN_TYPE "/problems/job-store-unavailable"
+#define STORE_DOWN_TITLE "Job store unavailable"
+#define STORE_DOWN_DETAIL                                                      \
+  "the job store (Redis, KMORPH_JOBS) cannot be reached now; synchronous "     \
+  "routes still answer; retry after the time in Retry-After"
+
 void srv__store_unavailable(api_response *out, const char *rid) {
-  api_problem(out, 503, "/problems/job-store-unavailable",
-              "Job store unavailable",
-              "the job store (Redis, KMORPH_JOBS) cannot be reached now; "
-              "synchronous routes still answer; retry after the time in "
-              "Retry-After",
+  api_problem(out, 503, STORE_DOWN_TYPE, STORE_DOWN_TITLE, STORE_DOWN_DETAIL,
               NULL, NULL, rid);
 }
 
-static enum MHD_Result store_down(srv_req *r) {
-  return srv__problem(r, 503, "/problems/job-store-unavailable",
-                      "Job store unavailable",
-                      "the job store (Redis, KMORPH_JOBS) cannot be reached "
-                      "now; synchronous routes still answer; retry after the "
-                      "time in Retry-After",
-                      NULL, NULL);
+enum MHD_Result srv__answer_store_down(srv_req *r) {
+  return srv__problem(r, 503, STORE_DOWN_TYPE, STORE_DOWN_TITLE,
+                      STORE_DOWN_DETAIL, NULL, NULL);
 }
 
 static enum MHD_Result delete_job(srv_req *r) {
   srv_server *s = r->srv;
   if (s->rjobs != NULL) {
     int rc = srv_rjobs_delete(s->rjobs, r->job_id);
-    if (rc == SRV_RJOBS_DOWN) return store_down(r);
+    if (rc == SRV_RJOBS_DOWN) return srv__answer_store_down(r);
     if (rc == 0) return srv__answer(r, 204, NULL, (char *)"", 0, false);
     return srv__problem(r, 404, "/problems/job-not-found", "Job not found",
                         "no such job (finished jobs are forgotten after a "
@@ -70,7 +68,7 @@ enum MHD_Result srv__serve_job(srv_req *r) {
   if (strcmp(r->method, "DELETE") == 0) return delete_job(r);
   int rc = s->rjobs != NULL ? srv_rjobs_get(s->rjobs, r->job_id, &v)
                             : s->store->ops->get(s->store, r->job_id, now, &v);
-  if (rc == SRV_RJOBS_DOWN) return store_down(r);
+  if (rc == SRV_RJOBS_DOWN) return srv__answer_store_down(r);
   if (rc != SRV_STORE_OK) return job_missing(r, rc, &v);
   double progress =
       v.frames_total ? (double)v.frames_done / (double)v.frames_total : 0.0;
@@ -135,7 +133,7 @@ enum MHD_Result srv__serve_result(srv_req *r) {
   int rc = s->rjobs != NULL ? srv_rjobs_result(s->rjobs, r->job_id, &v, &res)
                             : s->store->ops->result(s->store, r->job_id,
                                                     srv_now(), &v, &res);
-  if (rc == SRV_RJOBS_DOWN) return store_down(r);
+  if (rc == SRV_RJOBS_DOWN) return srv__answer_store_down(r);
   if (rc == SRV_RJOBS_NOMEM) {
     r->cut = "out of memory";
     return MHD_NO;
