@@ -47,10 +47,50 @@ static const char *crossing_reason(const km_morph_avoidance *a, bool single,
   if (single && a->input_crossings[0] > 0) return "from crosses itself";
   if (single && a->input_crossings[1] > 0) return "to crosses itself";
   if (!single) return "contours of the frames cross themselves or each other";
-  if (!a->searched)
-    return "the frames cross between the previewed times (t = k/8)";
+  if (a->repair_unrepaired > 0)
+    return "strands cross that pass through each other between frames "
+           "that do not cross: no repair separates them";
+  if (a->repair_events > 0) return "the repair did not separate every crossing";
+  if (a->repair_scan_crossing == 0)
+    return "the frames cross between the scanned times (t = k/32)";
   return "no start point or choice of matches the morph is free to make "
          "avoids the crossing";
+}
+
+/* "repaired_frames" (the frames the repair moved, with the largest
+ * displacement of each) and "repair" (what the scan found and did). */
+static bool add_repair(api_ctx *ctx, cJSON *o, const api_morph_plan *pl,
+                       const km_morph_avoidance *a) {
+  cJSON *list = cJSON_CreateArray(), *r = cJSON_CreateObject();
+  if (list == NULL || r == NULL) {
+    cJSON_Delete(list);
+    cJSON_Delete(r);
+    return api__oom(ctx);
+  }
+  if (!api__add_item(ctx, o, "repaired_frames", list)) {
+    cJSON_Delete(r);
+    return false;
+  }
+  if (!api__add_item(ctx, o, "repair", r)) return false;
+  bool ok = true;
+  for (size_t i = 0; ok && i < pl->nframes; i++) {
+    double moved = km_morph_repaired(pl->morph, pl->frames[i].t);
+    if (!(moved > 0)) continue;
+    cJSON *f = cJSON_CreateObject();
+    if (f == NULL || !cJSON_AddItemToArray(list, f)) {
+      cJSON_Delete(f);
+      return api__oom(ctx);
+    }
+    ok = api__add_num(ctx, f, "frame", (double)i) &&
+         api__add_num(ctx, f, "displacement", moved);
+  }
+  return ok &&
+         api__add_num(ctx, r, "scan_crossing_frames",
+                      (double)a->repair_scan_crossing) &&
+         api__add_num(ctx, r, "events", (double)a->repair_events) &&
+         api__add_num(ctx, r, "unrepaired", (double)a->repair_unrepaired) &&
+         api__add_num(ctx, r, "checks_crossing",
+                      (double)a->repair_checks_crossing);
 }
 
 cJSON *api__intersections_json(api_ctx *ctx, const api_morph_plan *pl) {
@@ -86,6 +126,7 @@ cJSON *api__intersections_json(api_ctx *ctx, const api_morph_plan *pl) {
                     (double)a.crossings_before) &&
        api__add_num(ctx, o, "preview_crossings_after",
                     (double)a.crossings_after);
+  if (ok && !pl->shapes) ok = add_repair(ctx, o, pl, &a);
   if (ok) return o;
   cJSON_Delete(o);
   return NULL;

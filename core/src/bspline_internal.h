@@ -74,5 +74,10 @@ km_status km__curve_transform_in_place(struct km_curve *c, double rot,
 /* km_curve_self_intersections with the caller's poll: -1 also when
  * stopped (then poll->stopped). */
 long km__self_intersections(const km_curve *c, double tol, km__poll *poll);
+/* The same count, with the crossings' parameters: *hits (when hits is not
+ * NULL) receives an array of count pairs (ta, tb), ta < tb, owned by the
+ * caller (km__free; NULL when there are none or on -1). */
+long km__self_intersection_params(const km_curve *c, double tol, km__poll *poll,
+                                  double **hits);
 
 #endif

@@ -497,6 +497,12 @@ static void sweep_pairs(ctx *x, seg **order) {
 }
 
 long km__self_intersections(const km_curve *c, double tol, km__poll *poll) {
+  return km__self_intersection_params(c, tol, poll, NULL);
+}
+
+long km__self_intersection_params(const km_curve *c, double tol, km__poll *poll,
+                                  double **hits) {
+  if (hits) *hits = NULL;
   if (!c || !c->knots || !c->cp || c->degree < KM_MIN_DEGREE ||
       c->degree > KM_MAX_DEGREE || c->n < (size_t)c->degree + 1)
     return -1;
@@ -539,6 +545,10 @@ long km__self_intersections(const km_curve *c, double tol, km__poll *poll) {
   sweep_pairs(&x, order);
   if (x.oom) goto cleanup;
   result = (long)x.nhit;
+  if (hits) {
+    *hits = x.hits;
+    x.hits = NULL;
+  }
 cleanup:
   km__free(order);
   km__free(x.segs);

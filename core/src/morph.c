@@ -28,6 +28,7 @@
 #include "morph_match.h"
 #include "morph_place.h"
 #include "morph_plan.h"
+#include "signature_internal.h"
 
 void km_morph_options_default(km_morph_options *o) {
   memset(o, 0, sizeof *o);
@@ -50,6 +51,7 @@ void km_morph_free(km_morph *m) {
   km__free(m->rb);
   km__frame_plan_free(m->plan);
   km__free(m->place_ab);
+  km__repair_free(m->repair);
   km__free(m);
 }
 
@@ -387,8 +389,19 @@ km_status km_morph_create(km_morph **out, const km_morph_input *from,
     return km__stopped(err);
   }
   if (!st && opt->intersections == KM_INTERSECTIONS_AVOID &&
-      opt->method == KM_METHOD_CURVATURE)
+      opt->method == KM_METHOD_CURVATURE) {
     st = km__avoid_crossings(&m, &poll);
+    /* an input that crosses itself is not repaired: its frames must
+     * cross near it */
+    if (!st && m->avoid.input_crossings[0] == 0 &&
+        m->avoid.input_crossings[1] == 0) {
+      st = km__repair_crossings(m, &poll);
+      if (st) { /* the avoidance frees its morphs on failure; so here */
+        km_morph_free(m);
+        m = NULL;
+      }
+    }
+  }
   if (poll.stopped || st == KM_ECANCELLED) {
     km_morph_free(m);
     return km__stopped(err);
@@ -562,7 +575,7 @@ static km_status planned_frame_with_metrics(const km_morph *m, double t,
   return st;
 }
 
-static km_status frame_impl(const km_morph *m, double t, km__poll *poll,
+static km_status frame_base(const km_morph *m, double t, km__poll *poll,
                             km_curve *out, km_frame_metrics *metrics,
                             km_signature *sig_out, km_error *err) {
   if (!(t >= 0.0 && t <= 1.0))
@@ -610,6 +623,49 @@ done:
   return st;
 }
 
+/* The metrics and signature of a repaired frame f, measured on f (the
+ * blend describes the frame before the repair). The closure gap is the
+ * blend's: the repair moves neither end. */
+static km_status repaired_metrics(const km_morph *m, const km_curve *f,
+                                  km__poll *poll, km_frame_metrics *metrics,
+                                  km_signature *sig_out, km_error *err) {
+  km_signature sig;
+  km_signature_init(&sig);
+  km_status st = km__signature_compute(f, m->tol, 1e-5, poll, &sig, err);
+  if (!st && metrics) {
+    metrics->length = sig.length;
+    metrics->max_abs_kappa = km_signature_max_abs_kappa(&sig);
+    metrics->bending_energy = km_signature_bending_energy(&sig);
+    metrics->self_intersections = km__self_intersections(f, m->tol, poll);
+    if (poll && poll->stopped) st = km__stopped(err);
+    if (!st && metrics->self_intersections < 0)
+      st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  }
+  if (!st && sig_out) {
+    km_signature_free(sig_out);
+    *sig_out = sig;
+    km_signature_init(&sig);
+  }
+  km_signature_free(&sig);
+  return st;
+}
+
+static km_status frame_impl(const km_morph *m, double t, km__poll *poll,
+                            km_curve *out, km_frame_metrics *metrics,
+                            km_signature *sig_out, km_error *err) {
+  km_status st = frame_base(m, t, poll, out, metrics, sig_out, err);
+  if (st || !km__repair_active(m->repair, t)) return st;
+  double moved;
+  st = km__repair_apply(m->repair, t, out, &moved, err);
+  if (!st && (metrics || sig_out))
+    st = repaired_metrics(m, out, poll, metrics, sig_out, err);
+  if (st) {
+    km_curve_free(out);
+    if (sig_out) km_signature_free(sig_out);
+  }
+  return st;
+}
+
 km_status km_morph_frame_points(const km_morph *m, double t,
                                 km_frame_parts parts, const km_stop *stop,
                                 size_t *points, km_error *err) {
@@ -620,8 +676,9 @@ km_status km_morph_frame_points(const km_morph *m, double t,
     *points = m->lin[0].n;
     return KM_OK;
   }
+  size_t extra = km__repair_extra_points(m->repair, t);
   if (m->plan && parts != KM_FRAME_WITH_SIGNATURE) {
-    *points = km__frame_plan_points(m->plan);
+    *points = km__frame_plan_points(m->plan) + extra;
     return KM_OK;
   }
   km__poll poll;
@@ -634,6 +691,6 @@ km_status km_morph_frame_points(const km_morph *m, double t,
     st = km__reconstruct(&sig, m->opt.degree, 0.9 * m->tol, m->opt.max_points,
                          &poll, NULL, NULL, &n, err);
   km_signature_free(&sig);
-  if (!st) *points = n;
+  if (!st) *points = n + extra;
   return st;
 }

@@ -28,6 +28,8 @@
 /* Starts of a closed `to` tried, best aligned first (km__best_shifts). */
 #define KM__SHIFT_CANDIDATES 4
 
+typedef struct km__repair km__repair;
+
 /* One input of a morph, made ready (km__input_prepare). */
 typedef struct km__input {
   km_curve curve;
@@ -56,6 +58,7 @@ struct km_morph {
   double (*place_ab)[5];
   double place_w_sum, place_qa[2], place_qb[2];
   km_morph_avoidance avoid; /* what intersections AVOID did */
+  km__repair *repair;       /* frames repaired (morph_repair.c), or NULL */
   /* the caller's stop condition while km_morph_create runs, NULL after:
    * frames take their own (km_morph_frame_until) */
   km__poll *poll;
@@ -117,6 +120,22 @@ km_status km__morph_frame(const km_morph *m, double t, km__poll *poll,
  * freed) and its avoid report filled. KM_OK, KM_ENOMEM or KM_ECANCELLED
  * (then every morph is freed and *mp is NULL). */
 km_status km__avoid_crossings(km_morph **mp, km__poll *poll);
+
+/* intersections AVOID, second step (morph_repair.c): frames at k / 32
+ * are scanned for crossings and the strands that cross are moved apart by
+ * a displacement smooth in t, kept in m->repair (NULL when nothing
+ * crosses) with the report in m->avoid. KM_OK, KM_ENOMEM or
+ * KM_ECANCELLED (then m is as it was). */
+km_status km__repair_crossings(km_morph *m, km__poll *poll);
+void km__repair_free(km__repair *rp);
+/* Whether the repair moves the frame at t. */
+bool km__repair_active(const km__repair *rp, double t);
+/* Control points the repair adds to the frame at t, at most. */
+size_t km__repair_extra_points(const km__repair *rp, double t);
+/* *f (the frame at t, placed) moved by the repair at t; *moved_by
+ * receives a bound on the displacement. KM_OK or KM_ENOMEM (err). */
+km_status km__repair_apply(const km__repair *rp, double t, km_curve *f,
+                           double *moved_by, km_error *err);
 
 /* Other starts of b: in each of nsec (>= 2) equal sectors of its length
  * but the one centred on its own start, the start that aligns best with a

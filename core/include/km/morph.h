@@ -237,7 +237,20 @@ typedef struct km_morph_avoidance {
   long crossings_after;    /* of the choice kept (0: none seen) */
   long input_crossings[2]; /* self-crossings of from and to themselves */
   size_t previews;         /* preview frames built */
+  /* the repair (frames that still cross after the choice): frames of the
+   * scan at t = k / 32 that crossed, events (pinches) repaired, events
+   * that could not be (their strands pass through each other between
+   * clean frames), and checks between the key times that still cross */
+  long repair_scan_crossing;
+  long repair_events;
+  long repair_unrepaired;
+  long repair_checks_crossing;
 } km_morph_avoidance;
+
+/* Whether the frame at t is repaired (moved by a displacement that
+ * separates strands that would cross), and by how much at most (the
+ * displacement's largest size, 0 when not repaired). */
+KM_API double km_morph_repaired(const km_morph *m, double t);
 
 /* The report of km_morph_create's avoidance into *out (all zero when
  * intersections was ALLOW or the inputs are not curvature-morphed). */
