@@ -22,6 +22,9 @@
 #include "num_print.h"
 #include "svg.h"
 
+/* The precision api/openapi.yaml promises for a curve's `length`. */
+#define LENGTH_REL_TOL 1e-12
+
 cJSON *api__number(double v) {
   char buf[API_NUM_PRINT_MAX];
   api__num_print(buf, v);
@@ -120,7 +123,7 @@ cJSON *api__curve_json(api_ctx *ctx, const km_curve *c, bool svg_d,
     api__oom(ctx);
     goto fail;
   }
-  length = km_curve_length(c);
+  length = km_curve_length_within(c, LENGTH_REL_TOL);
   if (!api__add_num(ctx, o, "length", length)) goto fail;
   if (svg_d) {
     /* Default tolerance as everywhere: 1e-5 of the curve's length. */
@@ -350,7 +353,7 @@ bool api__json_curve(api_ctx *ctx, api_svg_buf *b, const km_curve *c,
   else
     API_JSON_LIT(b, ",\"closed\":false,\"length\":");
   /* the length of the curve as printed, which the contract promises */
-  length = km_curve_length(&printed);
+  length = km_curve_length_within(&printed, LENGTH_REL_TOL);
   if (!api__json_num(ctx, b, length, "length")) goto done;
   if (svg_d) {
     /* Default tolerance as everywhere: 1e-5 of the curve's length. */
