@@ -254,7 +254,8 @@ bool api__json_nums(api_ctx *ctx, api_svg_buf *b, const double *v, size_t n,
   /* the whole array's room at once: a number, its comma or bracket */
   char *at = api__svg_buf_room(b, 2 + count * (API_NUM_PRINT_MAX + 2));
   if (at == NULL) return true;
-  char *p = at;
+  char *p = at, *last = NULL;
+  size_t last_len = 0;
   *p++ = '[';
   for (size_t i = 0; i < count; i++) {
     if (!isfinite(v[i])) {
@@ -267,7 +268,15 @@ bool api__json_nums(api_ctx *ctx, api_svg_buf *b, const double *v, size_t n,
     } else if (i > 0) {
       *p++ = ',';
     }
-    p += api__num_print(p, v[i]);
+    /* a number the same as the one before (every knot of a Hermite
+     * frame is double, the ends' are fourfold) is copied, not printed
+     * again: the same bits, the same digits */
+    if (stride == 1 && i > 0 && memcmp(&v[i], &v[i - 1], sizeof *v) == 0)
+      memcpy(p, last, last_len);
+    else
+      last_len = api__num_print(p, v[i]);
+    last = p;
+    p += last_len;
     if (stride == 2 && i % 2 == 1) *p++ = ']';
   }
   *p++ = ']';
