@@ -22,6 +22,9 @@
 #include "num_print.h"
 #include "svg.h"
 
+/* The precision api/openapi.yaml promises for a curve's `length`. */
+#define LENGTH_REL_TOL 1e-12
+
 cJSON *api__number(double v) {
   char buf[API_NUM_PRINT_MAX];
   api__num_print(buf, v);
@@ -120,7 +123,7 @@ cJSON *api__curve_json(api_ctx *ctx, const km_curve *c, bool svg_d,
     api__oom(ctx);
     goto fail;
   }
-  length = km_curve_length(c);
+  length = km_curve_length_within(c, LENGTH_REL_TOL);
   if (!api__add_num(ctx, o, "length", length)) goto fail;
   if (svg_d) {
     /* Default tolerance as everywhere: 1e-5 of the curve's length. */
@@ -251,7 +254,8 @@ bool api__json_nums(api_ctx *ctx, api_svg_buf *b, const double *v, size_t n,
   /* the whole array's room at once: a number, its comma or bracket */
   char *at = api__svg_buf_room(b, 2 + count * (API_NUM_PRINT_MAX + 2));
   if (at == NULL) return true;
-  char *p = at;
+  char *p = at, *last = NULL;
+  size_t last_len = 0;
   *p++ = '[';
   for (size_t i = 0; i < count; i++) {
     if (!isfinite(v[i])) {
@@ -264,7 +268,15 @@ bool api__json_nums(api_ctx *ctx, api_svg_buf *b, const double *v, size_t n,
     } else if (i > 0) {
       *p++ = ',';
     }
-    p += api__num_print(p, v[i]);
+    /* a number the same as the one before (every knot of a Hermite
+     * frame is double, the ends' are fourfold) is copied, not printed
+     * again: the same bits, the same digits */
+    if (stride == 1 && i > 0 && memcmp(&v[i], &v[i - 1], sizeof *v) == 0)
+      memcpy(p, last, last_len);
+    else
+      last_len = api__num_print(p, v[i]);
+    last = p;
+    p += last_len;
     if (stride == 2 && i % 2 == 1) *p++ = ']';
   }
   *p++ = ']';
@@ -350,7 +362,7 @@ bool api__json_curve(api_ctx *ctx, api_svg_buf *b, const km_curve *c,
   else
     API_JSON_LIT(b, ",\"closed\":false,\"length\":");
   /* the length of the curve as printed, which the contract promises */
-  length = km_curve_length(&printed);
+  length = km_curve_length_within(&printed, LENGTH_REL_TOL);
   if (!api__json_num(ctx, b, length, "length")) goto done;
   if (svg_d) {
     /* Default tolerance as everywhere: 1e-5 of the curve's length. */

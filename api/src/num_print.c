@@ -98,9 +98,18 @@ static const uint64_t pow10_u64[20] = {1u,
                                        10000000000000000000u};
 
 static int count_digits(uint64_t d) {
+#if defined(__GNUC__)
+  /* from the bit length: 1233 / 2^12 is just above log10(2), so t is the
+   * digit count of the lowest number of that many bits, less one, or the
+   * count itself; one comparison tells */
+  if (d == 0) return 1;
+  int t = ((64 - __builtin_clzll(d)) * 1233) >> 12;
+  return t + 1 - (d < pow10_u64[t] ? 1 : 0);
+#else
   int n = 1;
   while (n < 20 && d >= pow10_u64[n]) n++;
   return n;
+#endif
 }
 
 static api_decimal normalised(uint64_t digits, int exp10) {
@@ -173,20 +182,37 @@ static const char two_digits[201] = "00010203040506070809"
                                     "80818283848586878889"
                                     "90919293949596979899";
 
-/* The n decimal digits of d into out[0 .. n). */
+/* The 8 digits of d < 10^8, leading zeros included, into out[0 .. 8):
+ * two at a time, in 32-bit arithmetic */
+static void put_8_digits(char *out, uint32_t d) {
+  uint32_t hi = d / 10000, lo = d % 10000;
+  memcpy(out, &two_digits[2 * (hi / 100)], 2);
+  memcpy(out + 2, &two_digits[2 * (hi % 100)], 2);
+  memcpy(out + 4, &two_digits[2 * (lo / 100)], 2);
+  memcpy(out + 6, &two_digits[2 * (lo % 100)], 2);
+}
+
+/* The n decimal digits of d into out[0 .. n): eight at a time from the
+ * end while more than eight are left (a 64-bit division each), the rest
+ * two at a time in 32 bits. */
 static void put_digits(char *out, uint64_t d, int n) {
   char *p = out + n;
-  while (d >= 100) {
-    unsigned r = (unsigned)(d % 100);
-    d /= 100;
+  while (d >= 100000000u) {
+    p -= 8;
+    put_8_digits(p, (uint32_t)(d % 100000000u));
+    d /= 100000000u;
+  }
+  uint32_t r = (uint32_t)d;
+  while (r >= 100) {
+    p -= 2;
+    memcpy(p, &two_digits[2 * (r % 100)], 2);
+    r /= 100;
+  }
+  if (r >= 10) {
     p -= 2;
     memcpy(p, &two_digits[2 * r], 2);
-  }
-  if (d >= 10) {
-    p -= 2;
-    memcpy(p, &two_digits[2 * d], 2);
   } else {
-    *--p = (char)('0' + d);
+    *--p = (char)('0' + r);
   }
 }
 
@@ -218,7 +244,8 @@ static size_t put_fixed(char *out, api_decimal d) {
   if (lead >= 0) {
     /* digits, then the point moved into place */
     put_digits(out + 1, d.digits, d.ndigits);
-    memmove(out, out + 1, (size_t)lead + 1);
+    /* a few bytes: a call to memmove costs more */
+    for (int i = 0; i <= lead; i++) out[i] = out[i + 1];
     out[lead + 1] = '.';
     return (size_t)d.ndigits + 1;
   }

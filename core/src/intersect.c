@@ -94,12 +94,13 @@ static void seg_bbox(seg *s, int p) {
   cart(s->h[0], q);
   s->xmin = s->xmax = q[0];
   s->ymin = s->ymax = q[1];
+  /* comparisons, not fmin and fmax (calls here): the points are finite */
   for (int i = 1; i <= p; i++) {
     cart(s->h[i], q);
-    s->xmin = fmin(s->xmin, q[0]);
-    s->xmax = fmax(s->xmax, q[0]);
-    s->ymin = fmin(s->ymin, q[1]);
-    s->ymax = fmax(s->ymax, q[1]);
+    if (q[0] < s->xmin) s->xmin = q[0];
+    if (q[0] > s->xmax) s->xmax = q[0];
+    if (q[1] < s->ymin) s->ymin = q[1];
+    if (q[1] > s->ymax) s->ymax = q[1];
   }
 }
 
@@ -419,9 +420,39 @@ static bool consecutive_same_way(const ctx *x, const seg *A, const seg *B) {
   return (sf[0] != 0 && sf[0] == sg[0]) || (sf[1] != 0 && sf[1] == sg[1]);
 }
 
-static int by_xmin(const void *a, const void *b) {
-  double u = (*(const seg *const *)a)->xmin, v = (*(const seg *const *)b)->xmin;
-  return (u > v) - (u < v);
+/* Sort order[0 .. n) by xmin, stably (equal keys keep their order, as
+ * with the C library's merge sort this replaces: the sweep then visits
+ * pairs in the same order), with tmp[0 .. n) as scratch. Bottom-up merge
+ * over runs of 16 sorted by insertion: no callback a comparison, which
+ * cost a seventh of a frame's count. */
+static void sort_by_xmin(seg **order, seg **tmp, size_t n) {
+  const size_t run = 16;
+  for (size_t lo = 0; lo < n; lo += run) {
+    size_t hi = lo + run < n ? lo + run : n;
+    for (size_t i = lo + 1; i < hi; i++) {
+      seg *s = order[i];
+      size_t j = i;
+      for (; j > lo && order[j - 1]->xmin > s->xmin; j--)
+        order[j] = order[j - 1];
+      order[j] = s;
+    }
+  }
+  seg **from = order, **to = tmp;
+  for (size_t width = run; width < n; width *= 2) {
+    for (size_t lo = 0; lo < n; lo += 2 * width) {
+      size_t mid = lo + width < n ? lo + width : n;
+      size_t hi = mid + width < n ? mid + width : n;
+      size_t i = lo, j = mid, k = lo;
+      while (i < mid && j < hi)
+        to[k++] = from[j]->xmin < from[i]->xmin ? from[j++] : from[i++];
+      while (i < mid) to[k++] = from[i++];
+      while (j < hi) to[k++] = from[j++];
+    }
+    seg **t = from;
+    from = to;
+    to = t;
+  }
+  if (from != order) memcpy(order, from, n * sizeof *order);
 }
 
 /* Number of proper self-crossings of c: points where two different
@@ -538,10 +569,10 @@ long km__self_intersection_params(const km_curve *c, double tol, km__poll *poll,
   }
   if (x.oom) goto cleanup;
   /* the sweep orders pointers: a sub-curve is hundreds of bytes */
-  order = km__malloc((x.nseg + 1) * sizeof *order);
+  order = km__malloc((2 * x.nseg + 1) * sizeof *order);
   if (!order) goto cleanup;
   for (size_t i = 0; i < x.nseg; i++) order[i] = &x.segs[i];
-  qsort(order, x.nseg, sizeof *order, by_xmin);
+  sort_by_xmin(order, order + x.nseg, x.nseg);
   sweep_pairs(&x, order);
   if (x.oom) goto cleanup;
   result = (long)x.nhit;
