@@ -10,7 +10,7 @@
  * are which change, and how to keep the sequence from popping.
  *
  * One repair is implemented, for the glyph pairs whose frames still
- * cross (tests/core/test_repair.c lists them). A least change of
+ * cross (tests/fixtures/avoid/repair.json). A least change of
  * curvature (bumps of curvature over the two strands added to the
  * blended signature before the closure, fitted by Gauss-Newton) is the
  * obvious alternative, but it has not been implemented or measured, so
