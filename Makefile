@@ -295,9 +295,10 @@ run: deps build
 	  $(CLI) signature < docs/examples/circle-signature.json; fi
 
 bench: deps bench-morph bench-shapes bench-e2e
-	@$(MAKE) --no-print-directory build/bench/bench_core build/bench/bench_avoid
+	@$(MAKE) --no-print-directory build/bench/bench_core build/bench/bench_avoid build/bench/bench_repair
 	build/bench/bench_core
 	build/bench/bench_avoid
+	build/bench/bench_repair
 
 # End to end, as users get it: 1,000-frame morphs of glyph and icon pairs
 # (one contour and compound) and the shapes.json pairs through the CLI
@@ -351,6 +352,10 @@ build/bench/bench_morph: bench/bench_morph.c $(LIBCORE)
 	$(CC) $(CFLAGS) $(CORE_INC) $(CJSON_CFLAGS) $< -o $@ $(LIBCORE) $(CJSON_LIBS) -lm $(LDFLAGS)
 
 build/bench/bench_avoid: bench/bench_avoid.c $(LIBCORE)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) $(CORE_INC) $(CJSON_CFLAGS) $< -o $@ $(LIBCORE) $(CJSON_LIBS) -lm $(LDFLAGS)
+
+build/bench/bench_repair: bench/bench_repair.c $(LIBCORE)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) $(CORE_INC) $(CJSON_CFLAGS) $< -o $@ $(LIBCORE) $(CJSON_LIBS) -lm $(LDFLAGS)
 

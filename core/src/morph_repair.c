@@ -9,26 +9,22 @@
  * beside the shape, so a small local change separates it; the questions
  * are which change, and how to keep the sequence from popping.
  *
- * Two repairs were tried on the glyph pairs whose frames still cross
- * (tests/core/test_repair.c lists them):
- *  - a least change of curvature (like the closure solve): bumps of
- *    curvature over the two strands, fitted by Gauss-Newton with the
- *    closure solved again inside every step. It separates the strands,
- *    but a change of curvature on one strand turns the whole rest of the
- *    curve, which the closure then spreads back over everything: every
- *    step costs a frame per unknown, and fitting 10-20 bumps took
- *    hundreds of frames per key time and still left crossings where the
- *    lens was deep beside the strands' length.
- *  - a displacement of the strands themselves, kept: D(r, t) = sum_k
- *    c_k(t) N_k(r), uniform cubic B-splines N_k in the frame's normalised
- *    parameter r (arc length for planned frames) covering only the two
- *    strands, with 2-D coefficients. The frame plus D is again a B-spline
- *    (D's knots inserted into the frame, exactly), D vanishes at the ends
- *    so a closed frame stays closed, and the positions are linear in c,
- *    so the fit needs no frame to be rebuilt: Gauss-Newton on one-sided
- *    residuals (each sample of one strand at least h on its side of the
- *    other strand) with a small ridge and a second-difference smoothing,
- *    a few milliseconds a key time.
+ * One repair is implemented, for the glyph pairs whose frames still
+ * cross (tests/fixtures/avoid/repair.json). A least change of
+ * curvature (bumps of curvature over the two strands added to the
+ * blended signature before the closure, fitted by Gauss-Newton) is the
+ * obvious alternative, but it has not been implemented or measured, so
+ * nothing here claims how it would compare. The repair used is
+ * a displacement of the strands themselves: D(r, t) = sum_k
+ * c_k(t) N_k(r), uniform cubic B-splines N_k in the frame's normalised
+ * parameter r (arc length for planned frames) covering only the two
+ * strands, with 2-D coefficients. The frame plus D is again a B-spline
+ * (D's knots inserted into the frame, exactly), D vanishes at the ends
+ * so a closed frame stays closed, and the positions are linear in c,
+ * so the fit needs no frame to be rebuilt: Gauss-Newton on one-sided
+ * residuals (each sample of one strand at least h on its side of the
+ * other strand) with a small ridge and a second-difference smoothing,
+ * a few milliseconds a key time.
  *
  * Which side is right comes from the frames on either side in time that
  * do not cross (the clean neighbours): a strand on the left of the other
@@ -96,19 +92,19 @@ typedef struct strands {
 } strands;
 
 typedef struct km__repair_event {
-  long K;        /* grid: basis functions centred at k / K */
+  long K; /* grid: basis functions centred at k / K */
   long ka[2], kb[2];
-  size_t nrange; /* index ranges [ka, kb] of the functions used */
-  size_t nb;     /* functions used */
-  strands core;  /* where the crossings were */
-  strands pad;   /* where the fit looks */
+  size_t nrange;        /* index ranges [ka, kb] of the functions used */
+  size_t nb;            /* functions used */
+  strands core;         /* where the crossings were */
+  strands pad;          /* where the fit looks */
   int sigma_i, sigma_j; /* the side of I seen from J, and of J from I */
   /* per sample of each strand (fit_make's samples), the side of the
    * other strand it is on in both clean frames (+1 left, -1 right), or 0
    * (it does not face the other strand there, or the frames disagree) */
   signed char *side[2];
-  double h;             /* clearance */
-  double size;          /* of the clean frame before the event */
+  double h;    /* clearance */
+  double size; /* of the clean frame before the event */
   size_t nt;
   double t[MAX_KEYS];
   double *c;     /* nt x nb x 2 */
@@ -340,8 +336,8 @@ static bool project(const double (*y)[2], size_t n, const double p[2],
   for (size_t k = 0; k + 1 < n; k++) {
     double ex = y[k + 1][0] - y[k][0], ey = y[k + 1][1] - y[k][1];
     double ee = ex * ex + ey * ey;
-    double lam = ee > 0 ? ((p[0] - y[k][0]) * ex + (p[1] - y[k][1]) * ey) / ee
-                        : 0.0;
+    double lam =
+        ee > 0 ? ((p[0] - y[k][0]) * ex + (p[1] - y[k][1]) * ey) / ee : 0.0;
     lam = fmin(1.0, fmax(0.0, lam));
     double qx = y[k][0] + lam * ex - p[0], qy = y[k][1] + lam * ey - p[1];
     double d2 = qx * qx + qy * qy;
@@ -430,8 +426,7 @@ static void sides(const fit *ft, int sigma[2], double sep[2],
       bool faces =
           project((const double(*)[2])b->x, b->n, a->x[i], &k, &lam, &d2);
       double d = side_of((const double(*)[2])b->x, k, lam, a->x[i], n);
-      per[s][i] =
-          faces && fabs(d) < 0.05 * ft->size ? (d > 0) - (d < 0) : 0;
+      per[s][i] = faces && fabs(d) < 0.05 * ft->size ? (d > 0) - (d < 0) : 0;
       if (r < lo - wc || r > hi + wc) continue;
       int w = !faces ? 2 : (r >= lo && r <= hi) ? 0 : 1;
       for (; w < 3; w++)
@@ -477,8 +472,8 @@ static bool cholesky_solve(double *M, double *b, size_t n) {
  * sample of each strand at least h on its side of the other. */
 static km_status fit_solve(const fit *ft, double *c, km__poll *poll) {
   const km__repair_event *e = ft->e;
-  size_t w = 2 * e->nb, nmax = ft->s[0].n > ft->s[1].n ? ft->s[0].n
-                                                       : ft->s[1].n;
+  size_t w = 2 * e->nb,
+         nmax = ft->s[0].n > ft->s[1].n ? ft->s[0].n : ft->s[1].n;
   double *M = km__malloc(w * w * sizeof *M), *rhs = km__malloc(w * sizeof *rhs);
   double(*y[2])[2] = {km__malloc(nmax * sizeof *y[0]),
                       km__malloc(nmax * sizeof *y[1])};
@@ -719,9 +714,9 @@ static km_status sides_at(const km_morph *m, km__repair_event *e, double t,
  * than a quarter of the wanted clearance - a clearance set by a
  * near-touch would leave the repaired frames near-touching too. *ok
  * false when no side is known or the strands pass through each other. */
-static km_status event_sides(const km_morph *m, km__repair_event *e,
-                             int first, int last, double *tb, double *ta,
-                             km__poll *poll, bool *ok) {
+static km_status event_sides(const km_morph *m, km__repair_event *e, int first,
+                             int last, double *tb, double *ta, km__poll *poll,
+                             bool *ok) {
   int sg[2][2];
   double sep[2][2];
   signed char *per[2][2] = {{NULL, NULL}, {NULL, NULL}};
@@ -748,8 +743,8 @@ static km_status event_sides(const km_morph *m, km__repair_event *e,
   e->sigma_j = sg[0][1] != 0 && sg[0][1] == sg[1][1] ? sg[0][1] : 0;
   /* both seen and both reversed: the strands pass through each other */
   if ((e->sigma_i == 0 && e->sigma_j == 0) ||
-      (sg[0][0] && sg[1][0] && sg[0][0] != sg[1][0] && sg[0][1] &&
-       sg[1][1] && sg[0][1] != sg[1][1]))
+      (sg[0][0] && sg[1][0] && sg[0][0] != sg[1][0] && sg[0][1] && sg[1][1] &&
+       sg[0][1] != sg[1][1]))
     goto done;
   e->h = 0.004 * e->size;
   for (int k = 0; k < 2; k++)
@@ -758,10 +753,10 @@ static km_status event_sides(const km_morph *m, km__repair_event *e,
   e->h = fmax(e->h, 2 * m->tol);
   /* each sample keeps the side both clean frames agree on */
   for (int d = 0; d < 2; d++) {
-    size_t n = (size_t)ceil(((d ? e->pad.j1 - e->pad.j0 : e->pad.i1 -
-                                                            e->pad.i0)) *
-                            (double)e->K * PER_DR) +
-               1;
+    size_t n =
+        (size_t)ceil(((d ? e->pad.j1 - e->pad.j0 : e->pad.i1 - e->pad.i0)) *
+                     (double)e->K * PER_DR) +
+        1;
     if (n < 8) n = 8;
     for (size_t i = 0; i < n; i++)
       if (per[0][d][i] != per[1][d][i]) per[0][d][i] = 0;
@@ -835,8 +830,8 @@ static double largest_move(const km__repair_event *e) {
   double big = 0.0;
   for (size_t k = 0; k < e->nt; k++)
     for (size_t q = 0; q < e->nb; q++)
-      big = fmax(big, hypot(e->c[(k * e->nb + q) * 2],
-                            e->c[(k * e->nb + q) * 2 + 1]));
+      big = fmax(
+          big, hypot(e->c[(k * e->nb + q) * 2], e->c[(k * e->nb + q) * 2 + 1]));
   return big;
 }
 
@@ -888,8 +883,8 @@ done:
  * crosses is fitted and becomes a key (ROUNDS times at most). *left
  * receives the checks that still cross, *before how many of the first
  * round's checks crossed without the event. */
-static km_status event_verify(const km_morph *m, km__repair *rp,
-                              km__poll *poll, long *left, long *before) {
+static km_status event_verify(const km_morph *m, km__repair *rp, km__poll *poll,
+                              long *left, long *before) {
   km__repair_event *e = &rp->ev[rp->n - 1];
   size_t w = 2 * e->nb;
   double *c = km__malloc(w * sizeof *c);
