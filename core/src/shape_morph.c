@@ -45,6 +45,8 @@ void km_shape_morph_free(km_shape_morph *m) {
   km__free(m->ref);
   km__free(m->has_ref);
   km__free(m->sched);
+  km__free(m->fix);
+  km__free(m->fixed);
   km__free(m);
 }
 
@@ -275,6 +277,22 @@ static km_status take_refs(km_shape_morph *m, const km_shape *a,
   return KM_OK;
 }
 
+void km__shape_sched_monotone(km_shape_morph *m, size_t k) {
+  double *S = m->sched + (KM__SCHED + 1) * k;
+  /* each time takes the smaller of its own fit and the next's toward
+   * the missing side, so an interval's interpolation stays below the
+   * fit at both its ends (and between them where the fit is monotone);
+   * the whole end keeps its full size, and the last time before the
+   * point its own fit */
+  if (m->kind[k] == KM__VANISH) {
+    for (int j = 1; j + 1 < KM__SCHED; j++) S[j] = fmin(S[j], S[j + 1]);
+    for (int j = 1; j <= KM__SCHED; j++) S[j] = fmin(S[j], S[j - 1]);
+  } else if (m->kind[k] == KM__APPEAR) {
+    for (int j = KM__SCHED - 1; j > 1; j--) S[j] = fmin(S[j], S[j - 1]);
+    for (int j = KM__SCHED - 1; j >= 0; j--) S[j] = fmin(S[j], S[j + 1]);
+  }
+}
+
 /* The schedule of unpaired contours inside a parent: the scale that fits
  * at each t = j / KM__SCHED, then the running minimum from the side where
  * the contour is whole, so its size only falls toward its missing side
@@ -305,21 +323,7 @@ static km_status take_schedule(km_shape_morph *m, const km_stop *stop,
   }
   km__free(ratio);
   if (st != KM_OK) return st;
-  for (size_t k = 0; k < n; k++) {
-    double *S = m->sched + (KM__SCHED + 1) * k;
-    /* each time takes the smaller of its own fit and the next's toward
-     * the missing side, so an interval's interpolation stays below the
-     * fit at both its ends (and between them where the fit is monotone);
-     * the whole end keeps its full size, and the last time before the
-     * point its own fit */
-    if (m->kind[k] == KM__VANISH) {
-      for (int j = 1; j + 1 < KM__SCHED; j++) S[j] = fmin(S[j], S[j + 1]);
-      for (int j = 1; j <= KM__SCHED; j++) S[j] = fmin(S[j], S[j - 1]);
-    } else if (m->kind[k] == KM__APPEAR) {
-      for (int j = KM__SCHED - 1; j > 1; j--) S[j] = fmin(S[j], S[j - 1]);
-      for (int j = KM__SCHED - 1; j >= 0; j--) S[j] = fmin(S[j], S[j + 1]);
-    }
-  }
+  for (size_t k = 0; k < n; k++) km__shape_sched_monotone(m, k);
   m->scheduled = true;
   return KM_OK;
 }
@@ -354,6 +358,8 @@ km_status km_shape_morph_create(km_shape_morph **out, const km_shape *from,
     st = morph_pair(m, k, from, to, &mo, err);
   if (st == KM_OK) st = take_refs(m, from, to, stop, err);
   if (st == KM_OK) st = take_schedule(m, stop, err);
+  if (st == KM_OK && opt->morph.intersections == KM_INTERSECTIONS_AVOID)
+    st = km__shape_avoid(m, stop, err);
   if (st != KM_OK) goto cleanup;
   *out = m;
   m = NULL;
