@@ -120,9 +120,11 @@ struct km_shape_morph {
    * ln of a scale) at t = j / KM__FIX, j = 0..KM__FIX, zero at both ends,
    * applied where fixed[k] through a monotone cubic in t */
   bool local_follow;
-  double *fix;    /* 3 (KM__FIX + 1) per pair */
-  bool *fixed;    /* npairs, NULL when no slot is corrected */
-  bool no_adjust; /* while corrections are measured: no per-frame move */
+  double *fix;          /* 3 (KM__FIX + 1) per pair */
+  bool *fixed;          /* npairs, NULL when no slot is corrected */
+  bool no_adjust;       /* while corrections are measured: no per-frame move */
+  bool free_top_points; /* a top-level unpaired contour's point is where
+                           its host maps it, not pulled into the host */
 };
 
 /* Intervals of the correction grid (shape_avoid.c). */
@@ -131,8 +133,16 @@ struct km_shape_morph {
 /* Choose placement and corrections of m's frames so that contours do not
  * cross and children stay in their parents (shape_avoid.c); m is still
  * being built. KM_OK, KM_ECANCELLED, KM_ENOMEM, or a frame's status. */
-km_status km__shape_avoid(km_shape_morph *m, const km_stop *stop,
+km_status km__shape_avoid(km_shape_morph *m, const km_shape *a,
+                          const km_shape *b, const km_stop *stop,
                           km_error *err);
+
+/* Place the unpaired contours' points again (after free_top_points
+ * changed), and the anchors and the schedule that follow from them
+ * (shape_morph.c). km_shape_morph_create's statuses. */
+km_status km__shape_replan(km_shape_morph *m, const km_shape *a,
+                           const km_shape *b, const km_stop *stop,
+                           km_error *err);
 
 /* Make slot k's schedule fall toward its missing side (shape_morph.c). */
 void km__shape_sched_monotone(km_shape_morph *m, size_t k);

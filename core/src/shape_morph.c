@@ -144,6 +144,10 @@ static km_status place_point(km_shape_morph *m, size_t k, const km_shape *a,
   double f = sqrt(o->area[ho] / s->area[hs]);
   p[0] = o->centroid[2 * ho] + (c[0] - s->centroid[2 * hs]) * f;
   p[1] = o->centroid[2 * ho + 1] + (c[1] - s->centroid[2 * hs + 1]) * f;
+  /* a top-level contour's host is not its parent: under avoid it may be
+   * left where the mapping puts it, outside the host's partner */
+  if (m->free_top_points && (from ? m->parent_from[k] : m->parent_to[k]) < 0)
+    return KM_OK;
   return pull_inside(o, (size_t)ho, p);
 }
 
@@ -217,20 +221,11 @@ static km_status take_pairs(km_shape_morph *m, const km_shape *a,
   return KM_OK;
 }
 
-/* Kinds, parent slots and the points of unpaired contours, parents
- * before children (a child's point may be its vanishing parent's). KM_OK
- * or KM_ENOMEM. */
-static km_status plan_slots(km_shape_morph *m, const km_shape *a,
-                            const km_shape *b) {
+/* The points of unpaired contours, parents before children (a child's
+ * point may be its vanishing parent's). KM_OK or KM_ENOMEM. */
+static km_status place_points(km_shape_morph *m, const km_shape *a,
+                              const km_shape *b) {
   int maxd = 0;
-  for (size_t k = 0; k < m->npairs; k++) {
-    long i = m->pairs[k].from, j = m->pairs[k].to;
-    m->kind[k] = i >= 0 && j >= 0 ? KM__PAIRED
-                 : i >= 0         ? KM__VANISH
-                                  : KM__APPEAR;
-    m->parent_from[k] = i >= 0 ? slot_of(m, a->parent[i], true) : -1;
-    m->parent_to[k] = j >= 0 ? slot_of(m, b->parent[j], false) : -1;
-  }
   for (size_t k = 0; k < m->npairs; k++) {
     int d = slot_depth(m, k);
     if (d > maxd) maxd = d;
@@ -241,6 +236,21 @@ static km_status plan_slots(km_shape_morph *m, const km_shape *a,
       if (m->kind[k] != KM__PAIRED && slot_depth(m, k) == d)
         st = place_point(m, k, a, b);
   return st;
+}
+
+/* Kinds, parent slots and the points of unpaired contours. KM_OK or
+ * KM_ENOMEM. */
+static km_status plan_slots(km_shape_morph *m, const km_shape *a,
+                            const km_shape *b) {
+  for (size_t k = 0; k < m->npairs; k++) {
+    long i = m->pairs[k].from, j = m->pairs[k].to;
+    m->kind[k] = i >= 0 && j >= 0 ? KM__PAIRED
+                 : i >= 0         ? KM__VANISH
+                                  : KM__APPEAR;
+    m->parent_from[k] = i >= 0 ? slot_of(m, a->parent[i], true) : -1;
+    m->parent_to[k] = j >= 0 ? slot_of(m, b->parent[j], false) : -1;
+  }
+  return place_points(m, a, b);
 }
 
 /* Anchors of every slot, and the sampled end frames of every paired slot
@@ -328,6 +338,18 @@ static km_status take_schedule(km_shape_morph *m, const km_stop *stop,
   return KM_OK;
 }
 
+km_status km__shape_replan(km_shape_morph *m, const km_shape *a,
+                           const km_shape *b, const km_stop *stop,
+                           km_error *err) {
+  km_status st = place_points(m, a, b);
+  if (st != KM_OK)
+    return km__fail(err, st, KM_FIELD_NONE, -1, NAN, "out of memory");
+  st = take_refs(m, a, b, stop, err);
+  m->scheduled = false;
+  if (st == KM_OK) st = take_schedule(m, stop, err);
+  return st;
+}
+
 km_status km_shape_morph_create(km_shape_morph **out, const km_shape *from,
                                 const km_shape *to,
                                 const km_shape_morph_options *opt,
@@ -359,7 +381,7 @@ km_status km_shape_morph_create(km_shape_morph **out, const km_shape *from,
   if (st == KM_OK) st = take_refs(m, from, to, stop, err);
   if (st == KM_OK) st = take_schedule(m, stop, err);
   if (st == KM_OK && opt->morph.intersections == KM_INTERSECTIONS_AVOID)
-    st = km__shape_avoid(m, stop, err);
+    st = km__shape_avoid(m, from, to, stop, err);
   if (st != KM_OK) goto cleanup;
   *out = m;
   m = NULL;
