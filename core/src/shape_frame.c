@@ -78,32 +78,55 @@ void km__ref_sample(const km_curve *c, double *out) {
 }
 
 /* The similarity x -> g + z (x - h) (z complex: rotation and scale) that
- * maps the points X onto the points Y best in least squares, applied to
- * c (in place). */
-static void similar_map(const double *X, const double *Y, double c[2]) {
-  double hx = 0, hy = 0, gx = 0, gy = 0;
+ * maps the points X onto the points Y best in weighted least squares
+ * (w NULL: equal weights), applied to c (in place). */
+static void similar_map(const double *X, const double *Y, const double *w,
+                        double c[2]) {
+  double hx = 0, hy = 0, gx = 0, gy = 0, ws = 0;
   for (int i = 0; i < KM__REF_POINTS; i++) {
-    hx += X[2 * i];
-    hy += X[2 * i + 1];
-    gx += Y[2 * i];
-    gy += Y[2 * i + 1];
+    double wi = w ? w[i] : 1.0;
+    hx += wi * X[2 * i];
+    hy += wi * X[2 * i + 1];
+    gx += wi * Y[2 * i];
+    gy += wi * Y[2 * i + 1];
+    ws += wi;
   }
-  hx /= KM__REF_POINTS;
-  hy /= KM__REF_POINTS;
-  gx /= KM__REF_POINTS;
-  gy /= KM__REF_POINTS;
+  hx /= ws;
+  hy /= ws;
+  gx /= ws;
+  gy /= ws;
   double re = 0, im = 0, nn = 0;
   for (int i = 0; i < KM__REF_POINTS; i++) {
+    double wi = w ? w[i] : 1.0;
     double ax = X[2 * i] - hx, ay = X[2 * i + 1] - hy;
     double bx = Y[2 * i] - gx, by = Y[2 * i + 1] - gy;
-    re += bx * ax + by * ay; /* (b) conj(a) */
-    im += by * ax - bx * ay;
-    nn += ax * ax + ay * ay;
+    re += wi * (bx * ax + by * ay); /* (b) conj(a) */
+    im += wi * (by * ax - bx * ay);
+    nn += wi * (ax * ax + ay * ay);
   }
   double zr = nn > 0 ? re / nn : 1.0, zi = nn > 0 ? im / nn : 0.0;
   double dx = c[0] - hx, dy = c[1] - hy;
   c[0] = gx + zr * dx - zi * dy;
   c[1] = gy + zi * dx + zr * dy;
+}
+
+/* Weights of the points X near c: a Gaussian of the distance whose width
+ * is the distance to the nearest point plus a quarter of X's radius, so
+ * that a child is placed by the part of its parent around it. */
+static void local_weights(const double *X, const double c[2], double *w) {
+  double hx = 0, hy = 0, rr = 0, dmin = INFINITY;
+  for (int i = 0; i < KM__REF_POINTS; i++) {
+    hx += X[2 * i] / KM__REF_POINTS;
+    hy += X[2 * i + 1] / KM__REF_POINTS;
+  }
+  for (int i = 0; i < KM__REF_POINTS; i++) {
+    rr += (pow(X[2 * i] - hx, 2) + pow(X[2 * i + 1] - hy, 2)) / KM__REF_POINTS;
+    w[i] = hypot(X[2 * i] - c[0], X[2 * i + 1] - c[1]);
+    dmin = fmin(dmin, w[i]);
+  }
+  double sig = dmin + 0.25 * sqrt(rr);
+  for (int i = 0; i < KM__REF_POINTS; i++)
+    w[i] = sig > 0 ? exp(-(w[i] / sig) * (w[i] / sig)) + 1e-9 : 1.0;
 }
 
 bool km__follow_parent(const km_shape_morph *m, size_t k, long parent,
@@ -118,8 +141,13 @@ bool km__follow_parent(const km_shape_morph *m, size_t k, long parent,
   const double *r = m->ref + 4 * (size_t)parent * KM__REF_POINTS;
   memcpy(c0, an, sizeof c0);
   memcpy(c1, an + 2, sizeof c1);
-  similar_map(r, now, c0);
-  similar_map(r + 2 * KM__REF_POINTS, now, c1);
+  double w0[KM__REF_POINTS], w1[KM__REF_POINTS];
+  if (m->local_follow) {
+    local_weights(r, c0, w0);
+    local_weights(r + 2 * KM__REF_POINTS, c1, w1);
+  }
+  similar_map(r, now, m->local_follow ? w0 : NULL, c0);
+  similar_map(r + 2 * KM__REF_POINTS, now, m->local_follow ? w1 : NULL, c1);
   out[0] = (1 - t) * c0[0] + t * c1[0];
   out[1] = (1 - t) * c0[1] + t * c1[1];
   return true;
@@ -331,6 +359,23 @@ static km_status shrink_to_fit(const km_shape_morph *m, double t,
   return KM_OK;
 }
 
+/* Slot k's correction (km__shape_fix_at), scaled about the centroid of
+ * its flattening and then translated. */
+static void apply_fix(const km_shape_morph *m, double t, km_shape_frame *f,
+                      size_t k, flats *fs) {
+  double d[2], r, g[2];
+  if (!km__shape_fix_at(m, k, t, d, &r)) return;
+  /* an unpaired contour outside any parent takes its schedule here */
+  long p = f->parent[k];
+  if (m->kind[k] != KM__PAIRED && (p < 0 || !f->present[p]))
+    r = scheduled_ratio(m, k, t);
+  if (r != 1.0) {
+    centroid_of(fs->pt[k], fs->n[k], g);
+    scale_about(f, k, fs, g, r);
+  }
+  if (d[0] != 0.0 || d[1] != 0.0) translate(f, k, fs, d);
+}
+
 /* Placement and nesting adjustment parents first, then the metrics. */
 static km_status finish(const km_shape_morph *m, double t, km_shape_frame *f,
                         flats *fs, km__poll *poll, double *ratio) {
@@ -338,16 +383,20 @@ static km_status finish(const km_shape_morph *m, double t, km_shape_frame *f,
   for (size_t k = 0; k < f->ncontours; k++)
     if (frame_depth(f, k) > maxd) maxd = frame_depth(f, k);
   const double zero[2] = {0, 0};
-  for (int d = 1; d <= maxd; d++)
+  for (int d = 0; d <= maxd; d++)
     for (size_t k = 0; k < f->ncontours; k++) {
-      if (!f->present[k] || f->parent[k] < 0 || !f->present[f->parent[k]] ||
-          frame_depth(f, k) != d)
+      if (!f->present[k] || frame_depth(f, k) != d) continue;
+      if (f->parent[k] < 0 || !f->present[f->parent[k]]) {
+        apply_fix(m, t, f, k, fs);
         continue;
+      }
       follow(m, f, k, t, fs);
       double r = 1.0;
       bool moved;
       km_status st = shrink_to_fit(m, t, f, k, fs, &r);
-      if (st == KM_OK) st = adjust(f, k, fs, &moved);
+      apply_fix(m, t, f, k, fs);
+      moved = false;
+      if (st == KM_OK && !m->no_adjust) st = adjust(f, k, fs, &moved);
       if (st != KM_OK) return st;
       if (ratio) ratio[k] = r;
       if (moved) f->adjusted++;

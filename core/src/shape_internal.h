@@ -115,7 +115,42 @@ struct km_shape_morph {
                      size) an unpaired contour has at t = j / KM__SCHED,
                      falling toward its missing side; used when scheduled */
   bool scheduled;
+  /* intersections AVOID (shape_avoid.c): children placed by the parent's
+   * points near them, and per-slot corrections (translation dx, dy and
+   * ln of a scale) at t = j / KM__FIX, j = 0..KM__FIX, zero at both ends,
+   * applied where fixed[k] through a monotone cubic in t */
+  bool local_follow;
+  double *fix;          /* 3 (KM__FIX + 1) per pair */
+  bool *fixed;          /* npairs, NULL when no slot is corrected */
+  bool no_adjust;       /* while corrections are measured: no per-frame move */
+  bool free_top_points; /* a top-level unpaired contour's point is where
+                           its host maps it, not pulled into the host */
 };
+
+/* Intervals of the correction grid (shape_avoid.c). */
+#define KM__FIX 16
+
+/* Choose placement and corrections of m's frames so that contours do not
+ * cross and children stay in their parents (shape_avoid.c); m is still
+ * being built. KM_OK, KM_ECANCELLED, KM_ENOMEM, or a frame's status. */
+km_status km__shape_avoid(km_shape_morph *m, const km_shape *a,
+                          const km_shape *b, const km_stop *stop,
+                          km_error *err);
+
+/* Place the unpaired contours' points again (after free_top_points
+ * changed), and the anchors and the schedule that follow from them
+ * (shape_morph.c). km_shape_morph_create's statuses. */
+km_status km__shape_replan(km_shape_morph *m, const km_shape *a,
+                           const km_shape *b, const km_stop *stop,
+                           km_error *err);
+
+/* Make slot k's schedule fall toward its missing side (shape_morph.c). */
+void km__shape_sched_monotone(km_shape_morph *m, size_t k);
+
+/* Slot k's correction at t into d[2] (translation) and *r (scale about
+ * its centroid); false when it has none (shape_avoid.c). */
+bool km__shape_fix_at(const km_shape_morph *m, size_t k, double t, double d[2],
+                      double *r);
 
 /* The scale each unpaired slot of the frame at t takes to fit in its
  * parent, as a fraction of its nominal (1 - t or t), into ratio[npairs]

@@ -45,6 +45,8 @@ void km_shape_morph_free(km_shape_morph *m) {
   km__free(m->ref);
   km__free(m->has_ref);
   km__free(m->sched);
+  km__free(m->fix);
+  km__free(m->fixed);
   km__free(m);
 }
 
@@ -142,6 +144,10 @@ static km_status place_point(km_shape_morph *m, size_t k, const km_shape *a,
   double f = sqrt(o->area[ho] / s->area[hs]);
   p[0] = o->centroid[2 * ho] + (c[0] - s->centroid[2 * hs]) * f;
   p[1] = o->centroid[2 * ho + 1] + (c[1] - s->centroid[2 * hs + 1]) * f;
+  /* a top-level contour's host is not its parent: under avoid it may be
+   * left where the mapping puts it, outside the host's partner */
+  if (m->free_top_points && (from ? m->parent_from[k] : m->parent_to[k]) < 0)
+    return KM_OK;
   return pull_inside(o, (size_t)ho, p);
 }
 
@@ -215,20 +221,11 @@ static km_status take_pairs(km_shape_morph *m, const km_shape *a,
   return KM_OK;
 }
 
-/* Kinds, parent slots and the points of unpaired contours, parents
- * before children (a child's point may be its vanishing parent's). KM_OK
- * or KM_ENOMEM. */
-static km_status plan_slots(km_shape_morph *m, const km_shape *a,
-                            const km_shape *b) {
+/* The points of unpaired contours, parents before children (a child's
+ * point may be its vanishing parent's). KM_OK or KM_ENOMEM. */
+static km_status place_points(km_shape_morph *m, const km_shape *a,
+                              const km_shape *b) {
   int maxd = 0;
-  for (size_t k = 0; k < m->npairs; k++) {
-    long i = m->pairs[k].from, j = m->pairs[k].to;
-    m->kind[k] = i >= 0 && j >= 0 ? KM__PAIRED
-                 : i >= 0         ? KM__VANISH
-                                  : KM__APPEAR;
-    m->parent_from[k] = i >= 0 ? slot_of(m, a->parent[i], true) : -1;
-    m->parent_to[k] = j >= 0 ? slot_of(m, b->parent[j], false) : -1;
-  }
   for (size_t k = 0; k < m->npairs; k++) {
     int d = slot_depth(m, k);
     if (d > maxd) maxd = d;
@@ -239,6 +236,21 @@ static km_status plan_slots(km_shape_morph *m, const km_shape *a,
       if (m->kind[k] != KM__PAIRED && slot_depth(m, k) == d)
         st = place_point(m, k, a, b);
   return st;
+}
+
+/* Kinds, parent slots and the points of unpaired contours. KM_OK or
+ * KM_ENOMEM. */
+static km_status plan_slots(km_shape_morph *m, const km_shape *a,
+                            const km_shape *b) {
+  for (size_t k = 0; k < m->npairs; k++) {
+    long i = m->pairs[k].from, j = m->pairs[k].to;
+    m->kind[k] = i >= 0 && j >= 0 ? KM__PAIRED
+                 : i >= 0         ? KM__VANISH
+                                  : KM__APPEAR;
+    m->parent_from[k] = i >= 0 ? slot_of(m, a->parent[i], true) : -1;
+    m->parent_to[k] = j >= 0 ? slot_of(m, b->parent[j], false) : -1;
+  }
+  return place_points(m, a, b);
 }
 
 /* Anchors of every slot, and the sampled end frames of every paired slot
@@ -275,6 +287,22 @@ static km_status take_refs(km_shape_morph *m, const km_shape *a,
   return KM_OK;
 }
 
+void km__shape_sched_monotone(km_shape_morph *m, size_t k) {
+  double *S = m->sched + (KM__SCHED + 1) * k;
+  /* each time takes the smaller of its own fit and the next's toward
+   * the missing side, so an interval's interpolation stays below the
+   * fit at both its ends (and between them where the fit is monotone);
+   * the whole end keeps its full size, and the last time before the
+   * point its own fit */
+  if (m->kind[k] == KM__VANISH) {
+    for (int j = 1; j + 1 < KM__SCHED; j++) S[j] = fmin(S[j], S[j + 1]);
+    for (int j = 1; j <= KM__SCHED; j++) S[j] = fmin(S[j], S[j - 1]);
+  } else if (m->kind[k] == KM__APPEAR) {
+    for (int j = KM__SCHED - 1; j > 1; j--) S[j] = fmin(S[j], S[j - 1]);
+    for (int j = KM__SCHED - 1; j >= 0; j--) S[j] = fmin(S[j], S[j + 1]);
+  }
+}
+
 /* The schedule of unpaired contours inside a parent: the scale that fits
  * at each t = j / KM__SCHED, then the running minimum from the side where
  * the contour is whole, so its size only falls toward its missing side
@@ -305,23 +333,21 @@ static km_status take_schedule(km_shape_morph *m, const km_stop *stop,
   }
   km__free(ratio);
   if (st != KM_OK) return st;
-  for (size_t k = 0; k < n; k++) {
-    double *S = m->sched + (KM__SCHED + 1) * k;
-    /* each time takes the smaller of its own fit and the next's toward
-     * the missing side, so an interval's interpolation stays below the
-     * fit at both its ends (and between them where the fit is monotone);
-     * the whole end keeps its full size, and the last time before the
-     * point its own fit */
-    if (m->kind[k] == KM__VANISH) {
-      for (int j = 1; j + 1 < KM__SCHED; j++) S[j] = fmin(S[j], S[j + 1]);
-      for (int j = 1; j <= KM__SCHED; j++) S[j] = fmin(S[j], S[j - 1]);
-    } else if (m->kind[k] == KM__APPEAR) {
-      for (int j = KM__SCHED - 1; j > 1; j--) S[j] = fmin(S[j], S[j - 1]);
-      for (int j = KM__SCHED - 1; j >= 0; j--) S[j] = fmin(S[j], S[j + 1]);
-    }
-  }
+  for (size_t k = 0; k < n; k++) km__shape_sched_monotone(m, k);
   m->scheduled = true;
   return KM_OK;
+}
+
+km_status km__shape_replan(km_shape_morph *m, const km_shape *a,
+                           const km_shape *b, const km_stop *stop,
+                           km_error *err) {
+  km_status st = place_points(m, a, b);
+  if (st != KM_OK)
+    return km__fail(err, st, KM_FIELD_NONE, -1, NAN, "out of memory");
+  st = take_refs(m, a, b, stop, err);
+  m->scheduled = false;
+  if (st == KM_OK) st = take_schedule(m, stop, err);
+  return st;
 }
 
 km_status km_shape_morph_create(km_shape_morph **out, const km_shape *from,
@@ -354,6 +380,8 @@ km_status km_shape_morph_create(km_shape_morph **out, const km_shape *from,
     st = morph_pair(m, k, from, to, &mo, err);
   if (st == KM_OK) st = take_refs(m, from, to, stop, err);
   if (st == KM_OK) st = take_schedule(m, stop, err);
+  if (st == KM_OK && opt->morph.intersections == KM_INTERSECTIONS_AVOID)
+    st = km__shape_avoid(m, from, to, stop, err);
   if (st != KM_OK) goto cleanup;
   *out = m;
   m = NULL;

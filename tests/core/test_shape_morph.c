@@ -7,6 +7,7 @@
  * the blended length, so its radius is (1-t) r_a + t r_b), the linear
  * length law of a vanishing contour ((1-t) L), the inputs at t = 0 and 1.
  */
+#include <limits.h>
 #include <string.h>
 
 #include "km/curve.h"
@@ -374,12 +375,160 @@ static void frame_refuses_t_outside(void **state) {
   km_shape_free(&sb);
 }
 
+/* The i -> l shapes of the test above. */
+static void i_and_l(km_shape *si, km_shape *sl) {
+  km_curve i[2], l[1];
+  rect(&i[0], 0, 0, 1, 6);
+  circle(&i[1], 0.5, 7.5, 0.6, 1);
+  rect(&l[0], 0, 0, 1, 9);
+  shape_of(si, i, 2);
+  shape_of(sl, l, 1);
+}
+
+static km_shape_morph *morph_under(const km_shape *a, const km_shape *b,
+                                   km_intersections x) {
+  km_shape_morph_options o;
+  km_shape_morph_options_default(&o);
+  o.morph.intersections = x;
+  km_shape_morph *m = NULL;
+  assert_status(km_shape_morph_create(&m, a, b, &o, NULL, NULL), KM_OK);
+  return m;
+}
+
+/* Frames of 41 with a mutual crossing or a nesting failure. */
+static int failing_frames(const km_shape_morph *m) {
+  int bad = 0;
+  for (int k = 0; k <= 40; k++) {
+    km_shape_frame f;
+    km_shape_frame_init(&f);
+    assert_status(km_shape_morph_frame_until(m, k / 40.0, NULL, &f, NULL),
+                  KM_OK);
+    bad += f.mutual_intersections > 0 || !f.nesting_ok;
+    km_shape_frame_free(&f);
+  }
+  return bad;
+}
+
+/* Largest distance between the control points of two frames' curves. */
+static double frames_apart(const km_shape_frame *a, const km_shape_frame *b) {
+  double d = 0;
+  assert_int_equal(a->ncontours, b->ncontours);
+  for (size_t k = 0; k < a->ncontours; k++) {
+    assert_int_equal(a->present[k], b->present[k]);
+    if (!a->present[k]) continue;
+    assert_int_equal(a->contours[k].n, b->contours[k].n);
+    for (size_t i = 0; i < 2 * a->contours[k].n; i++)
+      d = fmax(d, fabs(a->contours[k].cp[i] - b->contours[k].cp[i]));
+  }
+  return d;
+}
+
+/* A morph whose frames keep holes inside and contours apart (ring to ring
+ * through rings) gets the same frames under avoid as under allow; one
+ * whose dot crosses the stem (i -> l) fails on no more frames under
+ * avoid, and its frames 0 and 1 are still the inputs (allow's ends). */
+static void avoid_keeps_clean_morphs_and_ends(void **state) {
+  (void)state;
+  km_curve a[2], b[2];
+  circle(&a[0], 0, 0, 4, 1);
+  circle(&a[1], 1, 0, 1, 0);
+  circle(&b[0], 0, 0, 3, 1);
+  circle(&b[1], -0.5, 0.5, 1.5, 0);
+  km_shape sa, sb, si, sl;
+  shape_of(&sa, a, 2);
+  shape_of(&sb, b, 2);
+  i_and_l(&si, &sl);
+  km_shape_morph *ma = morph_under(&sa, &sb, KM_INTERSECTIONS_ALLOW);
+  km_shape_morph *mv = morph_under(&sa, &sb, KM_INTERSECTIONS_AVOID);
+  km_shape_morph *ia = morph_under(&si, &sl, KM_INTERSECTIONS_ALLOW);
+  km_shape_morph *iv = morph_under(&si, &sl, KM_INTERSECTIONS_AVOID);
+  assert_int_equal(failing_frames(ma), 0);
+  for (int k = 0; k <= 10; k++) {
+    km_shape_frame f, g;
+    km_shape_frame_init(&f);
+    km_shape_frame_init(&g);
+    assert_status(km_shape_morph_frame_until(ma, k / 10.0, NULL, &f, NULL),
+                  KM_OK);
+    assert_status(km_shape_morph_frame_until(mv, k / 10.0, NULL, &g, NULL),
+                  KM_OK);
+    assert_true(frames_apart(&f, &g) == 0.0);
+    km_shape_frame_free(&f);
+    km_shape_frame_free(&g);
+  }
+  assert_true(failing_frames(iv) <= failing_frames(ia));
+  for (int e = 0; e <= 1; e++) {
+    km_shape_frame f, g;
+    km_shape_frame_init(&f);
+    km_shape_frame_init(&g);
+    assert_status(km_shape_morph_frame_until(ia, e, NULL, &f, NULL), KM_OK);
+    assert_status(km_shape_morph_frame_until(iv, e, NULL, &g, NULL), KM_OK);
+    assert_le(frames_apart(&f, &g), 1e-9);
+    km_shape_frame_free(&f);
+    km_shape_frame_free(&g);
+  }
+  km_shape_morph_free(ma);
+  km_shape_morph_free(mv);
+  km_shape_morph_free(ia);
+  km_shape_morph_free(iv);
+  km_shape_free(&sa);
+  km_shape_free(&sb);
+  km_shape_free(&si);
+  km_shape_free(&sl);
+}
+
+/* A stop counting its questions, saying yes from the n-th on. */
+typedef struct asker {
+  long asked, yes_at;
+} asker;
+
+static bool ask(void *ctx) {
+  asker *a = ctx;
+  return ++a->asked >= a->yes_at;
+}
+
+/* The previews and the search of avoid poll the caller's stop: a morph
+ * asks more questions under avoid than under allow, and a stop at any
+ * of them ends the morph with KM_ECANCELLED and nothing returned. */
+static void avoid_polls_the_stop(void **state) {
+  (void)state;
+  km_shape si, sl;
+  i_and_l(&si, &sl);
+  km_shape_morph_options o;
+  km_shape_morph_options_default(&o);
+  long asked[2];
+  for (int x = 0; x < 2; x++) {
+    asker a = {0, LONG_MAX};
+    km_stop stop = {ask, &a};
+    o.morph.intersections = x ? KM_INTERSECTIONS_AVOID : KM_INTERSECTIONS_ALLOW;
+    km_shape_morph *m = NULL;
+    assert_status(km_shape_morph_create(&m, &si, &sl, &o, &stop, NULL), KM_OK);
+    km_shape_morph_free(m);
+    asked[x] = a.asked;
+  }
+  assert_true(asked[1] > asked[0]);
+  for (long n = asked[0] + 1; n <= asked[1];
+       n += 1 + (asked[1] - asked[0]) / 4) {
+    asker a = {0, n};
+    km_stop stop = {ask, &a};
+    km_shape_morph *m = NULL;
+    km_error err;
+    assert_status(km_shape_morph_create(&m, &si, &sl, &o, &stop, &err),
+                  KM_ECANCELLED);
+    assert_null(m);
+    assert_int_equal(a.asked, n);
+  }
+  km_shape_free(&si);
+  km_shape_free(&sl);
+}
+
 static const struct CMUnitTest tests[] = {
     cmocka_unit_test(ring_to_ring_through_rings),
     cmocka_unit_test(o_to_c_counter_shrinks_away),
     cmocka_unit_test(i_to_l_dot_vanishes_into_the_stem),
     cmocka_unit_test(eight_to_three_both_counters_close),
     cmocka_unit_test(frame_refuses_t_outside),
+    cmocka_unit_test(avoid_keeps_clean_morphs_and_ends),
+    cmocka_unit_test(avoid_polls_the_stop),
 };
 
 TM_SUITE("shape_morph", tests, NULL, NULL);

@@ -232,8 +232,13 @@ KM_API void km_shape_frame_free(km_shape_frame *f);
  * ends or starts, is its centroid mapped onto its host pair (its parent's
  * pair, or for a top-level contour the nearest paired top-level contour)
  * by the host's centroids and the square root of its areas' ratio,
- * pulled into the host's partner when it falls outside. stop is polled
- * throughout (NULL: never). Returns KM_OK, or (err->index the pair at
+ * pulled into the host's partner when it falls outside. Under
+ * opt->morph.intersections KM_INTERSECTIONS_AVOID, when previews of
+ * interior frames show mutual crossings or a child outside its parent,
+ * the morph may place children by the part of their parent near them and
+ * correct contours' placement and size by amounts smooth in t and zero at
+ * t = 0 and 1; a morph whose previews are clean gets the frames it gets
+ * under ALLOW. stop is polled throughout (NULL: never). Returns KM_OK, or (err->index the pair at
  * fault where there is one):
  *   KM_EINVAL    from or to empty;
  *   km_shape_pair_check's statuses for opt->pairs;
