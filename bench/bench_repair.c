@@ -174,7 +174,6 @@ int main(void) {
   printf("%d pairs, %d frames each: %d frames cross, %d repaired, %d pairs "
          "crossing-free, largest displacement %.4f of the frame length, "
          "create %.1f ms a morph (mean)\n",
-         pairs, FRAMES, crossing, repaired, clean, move,
-         1e3 * create / pairs);
+         pairs, FRAMES, crossing, repaired, clean, move, 1e3 * create / pairs);
   return 0;
 }
