@@ -42,12 +42,16 @@ static char *read_file(const char *path) {
   return s;
 }
 
-static cJSON *fixture(void) {
-  char *text = read_file("tests/fixtures/avoid/glyphs.json");
+static cJSON *fixture_at(const char *path) {
+  char *text = read_file(path);
   cJSON *root = cJSON_Parse(text);
   free(text);
   assert_non_null(root);
   return root;
+}
+
+static cJSON *fixture(void) {
+  return fixture_at("tests/fixtures/avoid/glyphs.json");
 }
 
 static const char *glyph_d(const cJSON *root, const char *id) {
@@ -408,8 +412,60 @@ static void avoid_is_the_default(void **state) {
   cJSON_Delete(root);
 }
 
+/* The 21 pairs of tests/fixtures/avoid/repair.json still crossed after the
+ * free choices (61 frames of 861 by the answers' own count before the
+ * repair existed). With the repair, by the independent check here: at
+ * most 45 crossing frames and at least 7 pairs crossing-free (measured:
+ * 39-43 and 8-10), every repaired frame listed is closed where the pair
+ * is, its displacement under 5% of the frame's size, and frames 0 and
+ * 40 are never repaired (they are the inputs). */
+static void the_repair_separates_pinches(void **state) {
+  (void)state;
+  cJSON *root = fixture_at("tests/fixtures/avoid/repair.json");
+  const cJSON *p;
+  int total = 0, clean = 0, repaired = 0;
+  cJSON_ArrayForEach(p, member(root, "pairs")) {
+    const char *from = member(p, "from")->valuestring;
+    const char *to = member(p, "to")->valuestring;
+    cJSON *j = morph(root, from, to, "avoid");
+    bool crossing[FRAMES];
+    int n = crossing_frames(j, crossing);
+    total += n;
+    clean += n == 0;
+    const cJSON *r, *frames = member(j, "frames");
+    cJSON_ArrayForEach(r,
+                       member(member(j, "intersections"), "repaired_frames")) {
+      int k = member(r, "frame")->valueint;
+      assert_true(k > 0 && k < FRAMES - 1);
+      at_curve c;
+      at_curve_from_json(member(cJSON_GetArrayItem(frames, k), "curve"), &c);
+      double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+      for (size_t i = 0; i < c.n; i++) {
+        x0 = fmin(x0, c.cp[2 * i]);
+        x1 = fmax(x1, c.cp[2 * i]);
+        y0 = fmin(y0, c.cp[2 * i + 1]);
+        y1 = fmax(y1, c.cp[2 * i + 1]);
+      }
+      assert_true(c.closed);
+      assert_true(member(r, "displacement")->valuedouble <=
+                  0.05 * hypot(x1 - x0, y1 - y0));
+      at_curve_free(&c);
+      repaired++;
+    }
+    cJSON_Delete(j);
+  }
+  print_message("repair pairs: %d crossing frames of %d, %d of 21 pairs "
+                "crossing-free, %d frames repaired\n",
+                total, 21 * FRAMES, clean, repaired);
+  assert_true(total <= 45);
+  assert_true(clean >= 7);
+  assert_true(repaired > 0);
+  cJSON_Delete(root);
+}
+
 static const struct CMUnitTest tests[] = {
     cmocka_unit_test(avoid_is_the_default),
+    cmocka_unit_test(the_repair_separates_pinches),
     cmocka_unit_test(avoid_removes_most_crossing_frames),
     cmocka_unit_test(frames_that_did_not_cross_are_kept),
     cmocka_unit_test(avoided_sequences_do_not_jump),
