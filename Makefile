@@ -351,11 +351,11 @@ build/bench/bench_morph: bench/bench_morph.c $(LIBCORE)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) $(CORE_INC) $(CJSON_CFLAGS) $< -o $@ $(LIBCORE) $(CJSON_LIBS) -lm $(LDFLAGS)
 
-build/bench/bench_avoid: bench/bench_avoid.c $(LIBCORE)
+build/bench/bench_avoid: bench/bench_avoid.c bench/bench_glyphs.h $(LIBCORE)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) $(CORE_INC) $(CJSON_CFLAGS) $< -o $@ $(LIBCORE) $(CJSON_LIBS) -lm $(LDFLAGS)
 
-build/bench/bench_repair: bench/bench_repair.c $(LIBCORE)
+build/bench/bench_repair: bench/bench_repair.c bench/bench_glyphs.h $(LIBCORE)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) $(CORE_INC) $(CJSON_CFLAGS) $< -o $@ $(LIBCORE) $(CJSON_LIBS) -lm $(LDFLAGS)
 
