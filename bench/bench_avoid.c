@@ -1,13 +1,15 @@
 /* bench_avoid.c - the cost of "intersections": "avoid" against "allow" on
- * the glyph pairs of tests/fixtures/avoid/glyphs.json.
+ * the glyph pairs of tests/fixtures/avoid/glyphs.json and repair.json.
  *
  * Each pair is morphed into 41 frames both ways: km_morph_create plus 41
  * km_morph_frame calls, curve only (the planned frames of an SVG answer)
  * and with metrics (the JSON answer's default), best of runs repeated for
  * at least MIN_SECONDS. The per-frame time (creation amortised over the 41
- * frames) is summed over two groups of pairs: those whose previews do not
- * cross (avoid checks and keeps the frames: its whole cost is the check)
- * and those it searched. Glyph outlines are TrueType (M, L, Q, Z), built
+ * frames) is summed over three groups of pairs: those whose previews do
+ * not cross (avoid checks and keeps the frames: its whole cost is the
+ * check), those it searched and kept with no frame to repair, and those
+ * whose frames it repaired (mostly from repair.json: pairs that still
+ * cross after the choice). Glyph outlines are TrueType (M, L, Q, Z), built
  * with km_path exactly.
  *
  * Usage: bench_avoid (run from the repository root).
@@ -23,7 +25,7 @@
 #include "bench_glyphs.h"
 
 #define FRAMES 41
-#define FIXTURE "tests/fixtures/avoid/glyphs.json"
+#define GROUPS 3
 #define MIN_SECONDS 0.1
 
 /* One morph of FRAMES frames: its time in seconds, or a negative number. */
@@ -68,18 +70,22 @@ static double morph_best(const km_curve *a, const km_curve *b,
   return best;
 }
 
-int main(void) {
-  char *text = read_file(FIXTURE);
+/* [metrics][group][allow, avoid]: summed per-frame microseconds */
+typedef struct tally {
+  double sum[2][GROUPS][2];
+  int count[GROUPS];
+  long previews[GROUPS], events[GROUPS];
+} tally;
+
+/* Every pair of the fixture at path, into *tl; 0 or -1. */
+static int bench_fixture(const char *path, tally *tl) {
+  char *text = read_file(path);
   cJSON *root = text ? cJSON_Parse(text) : NULL;
   free(text);
   if (!root) {
-    fprintf(stderr, "cannot read %s\n", FIXTURE);
-    return 1;
+    fprintf(stderr, "cannot read %s\n", path);
+    return -1;
   }
-  /* [metrics][searched][allow, avoid]: summed per-frame microseconds */
-  double sum[2][2][2] = {{{0}}};
-  int count[2] = {0, 0};
-  long previews[2] = {0, 0};
   const cJSON *p;
   cJSON_ArrayForEach(p, cJSON_GetObjectItemCaseSensitive(root, "pairs")) {
     const char *from = cJSON_GetObjectItemCaseSensitive(p, "from")->valuestring;
@@ -89,7 +95,7 @@ int main(void) {
     if (!da || !db || glyph_curve(da, &a) || glyph_curve(db, &b)) {
       fprintf(stderr, "%s -> %s: cannot build the glyphs\n", from, to);
       cJSON_Delete(root);
-      return 1;
+      return -1;
     }
     km_morph_avoidance rep;
     memset(&rep, 0, sizeof rep);
@@ -103,29 +109,45 @@ int main(void) {
     if (t[0][0] < 0 || t[0][1] < 0 || t[1][0] < 0 || t[1][1] < 0) {
       fprintf(stderr, "%s -> %s: the morph failed\n", from, to);
       cJSON_Delete(root);
-      return 1;
+      return -1;
     }
-    int s = rep.searched ? 1 : 0;
-    count[s]++;
-    previews[s] += (long)rep.previews;
+    int g = rep.repair_events > 0 ? 2 : rep.searched ? 1 : 0;
+    tl->count[g]++;
+    tl->previews[g] += (long)rep.previews;
+    tl->events[g] += rep.repair_events;
     for (int metrics = 0; metrics < 2; metrics++)
       for (int k = 0; k < 2; k++)
-        sum[metrics][s][k] += 1e6 * t[metrics][k] / FRAMES;
+        tl->sum[metrics][g][k] += 1e6 * t[metrics][k] / FRAMES;
   }
   cJSON_Delete(root);
+  return 0;
+}
+
+int main(void) {
+  static const char *fixtures[] = {"tests/fixtures/avoid/glyphs.json",
+                                   "tests/fixtures/avoid/repair.json"};
+  static const char *group[GROUPS] = {"previews do not cross (kept)",
+                                      "previews cross (searched)",
+                                      "frames repaired"};
   printf("intersections avoid against allow, %d frames, per frame (creation "
          "amortised), mean over pairs:\n",
          FRAMES);
-  static const char *group[2] = {"previews do not cross (kept)",
-                                 "previews cross (searched)"};
-  for (int s = 0; s < 2; s++) {
-    if (count[s] == 0) continue;
-    printf("  %-30s %2d pairs, %5.1f previews: curve %6.1f us allow, %6.1f "
-           "us avoid (x%.2f); with metrics %6.1f us, %6.1f us (x%.2f)\n",
-           group[s], count[s], (double)previews[s] / count[s],
-           sum[0][s][0] / count[s], sum[0][s][1] / count[s],
-           sum[0][s][1] / sum[0][s][0], sum[1][s][0] / count[s],
-           sum[1][s][1] / count[s], sum[1][s][1] / sum[1][s][0]);
+  for (size_t i = 0; i < sizeof fixtures / sizeof *fixtures; i++) {
+    tally tl;
+    memset(&tl, 0, sizeof tl);
+    if (bench_fixture(fixtures[i], &tl)) return 1;
+    printf("%s\n", fixtures[i]);
+    for (int g = 0; g < GROUPS; g++) {
+      if (tl.count[g] == 0) continue;
+      double n = tl.count[g];
+      printf("  %-30s %2d pairs, %5.1f previews, %4.1f repair events: curve "
+             "%6.1f us allow, %6.1f us avoid (x%.2f); with metrics %6.1f us, "
+             "%6.1f us (x%.2f)\n",
+             group[g], tl.count[g], (double)tl.previews[g] / n,
+             (double)tl.events[g] / n, tl.sum[0][g][0] / n, tl.sum[0][g][1] / n,
+             tl.sum[0][g][1] / tl.sum[0][g][0], tl.sum[1][g][0] / n,
+             tl.sum[1][g][1] / n, tl.sum[1][g][1] / tl.sum[1][g][0]);
+    }
   }
   return 0;
 }
