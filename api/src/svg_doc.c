@@ -20,6 +20,7 @@
 
 #include "internal.h"
 #include "km/alloc.h"
+#include "km/limits.h"
 #include "svg_doc.h"
 
 #define DEF_FROM "#2166ac"
@@ -40,25 +41,92 @@ static void bbox_add(api_svg_bbox *b, double x, double y) {
   if (y > b->y1) b->y1 = y;
 }
 
-/* Bounding box of a curve's trace by sampling every knot span (the control
- * polygon would be safe but loose for NURBS and long legs). */
+/* Deepest halving of a piece whose control polygon still leaves the box. */
+#define BOX_DEPTH 10
+
+/* Box of the control points of a Bezier piece (homogeneous x w, y w, w;
+ * weights are positive, so the piece lies in their hull). */
+static void hull_box(const double (*h)[3], int p, double box[4]) {
+  box[0] = box[2] = h[0][0] / h[0][2];
+  box[1] = box[3] = h[0][1] / h[0][2];
+  for (int k = 1; k <= p; k++) {
+    double x = h[k][0] / h[k][2], y = h[k][1] / h[k][2];
+    box[0] = fmin(box[0], x);
+    box[1] = fmin(box[1], y);
+    box[2] = fmax(box[2], x);
+    box[3] = fmax(box[3], y);
+  }
+}
+
+/* Grow *b to hold a Bezier piece (homogeneous points h[0..p]). Its end
+ * points are on the trace; where its control polygon's box leaves *b by
+ * more than slack, the piece is halved (de Casteljau) and each half looked
+ * at again, so the box is the trace's to within slack (or, past BOX_DEPTH
+ * halvings, the polygon's, which holds the trace). */
+static void piece_bbox(const double (*h)[3], int p, int depth, double slack,
+                       api_svg_bbox *b) {
+  bbox_add(b, h[0][0] / h[0][2], h[0][1] / h[0][2]);
+  bbox_add(b, h[p][0] / h[p][2], h[p][1] / h[p][2]);
+  double hb[4];
+  hull_box(h, p, hb);
+  if (hb[0] >= b->x0 - slack && hb[1] >= b->y0 - slack &&
+      hb[2] <= b->x1 + slack && hb[3] <= b->y1 + slack)
+    return;
+  if (depth >= BOX_DEPTH || !(hb[2] - hb[0] + hb[3] - hb[1] > slack)) {
+    bbox_add(b, hb[0], hb[1]);
+    bbox_add(b, hb[2], hb[3]);
+    return;
+  }
+  double l[KM_MAX_DEGREE + 1][3], r[KM_MAX_DEGREE + 1][3],
+      q[KM_MAX_DEGREE + 1][3];
+  memcpy(q, h, (size_t)(p + 1) * sizeof *q);
+  for (int j = 0; j <= p; j++) {
+    memcpy(l[j], q[0], sizeof q[0]);
+    memcpy(r[p - j], q[p - j], sizeof q[0]);
+    for (int k = 0; k < p - j; k++)
+      for (int d = 0; d < 3; d++) q[k][d] = 0.5 * (q[k][d] + q[k + 1][d]);
+  }
+  piece_bbox((const double(*)[3])l, p, depth + 1, slack, b);
+  piece_bbox((const double(*)[3])r, p, depth + 1, slack, b);
+}
+
+/* Bounding box of a curve's trace to within 1e-6 of its control box: the
+ * curve in Bezier form, every piece's end points, and its control polygon
+ * halved where that polygon leaves the box (sampling would cut corners off
+ * and costs thousands of evaluations a frame). */
 static void curve_bbox(const km_curve *c, api_svg_bbox *b) {
   if (!c || c->n == 0) return;
-  size_t spans = 0;
-  for (size_t i = (size_t)c->degree; i < c->n; i++)
-    if (c->knots[i + 1] > c->knots[i]) spans++;
-  int per = spans ? (int)(4096 / spans) : 2;
-  if (per < 2) per = 2;
-  if (per > 64) per = 64;
-  for (size_t i = (size_t)c->degree; i < c->n; i++) {
-    double a = c->knots[i], e = c->knots[i + 1];
-    if (!(e > a)) continue;
-    for (int k = 0; k <= per; k++) {
-      double pt[1][2];
-      km_curve_eval(c, a + (e - a) * k / per, 0, pt);
-      bbox_add(b, pt[0][0], pt[0][1]);
-    }
+  km_curve bz;
+  km_curve_init(&bz);
+  km_error err;
+  if (c->degree > KM_MAX_DEGREE || km_curve_to_bezier(&bz, c, &err) != KM_OK) {
+    for (size_t j = 0; j < c->n; j++) /* the control box holds the trace */
+      bbox_add(b, c->cp[2 * j], c->cp[2 * j + 1]);
+    return;
   }
+  int p = bz.degree;
+  double cb[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
+  for (size_t j = 0; j < bz.n; j++) {
+    cb[0] = fmin(cb[0], bz.cp[2 * j]);
+    cb[1] = fmin(cb[1], bz.cp[2 * j + 1]);
+    cb[2] = fmax(cb[2], bz.cp[2 * j]);
+    cb[3] = fmax(cb[3], bz.cp[2 * j + 1]);
+  }
+  double slack = 1e-6 * fmax(cb[2] - cb[0], cb[3] - cb[1]);
+  /* end points first: most pieces then lie inside the box already */
+  for (size_t j = 0; j < bz.n; j += (size_t)p)
+    bbox_add(b, bz.cp[2 * j], bz.cp[2 * j + 1]);
+  for (size_t i = 0; i + (size_t)p < bz.n; i += (size_t)p) {
+    double h[KM_MAX_DEGREE + 1][3];
+    for (int k = 0; k <= p; k++) {
+      double w = bz.w ? bz.w[i + (size_t)k] : 1.0;
+      h[k][0] = bz.cp[2 * (i + (size_t)k)] * w;
+      h[k][1] = bz.cp[2 * (i + (size_t)k) + 1] * w;
+      h[k][2] = w;
+    }
+    piece_bbox((const double(*)[3])h, p, 0, slack, b);
+  }
+  km_curve_free(&bz);
 }
 
 /* "#rgb" or "#rrggbb". */

@@ -521,8 +521,58 @@ static void no_frames_still_give_a_document(void **state) {
   free(doc);
 }
 
+/* The number after `key` in the first <path ...> of a document. */
+static double path_number(const char *doc, const char *key) {
+  const char *p = strstr(doc, "<path ");
+  assert_non_null(p);
+  const char *a = strstr(p, key);
+  assert_non_null(a);
+  return strtod(a + strlen(key), NULL);
+}
+
+/* A frame is laid out by the box of its trace, not of its control points
+ * nor of samples: the cubic with control points (0, 0), (0, 10), (1, 3),
+ * (1, 0) has x = 3 t^2 - 2 t^3 (0 .. 1) and y = 30 t - 51 t^2 + 21 t^3,
+ * highest where y' = 30 - 102 t + 63 t^2 = 0, t = (102 - sqrt 2844) / 126,
+ * between samples; its overlay must be laid out exactly as that of the
+ * rectangle [0, 1] x [0, y max], whose corners are control points. */
+static void the_layout_box_is_the_trace_box(void **state) {
+  (void)state;
+  double t = (102 - sqrt(2844.0)) / 126,
+         ymax = 30 * t - 51 * t * t + 21 * t * t * t;
+  const double kb[] = {0, 0, 0, 0, 1, 1, 1, 1};
+  const double cb[] = {0, 0, 0, 10, 1, 3, 1, 0};
+  const double kr[] = {0, 0, 1, 2, 3, 4, 4};
+  const double cr[] = {0, 0, 1, 0, 1, ymax, 0, ymax, 0, 0};
+  km_curve c[2];
+  km_error err;
+  km_curve_init(&c[0]);
+  km_curve_init(&c[1]);
+  assert_status(km_curve_create(&c[0], 3, 4, kb, cb, NULL, false, &err), KM_OK);
+  assert_status(km_curve_create(&c[1], 1, 5, kr, cr, NULL, true, &err), KM_OK);
+  double scale[2], shift[2];
+  for (int k = 0; k < 2; k++) {
+    api_svg_frame f = {0, &c[k], NULL};
+    api_svg_options o;
+    memset(&o, 0, sizeof o);
+    o.layout = API_SVG_OVERLAY;
+    char *doc = api_svg_morph_document(&f, 1, &o);
+    assert_non_null(doc);
+    scale[k] = path_number(doc, "scale(");
+    shift[k] = path_number(doc, ") translate(");
+    free(doc);
+    km_curve_free(&c[k]);
+  }
+  /* the box is the trace's to 1e-6 of the control box (10 high): 2e-6 of
+   * the frame's 5.7; sampling at t = k / 64 misses the top by 5e-4 (9e-5
+   * of it), the control box overshoots by 4.8 */
+  assert_true(fabs(scale[0] - scale[1]) <= 4e-6 * scale[1]);
+  assert_true(fabs(shift[0] - shift[1]) <= 4e-6 * (1 + fabs(shift[1])));
+}
+
 static const struct CMUnitTest tests[] = {
     cmocka_unit_test(every_layout_is_well_formed_and_renders),
+    cmocka_unit_test(the_layout_box_is_the_trace_box),
     cmocka_unit_test(
         curvature_plot_without_signatures_and_single_frames_render),
     cmocka_unit_test(size_stroke_and_colour_options_are_honoured),
