@@ -8,64 +8,23 @@
  * the crossing count of the frames under ALLOW shows here), crossing
  * counts of frames (km_curve_self_intersections, checked against an
  * independent dense-polyline count in tests/api/test_api_avoid.c), and
- * the preview budget stated in core/src/morph_avoid.c (2 + 7 x 32).
+ * the preview budget stated in core/src/morph_avoid.c (2 + 7 x 32). The
+ * repair's motion is tested in test_repair_motion.c.
  */
 #include <cJSON.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "glyphs.h"
 #include "km/kmorph.h"
 #include "testmain.h"
 #include "testutil.h"
 
-static char *read_file(const char *path) {
-  FILE *fp = fopen(path, "rb");
-  assert_non_null(fp);
-  fseek(fp, 0, SEEK_END);
-  long n = ftell(fp);
-  fseek(fp, 0, SEEK_SET);
-  char *s = malloc((size_t)n + 1);
-  assert_non_null(s);
-  assert_int_equal(fread(s, 1, (size_t)n, fp), (size_t)n);
-  s[n] = '\0';
-  fclose(fp);
-  return s;
-}
-
-/* Glyph id of the fixture (absolute M, L, Q, Z path data) as a curve. */
+/* Glyph id of tests/fixtures/avoid/glyphs.json as a curve. */
 static void glyph(const char *id, km_curve *out) {
-  char *text = read_file("tests/fixtures/avoid/glyphs.json");
-  cJSON *root = cJSON_Parse(text), *g;
-  free(text);
-  assert_non_null(root);
-  const char *d = NULL;
-  cJSON_ArrayForEach(g, cJSON_GetObjectItemCaseSensitive(root, "glyphs")) {
-    if (!strcmp(cJSON_GetObjectItemCaseSensitive(g, "id")->valuestring, id))
-      d = cJSON_GetObjectItemCaseSensitive(g, "d")->valuestring;
-  }
-  assert_non_null(d);
-  km_path p;
-  km_path_init(&p);
-  double v[4];
-  while (*d) {
-    while (*d == ' ') d++;
-    char op = *d;
-    if (!op) break;
-    d++;
-    int n = op == 'M' || op == 'L' ? 2 : op == 'Q' ? 4 : 0;
-    for (int i = 0; i < n; i++) v[i] = strtod(d, (char **)&d);
-    km_status st = op == 'M'   ? km_path_move_to(&p, v[0], v[1], NULL)
-                   : op == 'L' ? km_path_line_to(&p, v[0], v[1], NULL)
-                   : op == 'Q'
-                       ? km_path_quad_to(&p, v[0], v[1], v[2], v[3], NULL)
-                   : op == 'Z' ? km_path_close(&p, NULL)
-                               : KM_EINVAL;
-    assert_status(st, KM_OK);
-  }
-  km_curve_init(out);
-  assert_status(km_path_to_curve(&p, 0.0, out, NULL), KM_OK);
-  km_path_free(&p);
+  cJSON *root = tg_fixture(TG_AVOID_PATH);
+  tg_glyph(root, id, out);
   cJSON_Delete(root);
 }
 
