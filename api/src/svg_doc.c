@@ -90,43 +90,59 @@ static void piece_bbox(const double (*h)[3], int p, int depth, double slack,
   piece_bbox((const double(*)[3])r, p, depth + 1, slack, b);
 }
 
-/* Bounding box of a curve's trace to within 1e-6 of its control box: the
- * curve in Bezier form, every piece's end points, and its control polygon
- * halved where that polygon leaves the box (sampling would cut corners off
- * and costs thousands of evaluations a frame). */
-static void curve_bbox(const km_curve *c, api_svg_bbox *b) {
-  if (!c || c->n == 0) return;
-  km_curve bz;
-  km_curve_init(&bz);
-  km_error err;
-  if (c->degree > KM_MAX_DEGREE || km_curve_to_bezier(&bz, c, &err) != KM_OK) {
-    for (size_t j = 0; j < c->n; j++) /* the control box holds the trace */
-      bbox_add(b, c->cp[2 * j], c->cp[2 * j + 1]);
-    return;
+/* The blossom of span i of c (knots[i] <= knots[i+1]) at x[0 .. p), in
+ * homogeneous coordinates: de Boor's scheme with x[r - 1] at level r. */
+static void span_blossom(const km_curve *c, size_t i, const double *x,
+                         double out[3]) {
+  int p = c->degree;
+  double d[KM_MAX_DEGREE + 1][3];
+  for (int k = 0; k <= p; k++) {
+    size_t j = i - (size_t)p + (size_t)k;
+    double w = c->w ? c->w[j] : 1.0;
+    d[k][0] = c->cp[2 * j] * w;
+    d[k][1] = c->cp[2 * j + 1] * w;
+    d[k][2] = w;
   }
-  int p = bz.degree;
+  for (int r = 1; r <= p; r++)
+    for (int k = p; k >= r; k--) {
+      double lo = c->knots[i - (size_t)p + (size_t)k],
+             hi = c->knots[i + 1 + (size_t)k - (size_t)r];
+      double al = hi > lo ? (x[r - 1] - lo) / (hi - lo) : 0.0;
+      for (int q = 0; q < 3; q++)
+        d[k][q] = (1 - al) * d[k - 1][q] + al * d[k][q];
+    }
+  memcpy(out, d[p], sizeof d[p]);
+}
+
+/* Bounding box of a curve's trace to within 1e-6 of its control box: each
+ * knot span as a Bezier piece (its control points the blossom's values at
+ * a^(p-j) b^j), the pieces' end points, and their control polygons halved
+ * where they leave the box (sampling would cut corners off and costs
+ * thousands of evaluations a frame). Nothing is allocated. */
+static void curve_bbox(const km_curve *c, api_svg_bbox *b) {
+  if (!c || c->n == 0 || c->degree < 1 || c->degree > KM_MAX_DEGREE) return;
+  int p = c->degree;
   double cb[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
-  for (size_t j = 0; j < bz.n; j++) {
-    cb[0] = fmin(cb[0], bz.cp[2 * j]);
-    cb[1] = fmin(cb[1], bz.cp[2 * j + 1]);
-    cb[2] = fmax(cb[2], bz.cp[2 * j]);
-    cb[3] = fmax(cb[3], bz.cp[2 * j + 1]);
+  for (size_t j = 0; j < c->n; j++) {
+    cb[0] = fmin(cb[0], c->cp[2 * j]);
+    cb[1] = fmin(cb[1], c->cp[2 * j + 1]);
+    cb[2] = fmax(cb[2], c->cp[2 * j]);
+    cb[3] = fmax(cb[3], c->cp[2 * j + 1]);
   }
   double slack = 1e-6 * fmax(cb[2] - cb[0], cb[3] - cb[1]);
-  /* end points first: most pieces then lie inside the box already */
-  for (size_t j = 0; j < bz.n; j += (size_t)p)
-    bbox_add(b, bz.cp[2 * j], bz.cp[2 * j + 1]);
-  for (size_t i = 0; i + (size_t)p < bz.n; i += (size_t)p) {
-    double h[KM_MAX_DEGREE + 1][3];
-    for (int k = 0; k <= p; k++) {
-      double w = bz.w ? bz.w[i + (size_t)k] : 1.0;
-      h[k][0] = bz.cp[2 * (i + (size_t)k)] * w;
-      h[k][1] = bz.cp[2 * (i + (size_t)k) + 1] * w;
-      h[k][2] = w;
+  /* the curve's ends first (clamped: its first and last control points) */
+  bbox_add(b, c->cp[0], c->cp[1]);
+  bbox_add(b, c->cp[2 * (c->n - 1)], c->cp[2 * (c->n - 1) + 1]);
+  for (size_t i = (size_t)p; i < c->n; i++) {
+    double lo = c->knots[i], hi = c->knots[i + 1];
+    if (!(hi > lo)) continue;
+    double h[KM_MAX_DEGREE + 1][3], x[KM_MAX_DEGREE];
+    for (int j = 0; j <= p; j++) {
+      for (int k = 0; k < p; k++) x[k] = k < p - j ? lo : hi;
+      span_blossom(c, i, x, h[j]);
     }
     piece_bbox((const double(*)[3])h, p, 0, slack, b);
   }
-  km_curve_free(&bz);
 }
 
 /* "#rgb" or "#rrggbb". */
