@@ -546,13 +546,16 @@ static km_status placed_signature(const km_signature *sig, double rot,
                              sig->closed, err);
 }
 
-/* The planned frame with the metrics of the exact frame: the blended and
- * closed signature gives length, curvature, energy and gap exactly (they
- * describe the exact frame, not its approximation), and the crossings are
- * counted on the returned curve, which is within the tolerance of it. The
- * exact frame's reconstruction, the costly part of the general path, is
- * not needed: a frame with metrics costs its signature and the crossing
- * count beyond the planned frame, and has the same curve as without. */
+/* The planned frame with the metrics of the signature it is built from:
+ * the blend closed by the frame's own closure correction (the basis and
+ * metric of the general path's lsq closure, its coefficients those the
+ * planned frame found) gives length, curvature, energy and gap exactly,
+ * and the crossings are counted on the returned curve, which is within
+ * the tolerance of it. Neither the exact frame's reconstruction nor a
+ * second closure solve is needed: a frame with metrics costs the blend,
+ * the closure's passes again and the crossing count beyond the planned
+ * frame, and has the same curve as without. Frames closed by their
+ * corners take the general path's closure. */
 static km_status planned_frame_with_metrics(const km_morph *m, double t,
                                             km_closure how, km__poll *poll,
                                             km_curve *out,
@@ -562,8 +565,31 @@ static km_status planned_frame_with_metrics(const km_morph *m, double t,
   km_signature_init(&sig);
   km_curve f;
   km_curve_init(&f);
-  double gap = 0.0;
-  km_status st = frame_signature(m, t, poll, &sig, &gap, err);
+  double gap = 0.0, c[KM__CLOSURE_INTERVALS - 3];
+  bool by_psi = false;
+  km_status st = KM_OK;
+  if (m->closed && how == KM_CLOSURE_LSQ) {
+    const km__input *a = &m->in[0], *b = &m->in[1];
+    double phia = a->sig.angle,
+           phib = phia + km__wrap_angle(b->sig.angle - phia);
+    st = km__frame_plan_closure(m->plan, t, (1 - t) * phia + t * phib, c, &gap,
+                                &by_psi, poll);
+    if (st == KM_ECANCELLED)
+      st = km__stopped(err);
+    else if (st == KM_ENOMEM)
+      st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+    else if (st) /* the general path's own closure then */
+      st = KM_OK;
+  }
+  if (!st && by_psi) {
+    km_signature blended;
+    km_signature_init(&blended);
+    st = km__blend_signature(m, t, &blended, err);
+    if (!st) st = km__closure_add(&blended, c, &sig, err);
+    km_signature_free(&blended);
+  } else if (!st) {
+    st = frame_signature(m, t, poll, &sig, &gap, err);
+  }
   if (!st) st = planned_frame(m, t, how, poll, &f, err);
   if (!st) st = exact_metrics(m, &sig, &f, gap, poll, metrics, err);
   if (!st) {

@@ -369,8 +369,8 @@ static km_status closure_coefficients(const qnode *q, size_t nq, double L,
 
 /* sig with kappa~ = kappa + psi' (psi' is quadratic on each basis
  * interval, so exact in Bernstein form from three values). */
-static km_status add_correction(const km_signature *sig, const double *c,
-                                km_signature *out, km_error *err) {
+km_status km__closure_add(const km_signature *sig, const double *c,
+                          km_signature *out, km_error *err) {
   double L = sig->length, h = L / NB;
   km_pp dpsi, k0, kt;
   km__pp_init(&dpsi);
@@ -436,7 +436,7 @@ km_status km__close_lsq(const km_signature *sig, bool by_corners,
     if (used_corners) *used_corners = st == KM_OK;
   } else {
     st = closure_coefficients(q, nq, L, weights, c, poll);
-    if (!st) st = add_correction(sig, c, out, err);
+    if (!st) st = km__closure_add(sig, c, out, err);
   }
 done:
   km__free(q);

@@ -64,6 +64,11 @@ km_status km__close_by_corners(const double *S, const double *tau, size_t nc,
 km_status km__close_lsq(const km_signature *sig, bool by_corners,
                         const double *weights, km_signature *out, double *gap0,
                         bool *used_corners, km__poll *poll, km_error *err);
+/* sig with its curvature changed by the closure correction psi' of
+ * coefficients c (KM__CLOSURE_INTERVALS - 3 of them, in radians of
+ * tangent angle) into *out, as km__close_lsq closes it. KM_ENOMEM. */
+km_status km__closure_add(const km_signature *sig, const double *c,
+                          km_signature *out, km_error *err);
 /* km__close_lsq of a blended frame of m (with m's closure by corners),
  * kept within the inputs' largest |kappa| where the least change would
  * cross it; statuses as km__close_lsq. */

@@ -461,3 +461,29 @@ done:
   if (st) return km__fail(err, st, KM_FIELD_NONE, -1, NAN, msg);
   return KM_OK;
 }
+
+km_status km__frame_plan_closure(const km__frame_plan *p, double t,
+                                 double theta0, double *c, double *gap0,
+                                 bool *by_psi, km__poll *poll) {
+  *by_psi = false;
+  if (!p->closed || p->by_corners) return KM_OK;
+  size_t nc = p->ncorners, scratch = km__plan_frame_scratch(p) + 4 * nc + 2;
+  double *sum = km__malloc((scratch + p->np) * sizeof(double));
+  if (!sum) return KM_ENOMEM;
+  /* theta_t alone: its gap, as the general path measures it */
+  double zero[NF + 6] = {0}, G[2], Lt = (1 - t) * p->La + t * p->Lb;
+  frame_pass(p, t, theta0, zero, NULL, false, sum, sum + 2 * p->np, G, NULL,
+             poll);
+  km_status st = KM_OK;
+  if (poll && poll->stopped) st = KM_ECANCELLED;
+  double cf[NF] = {0};
+  if (!st) st = frame_closure(p, t, theta0, true, cf, sum, sum + scratch, poll);
+  if (!st && poll && poll->stopped) st = KM_ECANCELLED;
+  if (!st) {
+    memcpy(c, cf, sizeof cf);
+    *gap0 = Lt * hypot(G[0], G[1]);
+    *by_psi = true;
+  }
+  km__free(sum);
+  return st;
+}
