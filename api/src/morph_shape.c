@@ -222,6 +222,7 @@ bool api__shape_build(api_ctx *ctx, api_morph_plan *pl, const km_stop *stop) {
   so.morph.stop = NULL;
   so.pairs = pairs;
   so.npairs = npairs;
+  so.pairs_free = pl->cmatches == NULL; /* not a person's pairing */
   st =
       km_shape_morph_create(&pl->smorph, &pl->sfrom, &pl->sto, &so, stop, &err);
   if (st == KM_EMATCH && pl->cmatches != NULL)

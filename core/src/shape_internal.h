@@ -125,7 +125,17 @@ struct km_shape_morph {
   bool no_adjust;       /* while corrections are measured: no per-frame move */
   bool free_top_points; /* a top-level unpaired contour's point is where
                            its host maps it, not pulled into the host */
+  long preview_fails;   /* mutual crossings and nesting failures of the
+                           kept choice's previews (-1: not previewed) */
 };
+
+/* Interior frames previewed under AVOID, t = j / (KM__PREVIEWS + 1). */
+#define KM__PREVIEWS 7
+/* Mutual crossings and nesting failures of m's frames at t = j / (n + 1),
+ * j = 1..n, or with between at the n + 1 times halfway between those and
+ * the ends (shape_avoid.c). KM_OK or a frame's status. */
+km_status km__shape_preview(const km_shape_morph *m, int n, bool between,
+                            const km_stop *stop, long *fails, km_error *err);
 
 /* Intervals of the correction grid (shape_avoid.c). */
 #define KM__FIX 16

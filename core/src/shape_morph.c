@@ -350,18 +350,16 @@ km_status km__shape_replan(km_shape_morph *m, const km_shape *a,
   return st;
 }
 
-km_status km_shape_morph_create(km_shape_morph **out, const km_shape *from,
-                                const km_shape *to,
-                                const km_shape_morph_options *opt,
-                                const km_stop *stop, km_error *err) {
-  km_shape_morph_options def;
-  km_shape_morph_options_default(&def);
-  if (!opt) opt = &def;
-  if (!out || !from || !to || !from->ncontours || !to->ncontours)
-    return km__fail(err, KM_EINVAL, KM_FIELD_NONE, -1, NAN, "empty shape");
+/* One morph of from and to with the pairing of opt (or the automatic
+ * one), its choices made under AVOID. */
+static km_status morph_once(km_shape_morph **out, const km_shape *from,
+                            const km_shape *to,
+                            const km_shape_morph_options *opt,
+                            const km_stop *stop, km_error *err) {
   km_shape_morph *m = km__calloc(1, sizeof *m);
   if (!m)
     return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, "out of memory");
+  m->preview_fails = -1;
   km_status st = take_pairs(m, from, to, opt, stop, err);
   if (st == KM_OK) {
     st = morph_alloc(m, m->npairs);
@@ -388,4 +386,111 @@ km_status km_shape_morph_create(km_shape_morph **out, const km_shape *from,
 cleanup:
   km_shape_morph_free(m);
   return st;
+}
+
+/* The swap of pairs i and j of base into cand (n pairs), if both are
+ * paired and the result is a valid pairing. */
+static bool swapped(const km_shape *from, const km_shape *to,
+                    const km_shape_pair *base, size_t n, size_t i, size_t j,
+                    km_shape_pair *cand) {
+  if (base[i].from < 0 || base[i].to < 0 || base[j].from < 0 || base[j].to < 0)
+    return false;
+  memcpy(cand, base, n * sizeof *cand);
+  cand[i].to = base[j].to;
+  cand[j].to = base[i].to;
+  return km_shape_pair_check(from, to, cand, n, NULL) == KM_OK;
+}
+
+/* Failures of m's frames at the previews' times and halfway between them
+ * (15 interior frames): what a pairing is judged by. */
+static km_status fine_fails(const km_shape_morph *m, const km_stop *stop,
+                            long *fails, km_error *err) {
+  long between = 0;
+  km_status st = km__shape_preview(m, KM__PREVIEWS, true, stop, &between, err);
+  *fails = (m->preview_fails > 0 ? m->preview_fails : 0) + between;
+  return st;
+}
+
+/* Under AVOID with a free pairing: pairings that swap the partners of two
+ * pairs (both paired, the swap valid by km_shape_pair_check: same roles,
+ * paired parents), in pair order, each a whole morph with its own
+ * choices, judged by the failures of 15 interior frames (the 7 previews
+ * and the 8 times between them and the ends: a crossing between previews
+ * is what the placement left); the first with fewer failures than the
+ * best so far replaces it, until one is clean or KM_SHAPE_PAIRINGS_TRIED
+ * are tried. Shapes without a valid swap (a glyph's outer contour and its
+ * hole) cost nothing more. Two bars of pause into the two of equal, or a
+ * dot and a stem into a question mark's body and dot, are paired by
+ * position, and their blends pass through each other: the swap keeps them
+ * apart. A swap whose pair cannot be morphed is passed over. */
+static km_status other_pairings(km_shape_morph **best, const km_shape *from,
+                                const km_shape *to,
+                                const km_shape_morph_options *opt,
+                                const km_stop *stop, km_error *err) {
+  size_t n = (*best)->npairs;
+  km_shape_pair *cand = km__malloc(2 * (n ? n : 1) * sizeof *cand);
+  if (!cand)
+    return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, "out of memory");
+  /* swaps of the first pairing, which the best may replace */
+  km_shape_pair *base = cand + n;
+  memcpy(base, (*best)->pairs, n * sizeof *base);
+  bool any = false;
+  for (size_t i = 0; i < n && !any; i++)
+    for (size_t j = i + 1; j < n && !any; j++)
+      any = swapped(from, to, base, n, i, j, cand);
+  long best_fails = 0;
+  km_status st = any ? fine_fails(*best, stop, &best_fails, err) : KM_OK;
+  km_shape_morph_options o = *opt;
+  o.pairs = cand;
+  o.npairs = n;
+  o.pairs_free = false;
+  int tried = 0;
+  for (size_t i = 0; i < n && st == KM_OK && best_fails > 0; i++)
+    for (size_t j = i + 1; j < n && st == KM_OK && best_fails > 0; j++) {
+      if (tried >= KM_SHAPE_PAIRINGS_TRIED) break;
+      if (!swapped(from, to, base, n, i, j, cand)) continue;
+      tried++;
+      km_shape_morph *alt = NULL;
+      km_error e2;
+      st = morph_once(&alt, from, to, &o, stop, &e2);
+      long fails = 0;
+      if (st == KM_OK) st = fine_fails(alt, stop, &fails, &e2);
+      if (st == KM_ECANCELLED || st == KM_ENOMEM) {
+        if (err) *err = e2;
+        km_shape_morph_free(alt);
+        break;
+      }
+      st = KM_OK; /* a pairing that cannot be morphed is passed over */
+      if (alt && fails < best_fails) {
+        km_shape_morph_free(*best);
+        *best = alt;
+        best_fails = fails;
+      } else {
+        km_shape_morph_free(alt);
+      }
+    }
+  km__free(cand);
+  return st;
+}
+
+km_status km_shape_morph_create(km_shape_morph **out, const km_shape *from,
+                                const km_shape *to,
+                                const km_shape_morph_options *opt,
+                                const km_stop *stop, km_error *err) {
+  km_shape_morph_options def;
+  km_shape_morph_options_default(&def);
+  if (!opt) opt = &def;
+  if (!out || !from || !to || !from->ncontours || !to->ncontours)
+    return km__fail(err, KM_EINVAL, KM_FIELD_NONE, -1, NAN, "empty shape");
+  km_shape_morph *m = NULL;
+  km_status st = morph_once(&m, from, to, opt, stop, err);
+  if (st == KM_OK && (opt->pairs == NULL || opt->pairs_free) &&
+      opt->morph.intersections == KM_INTERSECTIONS_AVOID)
+    st = other_pairings(&m, from, to, opt, stop, err);
+  if (st != KM_OK) {
+    km_shape_morph_free(m);
+    return st;
+  }
+  *out = m;
+  return KM_OK;
 }

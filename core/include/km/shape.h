@@ -188,11 +188,18 @@ typedef struct km_shape_morph_options {
                                  borrowed for the call; NULL: automatic */
   size_t npairs;
   km_shape_pair_costs costs; /* for the automatic pairing */
+  /* pairs (when given) came from km_shape_pair_auto, not from a person:
+   * under intersections AVOID the morph may pair otherwise where its
+   * previews still fail (automatic pairing is always free so) */
+  bool pairs_free;
 } km_shape_morph_options;
 
 /* Fill *o with defaults: km_morph_options_default, automatic pairing,
  * km_shape_pair_costs_default. */
 KM_API void km_shape_morph_options_default(km_shape_morph_options *o);
+
+/* Other pairings a morph under intersections AVOID tries at most. */
+#define KM_SHAPE_PAIRINGS_TRIED 6
 
 typedef struct km_shape_morph km_shape_morph;
 
@@ -238,7 +245,10 @@ KM_API void km_shape_frame_free(km_shape_frame *f);
  * the morph may place children by the part of their parent near them and
  * correct contours' placement and size by amounts smooth in t and zero at
  * t = 0 and 1; a morph whose previews are clean gets the frames it gets
- * under ALLOW. stop is polled throughout (NULL: never). Returns KM_OK, or (err->index the pair at
+ * under ALLOW. When they still fail and the pairing is free (automatic,
+ * or opt->pairs_free), pairings that swap the partners of two pairs are
+ * tried (at most KM_SHAPE_PAIRINGS_TRIED, each a whole morph) and the
+ * one whose previews fail least is kept (km_shape_morph_pairs tells it). stop is polled throughout (NULL: never). Returns KM_OK, or (err->index the pair at
  * fault where there is one):
  *   KM_EINVAL    from or to empty;
  *   km_shape_pair_check's statuses for opt->pairs;
