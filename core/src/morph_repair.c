@@ -92,7 +92,7 @@ typedef struct strands {
 } strands;
 
 /* Curvature repair: bumps of curvature per strand, and the largest. */
-#define KB_PER 4
+#define KB_PER 5
 #define MAX_KB (2 * KB_PER)
 /* Gauss-Newton steps of a curvature fit (each costs MAX_KB + 1 frames). */
 #define KGN_STEPS 8
@@ -100,6 +100,10 @@ typedef struct strands {
 #define KEPS 1e-5
 /* Largest change of a bump's turn in one step, radians. */
 #define KSTEP 0.15
+/* Weight of the rest of the frame's move against the clearance. */
+#ifndef KLOCAL
+#define KLOCAL 1.0
+#endif
 
 typedef struct km__repair_event {
   size_t w; /* coefficients per key time: 2 nb, or nk */
@@ -959,6 +963,7 @@ typedef struct kfit {
   km__repair_event *e;
   double t;
   size_t n[2], nn;
+  size_t nall;   /* nn and the ends of each strand's bumps (lo, hi) */
   double *r;     /* nn = n[0] + n[1] parameters */
   size_t *order; /* r sorted */
   double (*y)[2], (*y1)[2], (*y0)[2];
@@ -1005,7 +1010,7 @@ static km_status kfit_eval(kfit *k, const double *a, double (*y)[2]) {
   km_signature_init(&sig);
   km_status st = bumps_pp(ev, aa, 1, k->m->closed, &dk);
   if (!st) st = km__morph_signature_kappa(k->m, k->t, &dk, k->poll, &sig, NULL);
-  if (!st) st = sig_points(&sig, k->r, k->order, k->nn, y);
+  if (!st) st = sig_points(&sig, k->r, k->order, k->nall, y);
   km__pp_free(&dk);
   km_signature_free(&sig);
   return st;
@@ -1036,6 +1041,16 @@ static void kfit_residuals(const kfit *k, double (*y)[2], double *g,
   }
 }
 
+/* The move of each strand's bumps' far end beyond that of its near end
+ * (x, y of I, then of J), from the frame without bumps. */
+static void local_change(const kfit *k, double (*y)[2], double out[4]) {
+  for (int g = 0; g < 2; g++) {
+    size_t lo = k->nn + 2 * (size_t)g, hi = lo + 1;
+    for (int c = 0; c < 2; c++)
+      out[2 * g + c] = (y[hi][c] - k->y0[hi][c]) - (y[lo][c] - k->y0[lo][c]);
+  }
+}
+
 /* Fits the bumps at key time t into a (nk, warm start in a); *move
  * receives the largest move of a strand sample. */
 static km_status kfit_at(const km_morph *m, km__repair_event *e, double t,
@@ -1053,12 +1068,13 @@ static km_status kfit_at(const km_morph *m, km__repair_event *e, double t,
     k.n[s] = n < 8 ? 8 : n;
   }
   k.nn = k.n[0] + k.n[1];
-  size_t nn = k.nn, w = e->nk;
-  k.r = km__malloc(nn * sizeof *k.r);
-  k.order = km__malloc(nn * sizeof *k.order);
-  k.y = km__malloc(nn * sizeof *k.y);
-  k.y1 = km__malloc(nn * sizeof *k.y1);
-  k.y0 = km__malloc(nn * sizeof *k.y0);
+  k.nall = k.nn + 4;
+  size_t nn = k.nn, w = e->nk, na = k.nall;
+  k.r = km__malloc(na * sizeof *k.r);
+  k.order = km__malloc(na * sizeof *k.order);
+  k.y = km__malloc(na * sizeof *k.y);
+  k.y1 = km__malloc(na * sizeof *k.y1);
+  k.y0 = km__malloc(na * sizeof *k.y0);
   k.g = km__malloc(nn * sizeof *k.g);
   k.g1 = km__malloc(nn * sizeof *k.g1);
   double *J = km__malloc(nn * w * sizeof *J);
@@ -1073,8 +1089,15 @@ static km_status kfit_at(const km_morph *m, km__repair_event *e, double t,
       if (r > 1) r -= 1.0;
       k.r[(s ? k.n[0] : 0) + i] = r;
     }
-  for (size_t i = 0; i < nn; i++) k.order[i] = i;
-  sort_order(k.order, nn, k.r);
+  for (int g = 0; g < 2; g++)
+    for (int side = 0; side < 2; side++) {
+      size_t j = (size_t)g * KB_PER + (side ? KB_PER - 1 : 0);
+      double r = e->kc[j] + (side ? 2 : -2) * e->kdr[j];
+      r = m->closed ? r - floor(r) : fmin(fmax(r, 0.0), 1.0);
+      k.r[nn + 2 * (size_t)g + (size_t)side] = r;
+    }
+  for (size_t i = 0; i < na; i++) k.order[i] = i;
+  sort_order(k.order, na, k.r);
   k.reach = 10 * e->h + 0.02 * e->size;
   double zero[MAX_KB] = {0};
   st = kfit_eval(&k, zero, k.y0);
@@ -1089,6 +1112,8 @@ static km_status kfit_at(const km_morph *m, km__repair_event *e, double t,
       goto done;
     }
     /* the Jacobian of the violated residuals, by forward differences */
+    double lc[4], Jl[4][MAX_KB];
+    local_change(&k, k.y, lc);
     for (size_t j = 0; j < w; j++) {
       double b[MAX_KB], wj;
       memcpy(b, a, w * sizeof *b);
@@ -1096,6 +1121,9 @@ static km_status kfit_at(const km_morph *m, km__repair_event *e, double t,
       st = kfit_eval(&k, b, k.y1);
       if (st) goto done;
       kfit_residuals(&k, k.y1, k.g1, &wj);
+      double l1[4];
+      local_change(&k, k.y1, l1);
+      for (int q = 0; q < 4; q++) Jl[q][j] = (l1[q] - lc[q]) / KEPS;
       for (size_t i = 0; i < nn; i++)
         J[i * w + j] =
             k.g[i] < 0 && isfinite(k.g1[i]) ? (k.g1[i] - k.g[i]) / KEPS : 0.0;
@@ -1125,14 +1153,29 @@ static km_status kfit_at(const km_morph *m, km__repair_event *e, double t,
           for (int v = 0; v < 3; v++)
             M[q[u] * w + q[v]] += 1e-5 * sc * c3[u] * c3[v];
       }
+    /* the rest of the frame kept: each strand's bumps close by themselves
+     * (no turn, no move past them), so the closure has nothing new to
+     * spread */
+    for (int q = 0; q < 4 && KLOCAL > 0; q++) {
+      double ja = 0.0;
+      for (size_t p = 0; p < w; p++) ja += Jl[q][p] * a[p];
+      for (size_t p = 0; p < w; p++) {
+        rhs[p] += KLOCAL * Jl[q][p] * (ja - lc[q]);
+        for (size_t r = 0; r < w; r++)
+          M[p * w + r] += KLOCAL * Jl[q][p] * Jl[q][r];
+      }
+    }
     for (size_t p = 0; p < w; p++)
-      for (size_t q = 0; q < w; q++) M[p * w + q] += 1e2 * sc;
+      for (size_t q = 0; q < w; q++)
+        if (KLOCAL == 0 || p / KB_PER == q / KB_PER) M[p * w + q] += 1e2 * sc;
     if (!cholesky_solve(M, rhs, w)) break;
-    double mean = 0.0;
-    for (size_t p = 0; p < w; p++) mean += rhs[p] / (double)w;
+    double mean[2] = {0.0, 0.0};
+    for (size_t p = 0; p < w; p++)
+      mean[KLOCAL > 0 ? p / KB_PER : 0] +=
+          rhs[p] / (double)(KLOCAL > 0 ? KB_PER : w);
     double big = 0.0, dir[MAX_KB];
     for (size_t p = 0; p < w; p++) {
-      dir[p] = rhs[p] - mean - a[p];
+      dir[p] = rhs[p] - mean[KLOCAL > 0 ? p / KB_PER : 0] - a[p];
       big = fmax(big, fabs(dir[p]));
     }
     double f = big > KSTEP ? KSTEP / big : 1.0;

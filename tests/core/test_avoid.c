@@ -176,7 +176,6 @@ static void the_search_stops_when_asked(void **state) {
   assert_int_equal(finished, 1);
 }
 
-
 /* ---- the curvature repair --------------------------------------------- */
 
 /* Proper crossings of the chords of frame f sampled at n equal steps of
@@ -224,8 +223,8 @@ static void the_curvature_repair_separates_a_pinch(void **state) {
   o.intersections = KM_INTERSECTIONS_AVOID;
   km_morph_input A = {&a, NULL}, B = {&b, NULL};
   km_morph *off = NULL, *kap = NULL;
-  assert_status(
-      km__morph_create_repair(&off, &A, &B, &o, KM__REPAIR_OFF, NULL), KM_OK);
+  assert_status(km__morph_create_repair(&off, &A, &B, &o, KM__REPAIR_OFF, NULL),
+                KM_OK);
   assert_status(
       km__morph_create_repair(&kap, &A, &B, &o, KM__REPAIR_CURVATURE, NULL),
       KM_OK);
@@ -243,8 +242,7 @@ static void the_curvature_repair_separates_a_pinch(void **state) {
       /* the inputs: the same curve with and without the repair */
       assert_true(km_morph_repaired(kap, t) == 0.0);
       assert_int_equal(f.n, g.n);
-      for (size_t i = 0; i < 2 * f.n; i++)
-        assert_true(f.cp[i] == g.cp[i]);
+      for (size_t i = 0; i < 2 * f.n; i++) assert_true(f.cp[i] == g.cp[i]);
     }
     if (km_morph_repaired(kap, t) > 0) {
       changed++;
