@@ -13,8 +13,9 @@
  * share of a frame that moved more than 0.001 of its length. Create time
  * per morph is the best of 3.
  *
- * Usage: bench_repair [displacement|curvature] (run from the repository
- * root; displacement, the default repair, when none is named).
+ * Usage: bench_repair [displacement|curvature|both] (run from the
+ * repository root; "both": curvature, and displacement for the events
+ * curvature does not repair; without a name the core's default).
  */
 #include <cJSON.h>
 #include <math.h>
@@ -130,8 +131,10 @@ int main(int argc, char **argv) {
     how = KM__REPAIR_CURVATURE;
   else if (argc > 1 && strcmp(argv[1], "displacement") == 0)
     how = KM__REPAIR_DISPLACEMENT;
+  else if (argc > 1 && strcmp(argv[1], "both") == 0)
+    how = KM__REPAIR_BOTH;
   else if (argc > 1) {
-    fprintf(stderr, "usage: bench_repair [displacement|curvature]\n");
+    fprintf(stderr, "usage: bench_repair [displacement|curvature|both]\n");
     return 2;
   }
   char *text = read_file(FIXTURE);
@@ -144,8 +147,9 @@ int main(int argc, char **argv) {
   int pairs = 0, clean = 0, crossing = 0, before = 0, repaired = 0;
   double move = 0.0, median = 0.0, share = 0.0, create = 0.0;
   const cJSON *p;
-  printf("repair: %s\n",
-         how == KM__REPAIR_CURVATURE ? "curvature" : "displacement");
+  printf("repair: %s\n", how == KM__REPAIR_CURVATURE ? "curvature"
+                         : how == KM__REPAIR_BOTH    ? "both"
+                                                     : "displacement");
   printf("%-28s %-28s cross before repaired  move/len  median  share  "
          "create ms\n",
          "from", "to");

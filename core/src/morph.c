@@ -691,19 +691,17 @@ static km_status repaired_metrics(const km_morph *m, const km_curve *f,
 static km_status frame_impl(const km_morph *m, double t, km__poll *poll,
                             km_curve *out, km_frame_metrics *metrics,
                             km_signature *sig_out, km_error *err) {
-  if (km__repair_is_kappa(m->repair) && km__repair_active(m->repair, t)) {
-    /* the curvature repair: the frame of the changed curvature, closed and
-     * measured as any frame of the general path */
-    km_pp dk;
-    km__pp_init(&dk);
-    km_status st = km__repair_kappa(m->repair, t, (size_t)-1, &dk);
-    if (st) return km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
-    st = frame_base(m, t, dk.m ? &dk : NULL, poll, out, metrics, sig_out, err);
-    km__pp_free(&dk);
-    return st;
-  }
-  km_status st = frame_base(m, t, NULL, poll, out, metrics, sig_out, err);
-  if (st || !km__repair_active(m->repair, t)) return st;
+  /* the curvature repair: the frame of the changed curvature, closed and
+   * measured as any frame of the general path */
+  km_pp dk;
+  km__pp_init(&dk);
+  km_status st = km__repair_kappa_active(m->repair, t)
+                     ? km__repair_kappa(m->repair, t, (size_t)-1, &dk)
+                     : KM_OK;
+  if (st) return km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
+  st = frame_base(m, t, dk.m ? &dk : NULL, poll, out, metrics, sig_out, err);
+  km__pp_free(&dk);
+  if (st || !km__repair_displaces(m->repair, t)) return st;
   double moved;
   st = km__repair_apply(m->repair, t, out, &moved, err);
   if (!st && (metrics || sig_out))
@@ -725,9 +723,8 @@ km_status km_morph_frame_points(const km_morph *m, double t,
     *points = m->lin[0].n;
     return KM_OK;
   }
-  bool kappa =
-      km__repair_is_kappa(m->repair) && km__repair_active(m->repair, t);
-  size_t extra = kappa ? 0 : km__repair_extra_points(m->repair, t);
+  bool kappa = km__repair_kappa_active(m->repair, t);
+  size_t extra = km__repair_extra_points(m->repair, t);
   if (m->plan && parts != KM_FRAME_WITH_SIGNATURE && !kappa) {
     *points = km__frame_plan_points(m->plan) + extra;
     return KM_OK;

@@ -130,9 +130,11 @@ km_status km__avoid_crossings(km_morph **mp, km__poll *poll);
 km_status km__repair_crossings(km_morph *m, km__repair_method how,
                                km__poll *poll);
 void km__repair_free(km__repair *rp);
-/* Whether rp changes curvature (KM__REPAIR_CURVATURE) rather than
- * displacing the frame; false for NULL. */
-bool km__repair_is_kappa(const km__repair *rp);
+/* Whether rp changes the curvature of the frame at t (an event repaired
+ * by curvature), and whether it displaces it (an event repaired by
+ * displacement); false for NULL. */
+bool km__repair_kappa_active(const km__repair *rp, double t);
+bool km__repair_displaces(const km__repair *rp, double t);
 /* The curvature repair's change at t, the sum over its first nev events
  * (all: (size_t)-1), as pieces over the normalised arc length [0, 1] in
  * units of 1 / length (an empty *out, m = 0, when nothing changes; the

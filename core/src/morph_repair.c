@@ -132,9 +132,9 @@ typedef struct km__repair_event {
 } km__repair_event;
 
 struct km__repair {
-  bool kappa;     /* KM__REPAIR_CURVATURE */
-  bool closed;    /* the morph's frames are closed */
-  long fits_left; /* FITS: the key times fitted, over every event */
+  bool closed;     /* the morph's frames are closed */
+  long fits_left;  /* FITS: the key times fitted, over every event */
+  long kfits_left; /* the same for the curvature fits (their own FITS) */
   size_t n;
   km__repair_event ev[MAX_EVENTS];
   int degree; /* of the frames */
@@ -881,8 +881,23 @@ km_status km__add_kappa(const km_signature *sig, const km_pp *dk,
   return st;
 }
 
-bool km__repair_is_kappa(const km__repair *rp) {
-  return rp && rp->kappa;
+/* Whether an event of the kind (curvature: kappa) changes the frame at t. */
+static bool kind_active(const km__repair *rp, double t, bool kappa) {
+  for (size_t i = 0; rp && i < rp->n; i++) {
+    const km__repair_event *e = &rp->ev[i];
+    if ((e->nk > 0) == kappa && e->nt >= 2 && t > e->t[0] &&
+        t < e->t[e->nt - 1])
+      return true;
+  }
+  return false;
+}
+
+bool km__repair_kappa_active(const km__repair *rp, double t) {
+  return kind_active(rp, t, true);
+}
+
+bool km__repair_displaces(const km__repair *rp, double t) {
+  return kind_active(rp, t, false);
 }
 
 km_status km__repair_kappa(const km__repair *rp, double t, size_t nev,
@@ -894,7 +909,7 @@ km_status km__repair_kappa(const km__repair *rp, double t, size_t nev,
   km__pp_init(out);
   for (size_t i = 0; rp && i < rp->n && i < nev; i++) {
     const km__repair_event *e = &rp->ev[i];
-    if (!coefficients_at(e, t, buf[n])) continue;
+    if (e->nk == 0 || !coefficients_at(e, t, buf[n])) continue;
     ev[n] = e;
     a[n] = buf[n];
     n++;
@@ -1212,9 +1227,9 @@ done:
  * *move receives the curvature fit's largest move (0 for a displacement). */
 static km_status fit_at(const km_morph *m, km__repair *rp, km__repair_event *e,
                         double t, double *c, double *move, km__poll *poll) {
-  if (rp->fits_left-- <= 0) return KM_ELIMIT;
+  if ((e->nk ? rp->kfits_left-- : rp->fits_left--) <= 0) return KM_ELIMIT;
   *move = 0.0;
-  if (rp->kappa) return kfit_at(m, e, t, c, move, poll);
+  if (e->nk) return kfit_at(m, e, t, c, move, poll);
   km_curve f;
   km_status st = frame_at(m, t, poll, &f);
   fit ft;
@@ -1248,7 +1263,7 @@ static km_status repaired_crossings(const km_morph *m, const km__repair *rp,
   km_curve f;
   km_curve_init(&f);
   km_status st = KM_OK;
-  if (rp->kappa) {
+  if (km__repair_kappa_active(rp, t)) {
     km_pp dk;
     st = km__repair_kappa(rp, t, rp->n, &dk);
     if (!st && dk.m)
@@ -1260,8 +1275,9 @@ static km_status repaired_crossings(const km_morph *m, const km__repair *rp,
     st = frame_at(m, t, poll, &f);
   }
   double *c = NULL;
-  for (size_t i = 0; !st && !rp->kappa && i < rp->n; i++) {
+  for (size_t i = 0; !st && i < rp->n; i++) {
     const km__repair_event *e = &rp->ev[i];
+    if (e->nk) continue;
     km__free(c);
     c = km__malloc(2 * e->nb * sizeof *c);
     if (!c) {
@@ -1451,51 +1467,66 @@ km_status km__repair_crossings(km_morph *m, km__repair_method how,
   km__repair *rp = km__calloc(1, sizeof *rp);
   if (!rp) return KM_ENOMEM;
   rp->degree = m->opt.degree;
-  rp->kappa = how == KM__REPAIR_CURVATURE;
   rp->closed = m->closed;
-  rp->fits_left = FITS;
+  rp->fits_left = rp->kfits_left = FITS;
   long unrepaired = 0, left_total = 0;
-  for (size_t i = 0; i < nsev; i++) {
-    km__repair_event *e = &rp->ev[rp->n];
-    memset(e, 0, sizeof *e);
-    e->core = sev[i].s;
-    if (!event_layout(e, m->closed)) {
-      unrepaired++;
-      continue;
+  /* each event by curvature, by displacement, or by curvature and, where
+   * that is not kept, by displacement */
+  int tries = how == KM__REPAIR_BOTH ? 2 : 1;
+  bool stop = false;
+  for (size_t i = 0; i < nsev && !stop; i++) {
+    bool kept = false;
+    for (int attempt = 0; attempt < tries && !kept && !stop; attempt++) {
+      km__repair_event *e = &rp->ev[rp->n];
+      memset(e, 0, sizeof *e);
+      e->core = sev[i].s;
+      if (!event_layout(e, m->closed)) break;
+      e->w = 2 * e->nb;
+      if (how != KM__REPAIR_DISPLACEMENT && attempt == 0) kappa_layout(e);
+      double tb = 0.0, ta = 1.0;
+      bool ok;
+      st = event_sides(m, e, sev[i].first, sev[i].last, &tb, &ta, poll, &ok);
+      if (st || !ok) {
+        event_free(e);
+        stop = st != KM_OK;
+        break;
+      }
+      st = event_fit(m, rp, e, tb, ta, poll);
+      if (st == KM_ELIMIT && attempt + 1 < tries) {
+        /* the curvature fits' budget is spent: displacement */
+        event_free(e);
+        st = KM_OK;
+        continue;
+      }
+      if (st == KM_ELIMIT) { /* the budget is spent: no more events */
+        event_free(e);
+        unrepaired += (long)(nsev - i - 1);
+        st = KM_OK;
+        stop = true;
+        break;
+      }
+      if (st) {
+        event_free(e);
+        stop = true;
+        break;
+      }
+      rp->n++;
+      long left = 0, before = 0;
+      st = event_verify(m, rp, poll, &left, &before);
+      if (st) {
+        stop = true;
+        break;
+      }
+      /* kept when it helps and stays a local change */
+      if (left >= before || largest_move(e) > MAX_MOVE * e->size) {
+        event_free(e);
+        rp->n--;
+        continue;
+      }
+      left_total += left;
+      kept = true;
     }
-    e->w = 2 * e->nb;
-    if (rp->kappa) kappa_layout(e);
-    double tb = 0.0, ta = 1.0;
-    bool ok;
-    st = event_sides(m, e, sev[i].first, sev[i].last, &tb, &ta, poll, &ok);
-    if (st) break;
-    if (!ok) {
-      unrepaired++;
-      continue;
-    }
-    st = event_fit(m, rp, e, tb, ta, poll);
-    if (st == KM_ELIMIT) { /* the budget is spent: no more events */
-      event_free(e);
-      unrepaired += (long)(nsev - i);
-      st = KM_OK;
-      break;
-    }
-    if (st) {
-      event_free(e);
-      break;
-    }
-    rp->n++;
-    long left = 0, before = 0;
-    st = event_verify(m, rp, poll, &left, &before);
-    if (st) break;
-    /* kept when it helps and stays a local change */
-    if (left >= before || largest_move(e) > MAX_MOVE * e->size) {
-      event_free(e);
-      rp->n--;
-      unrepaired++;
-      continue;
-    }
-    left_total += left;
+    if (!kept && !st) unrepaired++;
   }
   if (!st) {
     m->avoid.repair_events = (long)rp->n;
@@ -1531,10 +1562,9 @@ bool km__repair_active(const km__repair *rp, double t) {
 size_t km__repair_extra_points(const km__repair *rp, double t) {
   size_t extra = 0;
   int p = rp ? rp->degree : 3;
-  if (rp && rp->kappa) return 0;
   for (size_t i = 0; rp && i < rp->n; i++) {
     const km__repair_event *e = &rp->ev[i];
-    if (e->nt >= 2 && t > e->t[0] && t < e->t[e->nt - 1])
+    if (e->nk == 0 && e->nt >= 2 && t > e->t[0] && t < e->t[e->nt - 1])
       extra += event_knots(e) * (size_t)(p - 2);
   }
   return extra;
@@ -1544,10 +1574,10 @@ km_status km__repair_apply(const km__repair *rp, double t, km_curve *f,
                            double *moved_by, km_error *err) {
   *moved_by = 0.0;
   km_status st = KM_OK;
-  for (size_t i = 0; rp && !rp->kappa && !st && i < rp->n; i++) {
+  for (size_t i = 0; rp && !st && i < rp->n; i++) {
     const km__repair_event *e = &rp->ev[i];
     double c[MAX_BASIS * 2];
-    if (!coefficients_at(e, t, c)) continue;
+    if (e->nk || !coefficients_at(e, t, c)) continue;
     /* the largest displacement: D is a convex combination of its
      * coefficients, so their largest norm bounds it */
     for (size_t q = 0; q < e->nb; q++)
@@ -1563,7 +1593,7 @@ double km_morph_repaired(const km_morph *m, double t) {
     const km__repair_event *e = &m->repair->ev[i];
     double c[MAX_BASIS * 2];
     if (!coefficients_at(e, t, c)) continue;
-    if (m->repair->kappa) {
+    if (e->nk) {
       size = fmax(size, kappa_move(e, t));
       continue;
     }

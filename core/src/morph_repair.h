@@ -14,7 +14,9 @@ typedef enum km__repair_method {
   /* add bumps of curvature over the strands before the closure */
   KM__REPAIR_CURVATURE = 1,
   /* no repair: the frames avoid's choices give */
-  KM__REPAIR_OFF = 2
+  KM__REPAIR_OFF = 2,
+  /* each event by curvature, by displacement where that is not kept */
+  KM__REPAIR_BOTH = 3
 } km__repair_method;
 
 #define KM__REPAIR_DEFAULT KM__REPAIR_DISPLACEMENT
