@@ -10,8 +10,10 @@
  * without repair sampled at 512 equal steps of its parameter (arc length
  * for both): the largest move relative to the frame's length, and the
  * move elsewhere - the largest median move of a frame, and the largest
- * share of a frame that moved more than 0.001 of its length. Create time
- * per morph is the best of 3.
+ * share of a frame that moved more than 0.001 of its length; and the
+ * largest |kappa| of a changed frame over the inputs' (the frames 0 and
+ * 1), which the blend keeps at 1 or below. Create time per morph is the
+ * best of 3.
  *
  * Usage: bench_repair [displacement|curvature|both] (run from the
  * repository root; "both": curvature, and displacement for the events
@@ -38,6 +40,7 @@ typedef struct pair_result {
   double move;   /* largest move / frame length */
   double median; /* largest median move / frame length */
   double share;  /* largest share of a frame moved > 0.001 length */
+  double kappa;  /* largest |kappa| of a changed frame / the inputs' */
 } pair_result;
 
 static int cmp_double(const void *a, const void *b) {
@@ -95,6 +98,7 @@ static int measure(const km_curve *a, const km_curve *b, km__repair_method how,
       km_morph_free(m);
       continue;
     }
+    double bound = 0.0, kmax = 0.0;
     for (int i = 0; i < FRAMES; i++) {
       double t = i / (double)(FRAMES - 1);
       km_curve f, g;
@@ -106,7 +110,9 @@ static int measure(const km_curve *a, const km_curve *b, km__repair_method how,
       if (!st) {
         if (mt.self_intersections > 0) r->crossing++;
         if (mg.self_intersections > 0) r->before++;
+        if (i == 0 || i == FRAMES - 1) bound = fmax(bound, mg.max_abs_kappa);
         if (km_morph_repaired(m, t) > 0) {
+          kmax = fmax(kmax, mt.max_abs_kappa);
           r->repaired++;
           compare(&f, &g, mt.length, r);
         }
@@ -119,6 +125,7 @@ static int measure(const km_curve *a, const km_curve *b, km__repair_method how,
         return -1;
       }
     }
+    r->kappa = bound > 0 ? kmax / bound : 0.0;
     km_morph_free(m);
   }
   km_morph_free(off);
@@ -145,13 +152,13 @@ int main(int argc, char **argv) {
     return 1;
   }
   int pairs = 0, clean = 0, crossing = 0, before = 0, repaired = 0;
-  double move = 0.0, median = 0.0, share = 0.0, create = 0.0;
+  double move = 0.0, median = 0.0, share = 0.0, kappa = 0.0, create = 0.0;
   const cJSON *p;
   printf("repair: %s\n", how == KM__REPAIR_CURVATURE ? "curvature"
                          : how == KM__REPAIR_BOTH    ? "both"
                                                      : "displacement");
   printf("%-28s %-28s cross before repaired  move/len  median  share  "
-         "create ms\n",
+         "kappa  create ms\n",
          "from", "to");
   cJSON_ArrayForEach(p, cJSON_GetObjectItemCaseSensitive(root, "pairs")) {
     const char *from = cJSON_GetObjectItemCaseSensitive(p, "from")->valuestring;
@@ -172,9 +179,9 @@ int main(int argc, char **argv) {
       cJSON_Delete(root);
       return 1;
     }
-    printf("%-28s %-28s %5d %6d %8d  %8.4f  %6.4f  %5.2f  %9.1f\n", from, to,
-           r.crossing, r.before, r.repaired, r.move, r.median, r.share,
-           1e3 * r.create_s);
+    printf("%-28s %-28s %5d %6d %8d  %8.4f  %6.4f  %5.2f  %5.2f  %9.1f\n", from,
+           to, r.crossing, r.before, r.repaired, r.move, r.median, r.share,
+           r.kappa, 1e3 * r.create_s);
     fflush(stdout);
     pairs++;
     clean += r.crossing == 0;
@@ -184,14 +191,16 @@ int main(int argc, char **argv) {
     move = fmax(move, r.move);
     median = fmax(median, r.median);
     share = fmax(share, r.share);
+    kappa = fmax(kappa, r.kappa);
     create += r.create_s;
   }
   cJSON_Delete(root);
   printf("%d pairs, %d frames each: %d frames cross (%d without repair), "
          "%d repaired, %d pairs crossing-free, largest move %.4f of the "
          "frame length, largest median move %.4f, largest share moved "
-         "%.2f, create %.1f ms a morph (mean)\n",
+         "%.2f, largest |kappa| of a changed frame %.2f of the inputs', "
+         "create %.1f ms a morph (mean)\n",
          pairs, FRAMES, crossing, before, repaired, clean, move, median, share,
-         1e3 * create / pairs);
+         kappa, 1e3 * create / pairs);
   return 0;
 }

@@ -124,7 +124,8 @@ km_status km__avoid_crossings(km_morph **mp, km__poll *poll);
 
 /* intersections AVOID, second step (morph_repair.c): frames at k / 32
  * are scanned for crossings and the strands that cross are moved apart by
- * a displacement smooth in t, kept in m->repair (NULL when nothing
+ * a change smooth in t (a displacement, a change of curvature or either,
+ * as how says), kept in m->repair (NULL when nothing
  * crosses) with the report in m->avoid. KM_OK, KM_ENOMEM or
  * KM_ECANCELLED (then m is as it was). */
 km_status km__repair_crossings(km_morph *m, km__repair_method how,
