@@ -1070,9 +1070,12 @@ static km_status kfit_eval(kfit *k, const double *a, double (*y)[2]) {
 }
 
 /* One-sided residuals of positions y: per sample, sigma d - h against the
- * other strand, INFINITY where none applies; the worst into *worst. */
+ * other strand, INFINITY where none applies; the worst into *worst. With
+ * only (not NULL), just the samples whose only[] is negative (the
+ * violated ones, whose derivatives the fit takes): the projections are
+ * most of a fit's cost. */
 static void kfit_residuals(const kfit *k, double (*y)[2], double *g,
-                           double *worst) {
+                           const double *only, double *worst) {
   const km__repair_event *e = k->e;
   *worst = 0.0;
   for (int s = 0; s < 2; s++) {
@@ -1081,7 +1084,7 @@ static void kfit_residuals(const kfit *k, double (*y)[2], double *g,
     for (size_t i = 0; i < k->n[s]; i++) {
       g[off + i] = INFINITY;
       int sigma = e->side[s][i] ? e->side[s][i] : whole;
-      if (sigma == 0) continue;
+      if (sigma == 0 || (only && !(only[off + i] < 0))) continue;
       size_t q;
       double lam, d2, nrm[2];
       const double(*b)[2] = (const double(*)[2])(y + ooff);
@@ -1158,7 +1161,7 @@ static km_status kfit_at(const km_morph *m, km__repair_event *e, double t,
   double worst;
   st = kfit_eval(&k, a, k.y);
   if (st) goto done;
-  kfit_residuals(&k, k.y, k.g, &worst);
+  kfit_residuals(&k, k.y, k.g, NULL, &worst);
   for (int step = 0; step < KGN_STEPS && worst < -0.02 * e->h; step++) {
     if (km__poll_stop(poll, (long)(nn * (w + 1)))) {
       st = KM_ECANCELLED;
@@ -1173,7 +1176,7 @@ static km_status kfit_at(const km_morph *m, km__repair_event *e, double t,
       b[j] += KEPS;
       st = kfit_eval(&k, b, k.y1);
       if (st) goto done;
-      kfit_residuals(&k, k.y1, k.g1, &wj);
+      kfit_residuals(&k, k.y1, k.g1, k.g, &wj);
       double l1[4];
       local_change(&k, k.y1, l1);
       for (int q = 0; q < 4; q++) Jl[q][j] = (l1[q] - lc[q]) / KEPS;
@@ -1239,7 +1242,7 @@ static km_status kfit_at(const km_morph *m, km__repair_event *e, double t,
       for (size_t p = 0; p < w; p++) trial[p] = a[p] + f * dir[p];
       st = kfit_eval(&k, trial, k.y1);
       if (st) goto done;
-      kfit_residuals(&k, k.y1, k.g1, &wt);
+      kfit_residuals(&k, k.y1, k.g1, NULL, &wt);
       if (wt > worst) {
         took = true;
         break;
