@@ -54,9 +54,9 @@
  * displacement repairs.
  * KM__REPAIR_BOTH tries the curvature on each event and the
  * displacement where that is not kept: 39 frames, 11 pairs, no pair
- * worse than the displacement, but about six times its create time
- * (655 ms against 113 ms a morph on a loaded machine; the DejaVu Serif
- * G pairs take seconds). The displacement stays the default because it
+ * worse than the displacement, but four to six times its create time
+ * (395-618 ms against 110-115 ms a morph on a loaded machine; the
+ * DejaVu Serif G pairs take seconds). The displacement stays the default because it
  * keeps the fewest crossing frames of the two single methods, is local
  * (a repaired frame is the frame plus D, exactly) and keeps create
  * interactive (milliseconds, not seconds); its cost is the curvature
