@@ -374,6 +374,13 @@ static km_status pick_start(km_morph **mp, const double *cand, size_t ncand,
 km_status km_morph_create(km_morph **out, const km_morph_input *from,
                           const km_morph_input *to, const km_morph_options *opt,
                           km_error *err) {
+  return km__morph_create_repair(out, from, to, opt, KM__REPAIR_DEFAULT, err);
+}
+
+km_status km__morph_create_repair(km_morph **out, const km_morph_input *from,
+                                  const km_morph_input *to,
+                                  const km_morph_options *opt,
+                                  km__repair_method repair, km_error *err) {
   double cand[KM__SHIFT_CANDIDATES];
   size_t ncand = 0;
   km_morph *m = NULL;
@@ -393,9 +400,9 @@ km_status km_morph_create(km_morph **out, const km_morph_input *from,
     st = km__avoid_crossings(&m, &poll);
     /* an input that crosses itself is not repaired: its frames must
      * cross near it */
-    if (!st && m->avoid.input_crossings[0] == 0 &&
+    if (!st && repair != KM__REPAIR_OFF && m->avoid.input_crossings[0] == 0 &&
         m->avoid.input_crossings[1] == 0) {
-      st = km__repair_crossings(m, &poll);
+      st = km__repair_crossings(m, repair, &poll);
       if (st) { /* the avoidance frees its morphs on failure; so here */
         km_morph_free(m);
         m = NULL;
@@ -464,6 +471,25 @@ km_status km__morph_frame(const km_morph *m, double t, km__poll *poll,
   return frame_impl(m, t, poll, out, NULL, NULL, err);
 }
 
+static km_status frame_signature(const km_morph *m, double t, const km_pp *dk,
+                                 km__poll *poll, km_signature *out, double *gap,
+                                 km_error *err);
+static km_status frame_base(const km_morph *m, double t, const km_pp *dk,
+                            km__poll *poll, km_curve *out,
+                            km_frame_metrics *metrics, km_signature *sig_out,
+                            km_error *err);
+
+km_status km__morph_frame_kappa(const km_morph *m, double t, const km_pp *dk,
+                                km__poll *poll, km_curve *out, km_error *err) {
+  return frame_base(m, t, dk, poll, out, NULL, NULL, err);
+}
+
+km_status km__morph_signature_kappa(const km_morph *m, double t,
+                                    const km_pp *dk, km__poll *poll,
+                                    km_signature *out, km_error *err) {
+  return frame_signature(m, t, dk, poll, out, NULL, err);
+}
+
 void km_morph_avoided(const km_morph *m, km_morph_avoidance *out) {
   *out = m->avoid;
 }
@@ -484,9 +510,11 @@ km_status km_morph_frame_until(const km_morph *m, double t, const km_stop *stop,
 
 /* Frame t's exact signature, the blend and the closure of the general
  * path (lsq when the morph closes so), into *out (the caller frees it);
- * gap (if not NULL) receives the gap before closure (0 when open). */
-static km_status frame_signature(const km_morph *m, double t, km__poll *poll,
-                                 km_signature *out, double *gap,
+ * gap (if not NULL) receives the gap before closure (0 when open). dk
+ * (NULL: none) is a change of curvature added to the blend before the
+ * closure (the curvature repair, km__repair_kappa). */
+static km_status frame_signature(const km_morph *m, double t, const km_pp *dk,
+                                 km__poll *poll, km_signature *out, double *gap,
                                  km_error *err) {
   km_closure how =
       m->opt.closure == KM_CLOSURE_AUTO ? KM_CLOSURE_LSQ : m->opt.closure;
@@ -494,6 +522,13 @@ static km_status frame_signature(const km_morph *m, double t, km__poll *poll,
   km_signature_init(&blended);
   double g = 0.0;
   km_status st = km__blend_signature(m, t, &blended, err);
+  if (!st && dk) {
+    km_signature sum;
+    km_signature_init(&sum);
+    st = km__add_kappa(&blended, dk, &sum, err);
+    km_signature_free(&blended);
+    blended = sum;
+  }
   /* the blend is linear in the pieces: a few units each */
   if (!st && km__poll_stop(poll, 4 * (long)blended.kappa.n))
     st = km__stopped(err);
@@ -588,7 +623,7 @@ static km_status planned_frame_with_metrics(const km_morph *m, double t,
     if (!st) st = km__closure_add(&blended, c, &sig, err);
     km_signature_free(&blended);
   } else if (!st) {
-    st = frame_signature(m, t, poll, &sig, &gap, err);
+    st = frame_signature(m, t, NULL, poll, &sig, &gap, err);
   }
   if (!st) st = planned_frame(m, t, how, poll, &f, err);
   if (!st) st = exact_metrics(m, &sig, &f, gap, poll, metrics, err);
@@ -601,9 +636,12 @@ static km_status planned_frame_with_metrics(const km_morph *m, double t,
   return st;
 }
 
-static km_status frame_base(const km_morph *m, double t, km__poll *poll,
-                            km_curve *out, km_frame_metrics *metrics,
-                            km_signature *sig_out, km_error *err) {
+/* The frame at t; dk (NULL: none) as in frame_signature, which takes the
+ * general path. */
+static km_status frame_base(const km_morph *m, double t, const km_pp *dk,
+                            km__poll *poll, km_curve *out,
+                            km_frame_metrics *metrics, km_signature *sig_out,
+                            km_error *err) {
   if (!(t >= 0.0 && t <= 1.0))
     return km__fail(err, KM_ERANGE, KM_FIELD_TIMES, -1, t,
                     "time %g is outside [0, 1]", t);
@@ -611,7 +649,7 @@ static km_status frame_base(const km_morph *m, double t, km__poll *poll,
     return km__linear_frame(m, t, out, metrics, sig_out, poll, err);
   km_closure how =
       m->opt.closure == KM_CLOSURE_AUTO ? KM_CLOSURE_LSQ : m->opt.closure;
-  if (m->plan && !sig_out)
+  if (m->plan && !sig_out && !dk)
     return metrics
                ? planned_frame_with_metrics(m, t, how, poll, out, metrics, err)
                : planned_frame(m, t, how, poll, out, err);
@@ -621,7 +659,7 @@ static km_status frame_base(const km_morph *m, double t, km__poll *poll,
   km_curve_init(&f);
   km_curve_init(&placed);
   double gap = 0.0, bound = 0.0, rot, T[2];
-  km_status st = frame_signature(m, t, poll, &sig, &gap, err);
+  km_status st = frame_signature(m, t, dk, poll, &sig, &gap, err);
   if (!st)
     st = km__reconstruct(&sig, m->opt.degree, 0.9 * m->tol, m->opt.max_points,
                          poll, &f, &bound, NULL, err);
@@ -679,8 +717,17 @@ static km_status repaired_metrics(const km_morph *m, const km_curve *f,
 static km_status frame_impl(const km_morph *m, double t, km__poll *poll,
                             km_curve *out, km_frame_metrics *metrics,
                             km_signature *sig_out, km_error *err) {
-  km_status st = frame_base(m, t, poll, out, metrics, sig_out, err);
-  if (st || !km__repair_active(m->repair, t)) return st;
+  /* the curvature repair: the frame of the changed curvature, closed and
+   * measured as any frame of the general path */
+  km_pp dk;
+  km__pp_init(&dk);
+  km_status st = km__repair_kappa_active(m->repair, t)
+                     ? km__repair_kappa(m->repair, t, (size_t)-1, &dk)
+                     : KM_OK;
+  if (st) return km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
+  st = frame_base(m, t, dk.m ? &dk : NULL, poll, out, metrics, sig_out, err);
+  km__pp_free(&dk);
+  if (st || !km__repair_displaces(m->repair, t)) return st;
   double moved;
   st = km__repair_apply(m->repair, t, out, &moved, err);
   if (!st && (metrics || sig_out))
@@ -702,8 +749,9 @@ km_status km_morph_frame_points(const km_morph *m, double t,
     *points = m->lin[0].n;
     return KM_OK;
   }
+  bool kappa = km__repair_kappa_active(m->repair, t);
   size_t extra = km__repair_extra_points(m->repair, t);
-  if (m->plan && parts != KM_FRAME_WITH_SIGNATURE) {
+  if (m->plan && parts != KM_FRAME_WITH_SIGNATURE && !kappa) {
     *points = km__frame_plan_points(m->plan) + extra;
     return KM_OK;
   }
@@ -712,7 +760,13 @@ km_status km_morph_frame_points(const km_morph *m, double t,
   km_signature sig;
   km_signature_init(&sig);
   size_t n = 0;
-  km_status st = frame_signature(m, t, &poll, &sig, NULL, err);
+  km_pp dk;
+  km__pp_init(&dk);
+  km_status st =
+      kappa ? km__repair_kappa(m->repair, t, (size_t)-1, &dk) : KM_OK;
+  if (st) return km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
+  st = frame_signature(m, t, dk.m ? &dk : NULL, &poll, &sig, NULL, err);
+  km__pp_free(&dk);
   if (!st)
     st = km__reconstruct(&sig, m->opt.degree, 0.9 * m->tol, m->opt.max_points,
                          &poll, NULL, NULL, &n, err);

@@ -21,6 +21,7 @@
 #include "km/signature.h"
 #include "km/status.h"
 #include "morph_plan.h"
+#include "morph_repair.h"
 
 /* Samples of an input's position table, at s = L j / KM__TABLE_N: the
  * placement targets and the start alignment read it. */
@@ -123,11 +124,36 @@ km_status km__avoid_crossings(km_morph **mp, km__poll *poll);
 
 /* intersections AVOID, second step (morph_repair.c): frames at k / 32
  * are scanned for crossings and the strands that cross are moved apart by
- * a displacement smooth in t, kept in m->repair (NULL when nothing
+ * a change smooth in t (a displacement, a change of curvature or either,
+ * as how says), kept in m->repair (NULL when nothing
  * crosses) with the report in m->avoid. KM_OK, KM_ENOMEM or
  * KM_ECANCELLED (then m is as it was). */
-km_status km__repair_crossings(km_morph *m, km__poll *poll);
+km_status km__repair_crossings(km_morph *m, km__repair_method how,
+                               km__poll *poll);
 void km__repair_free(km__repair *rp);
+/* Whether rp changes the curvature of the frame at t (an event repaired
+ * by curvature), and whether it displaces it (an event repaired by
+ * displacement); false for NULL. */
+bool km__repair_kappa_active(const km__repair *rp, double t);
+bool km__repair_displaces(const km__repair *rp, double t);
+/* The curvature repair's change at t, the sum over its first nev events
+ * (all: (size_t)-1), as pieces over the normalised arc length [0, 1] in
+ * units of 1 / length (an empty *out, m = 0, when nothing changes; the
+ * caller frees it). KM_OK or KM_ENOMEM. */
+km_status km__repair_kappa(const km__repair *rp, double t, size_t nev,
+                           km_pp *out);
+/* sig with dk (as km__repair_kappa makes it) added to its curvature, into
+ * *out (the caller frees it). Statuses of km_signature_create. */
+km_status km__add_kappa(const km_signature *sig, const km_pp *dk,
+                        km_signature *out, km_error *err);
+/* The frame at t (placed, closed as any frame) of the blend plus dk, by
+ * the general path; and its closed signature before the reconstruction
+ * (not placed). Statuses as km_morph_frame. */
+km_status km__morph_frame_kappa(const km_morph *m, double t, const km_pp *dk,
+                                km__poll *poll, km_curve *out, km_error *err);
+km_status km__morph_signature_kappa(const km_morph *m, double t,
+                                    const km_pp *dk, km__poll *poll,
+                                    km_signature *out, km_error *err);
 /* Whether the repair moves the frame at t. */
 bool km__repair_active(const km__repair *rp, double t);
 /* Control points the repair adds to the frame at t, at most. */

@@ -1,6 +1,7 @@
 /* morph_repair.c - intersections AVOID, second step: frames that still
  * cross after the choices of morph_avoid.c are repaired by moving the
- * strands that cross apart, by a displacement that varies smoothly in t.
+ * strands that cross apart, by a change that varies smoothly in t: a
+ * displacement (the default) or a change of curvature.
  *
  * DESIGN. What is left after the free choices are made is mostly a pinch:
  * two strands of the frame (the two sides of a thin stroke, the arms of a
@@ -9,13 +10,14 @@
  * beside the shape, so a small local change separates it; the questions
  * are which change, and how to keep the sequence from popping.
  *
- * One repair is implemented, for the glyph pairs whose frames still
- * cross (tests/fixtures/avoid/repair.json). A least change of
- * curvature (bumps of curvature over the two strands added to the
- * blended signature before the closure, fitted by Gauss-Newton) is the
- * obvious alternative, but it has not been implemented or measured, so
- * nothing here claims how it would compare. The repair used is
- * a displacement of the strands themselves: D(r, t) = sum_k
+ * Two repairs are implemented and measured on the glyph pairs whose
+ * frames still cross (tests/fixtures/avoid/repair.json, 21 pairs, 41
+ * frames each, 61 crossing frames without repair; bench/bench_repair.c,
+ * figures in bench/RESULTS.md "Crossing repair"); the switch between them
+ * is internal (morph_repair.h), km_morph_create uses the default.
+ *
+ * The default, KM__REPAIR_DISPLACEMENT, displaces the strands
+ * themselves: D(r, t) = sum_k
  * c_k(t) N_k(r), uniform cubic B-splines N_k in the frame's normalised
  * parameter r (arc length for planned frames) covering only the two
  * strands, with 2-D coefficients. The frame plus D is again a B-spline
@@ -24,7 +26,41 @@
  * so the fit needs no frame to be rebuilt: Gauss-Newton on one-sided
  * residuals (each sample of one strand at least h on its side of the
  * other strand) with a small ridge and a second-difference smoothing,
- * a few milliseconds a key time.
+ * a few milliseconds a key time. Measured: 43 frames still cross, 8
+ * pairs crossing-free, largest move 0.0047 of the frame's length; but D
+ * bends the strands it moves, and the largest |kappa| of a repaired frame
+ * reaches 19 times the inputs' (DejaVu Sans Oblique 7 -> DejaVu Serif 2;
+ * 12 and 19 in three pairs).
+ *
+ * KM__REPAIR_CURVATURE is the least change of curvature: bumps of
+ * curvature (five uniform cubic B-splines across each strand, each
+ * coefficient the turn it adds) added to the blended curvature before
+ * the closure, the frame then closed and reconstructed as any frame of
+ * the general path, so it stays a curvature morph. The frame is a black
+ * box from bumps to closed curve, so the same one-sided residuals are
+ * fitted by Gauss-Newton with forward differences, one frame per bump
+ * and step. A bump turns everything after it and the closure spreads
+ * what that moves over the whole length (the first fit moved the median
+ * point of a repaired frame by 0.0073 of the length): each strand's
+ * bumps therefore keep their own turn at zero and, as a soft residual,
+ * the curve past them where it was. Measured: 46 frames still cross, 10
+ * pairs crossing-free (it separates three pinches the displacement
+ * cannot: DejaVu Sans m -> Liberation Serif 3, DejaVu Serif m -> DejaVu
+ * Sans Bold M, Liberation Serif h -> DejaVu Serif Italic W), largest
+ * move 0.0059, the median point of a repaired frame moved up to 0.0028
+ * of the length, |kappa| at most 2.2 times the inputs' (below 1 in all
+ * but one pair), and about three times the displacement's create time;
+ * it loses DejaVu Serif G -> Liberation Serif 5 and G -> y, which the
+ * displacement repairs.
+ * KM__REPAIR_BOTH tries the curvature on each event and the
+ * displacement where that is not kept: 39 frames, 11 pairs, no pair
+ * worse than the displacement, but four to six times its create time
+ * (395-618 ms against 110-115 ms a morph on a loaded machine; the
+ * DejaVu Serif G pairs take seconds). The displacement stays the default because it
+ * keeps the fewest crossing frames of the two single methods, is local
+ * (a repaired frame is the frame plus D, exactly) and keeps create
+ * interactive (milliseconds, not seconds); its cost is the curvature
+ * spikes above. BOTH is the better repair where create time allows.
  *
  * Which side is right comes from the frames on either side in time that
  * do not cross (the clean neighbours): a strand on the left of the other
@@ -44,11 +80,13 @@
  * most.
  *
  * What it keeps and relaxes: frames outside the events are untouched
- * (the same frames as without repair); frames 0 and 1 too. A repaired
- * frame is the curvature frame plus D exactly: its tolerance is the
- * frame's, but its curvature is no longer the blend and may exceed the
- * inputs' bound where D bends the strand; its metrics are measured on the
- * repaired curve. Budget: SCAN - 1 frames and crossing counts for every
+ * (the same frames as without repair); frames 0 and 1 too. A frame
+ * repaired by displacement is the curvature frame plus D exactly: its
+ * tolerance is the frame's, but its curvature is no longer the blend and
+ * may exceed the inputs' bound where D bends the strand; its metrics are
+ * measured on the repaired curve. A frame repaired by curvature is the
+ * blend plus the bumps, closed: its metrics are the general path's, and
+ * the bumps may take its curvature past the inputs' bound. Budget: SCAN - 1 frames and crossing counts for every
  * morph; per event at most MAX_KEYS key frames and VERIFY checks between
  * them, every one polling the caller's stop.
  */
@@ -91,8 +129,28 @@ typedef struct strands {
   double i0, i1, j0, j1; /* two strands in r, i1 < j0 unless wrapped */
 } strands;
 
+/* Curvature repair: bumps of curvature per strand, and the largest. */
+#define KB_PER 5
+#define MAX_KB (2 * KB_PER)
+/* Gauss-Newton steps of a curvature fit (each costs MAX_KB + 1 frames). */
+#define KGN_STEPS 8
+/* Finite-difference step of a bump's turn, radians. */
+#define KEPS 1e-5
+/* Largest change of a bump's turn in one step, radians. */
+#define KSTEP 0.15
+/* Weight of the rest of the frame's move against the clearance. */
+#ifndef KLOCAL
+#define KLOCAL 1.0
+#endif
+
 typedef struct km__repair_event {
-  long K; /* grid: basis functions centred at k / K */
+  size_t w; /* coefficients per key time: 2 nb, or nk */
+  /* curvature bumps (KM__REPAIR_CURVATURE): centres and spacings in r;
+   * a bump's coefficient is the turn it adds, radians */
+  size_t nk;
+  double kc[MAX_KB], kdr[MAX_KB];
+  double kmove[MAX_KEYS]; /* largest move of a strand per key time */
+  long K;                 /* grid: basis functions centred at k / K */
   long ka[2], kb[2];
   size_t nrange;        /* index ranges [ka, kb] of the functions used */
   size_t nb;            /* functions used */
@@ -112,7 +170,9 @@ typedef struct km__repair_event {
 } km__repair_event;
 
 struct km__repair {
-  long fits_left; /* FITS: the key times fitted, over every event */
+  bool closed;     /* the morph's frames are closed */
+  long fits_left;  /* FITS: the key times fitted, over every event */
+  long kfits_left; /* the same for the curvature fits (their own FITS) */
   size_t n;
   km__repair_event ev[MAX_EVENTS];
   int degree; /* of the frames */
@@ -237,7 +297,7 @@ static km_status add_displacement(km_curve *f, const km__repair_event *e,
 
 /* Fritsch-Carlson slopes of the event's coefficients over its key times. */
 static void hermite_slopes(km__repair_event *e) {
-  size_t nt = e->nt, w = 2 * e->nb;
+  size_t nt = e->nt, w = e->w;
   for (size_t q = 0; q < w; q++) {
     for (size_t k = 0; k < nt; k++) {
       double m = 0.0;
@@ -257,7 +317,7 @@ static void hermite_slopes(km__repair_event *e) {
 
 /* The coefficients at t into c (2 nb values); false outside the event. */
 static bool coefficients_at(const km__repair_event *e, double t, double *c) {
-  size_t nt = e->nt, w = 2 * e->nb;
+  size_t nt = e->nt, w = e->w;
   if (nt < 2 || !(t > e->t[0] && t < e->t[nt - 1])) return false;
   size_t k = 0;
   while (k + 2 < nt && t >= e->t[k + 1]) k++;
@@ -770,11 +830,447 @@ done:
   return st;
 }
 
-/* Fits the coefficients at key time t into c (2 nb, warm start in c). */
-static km_status fit_at(const km_morph *m, km__repair *rp,
-                        const km__repair_event *e, double t, double *c,
-                        km__poll *poll) {
-  if (rp->fits_left-- <= 0) return KM_ELIMIT;
+/* ---- the curvature repair ---------------------------------------------- */
+
+/* Uniform cubic B-spline bump j of e at r (one period when closed). */
+static double bump_at(const km__repair_event *e, size_t j, double r,
+                      bool closed) {
+  double v = 0.0;
+  for (int k = closed ? -1 : 0; k <= (closed ? 1 : 0); k++)
+    v += km__bspline3((r + k - e->kc[j]) / e->kdr[j] + 2.0);
+  return v / e->kdr[j];
+}
+
+static int cmp_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+/* The bumps of events ev[0..n) with coefficients a[i] (NULL: none) as
+ * cubic pieces over [0, 1]: exact, from four values a piece. */
+static km_status bumps_pp(const km__repair_event *const *ev,
+                          const double *const *a, size_t n, bool closed,
+                          km_pp *out) {
+  size_t nb = 2;
+  for (size_t i = 0; i < n; i++) nb += 5 * ev[i]->nk;
+  double *x = km__malloc(nb * sizeof *x);
+  if (!x) return KM_ENOMEM;
+  size_t m = 0;
+  x[m++] = 0.0;
+  x[m++] = 1.0;
+  for (size_t i = 0; i < n; i++)
+    for (size_t j = 0; j < ev[i]->nk; j++)
+      for (int k = 0; k < 5; k++) {
+        double r = ev[i]->kc[j] + (k - 2) * ev[i]->kdr[j];
+        if (closed) r -= floor(r);
+        if (r > 0 && r < 1) x[m++] = r;
+      }
+  qsort(x, m, sizeof *x, cmp_double);
+  size_t u = 1;
+  for (size_t i = 1; i < m; i++)
+    if (x[i] - x[u - 1] > 1e-12) x[u++] = x[i];
+  x[u - 1] = 1.0;
+  km_status st = km__pp_alloc(out, 3, u - 1);
+  if (st) {
+    km__free(x);
+    return st;
+  }
+  for (size_t p = 0; p + 1 < u; p++) {
+    double f[4];
+    for (int q = 0; q < 4; q++) {
+      double r = x[p] + (x[p + 1] - x[p]) * q / 3.0, v = 0.0;
+      for (size_t i = 0; i < n; i++)
+        for (size_t j = 0; j < ev[i]->nk; j++)
+          if (a[i][j] != 0) v += a[i][j] * bump_at(ev[i], j, r, closed);
+      f[q] = v;
+    }
+    /* Bernstein coefficients of the cubic through f at 0, 1/3, 2/3, 1 */
+    double A = 27 * f[1] - 8 * f[0] - f[3], B = 27 * f[2] - f[0] - 8 * f[3];
+    double *c = out->c + 4 * p;
+    c[0] = f[0];
+    c[1] = (2 * A - B) / 18;
+    c[2] = (2 * B - A) / 18;
+    c[3] = f[3];
+    out->x[p] = x[p];
+  }
+  out->x[u - 1] = 1.0;
+  km__free(x);
+  return KM_OK;
+}
+
+km_status km__add_kappa(const km_signature *sig, const km_pp *dk,
+                        km_signature *out, km_error *err) {
+  km_pp k0, kt;
+  km__pp_init(&k0);
+  km__pp_init(&kt);
+  km_fn kf;
+  km_fn_init(&kf);
+  double L = sig->length;
+  km_status st = km__pp_from_fn(&k0, &sig->kappa);
+  if (!st) st = km__pp_blend(&kt, &k0, 1.0, dk, 1.0 / L, 0.0, L);
+  if (!st) st = km__pp_to_fn(&kf, &kt);
+  if (st) st = km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
+  if (!st)
+    st = km_signature_create(out, L, sig->start, sig->angle, &kf, sig->corners,
+                             sig->ncorners, sig->closed, err);
+  km_fn_free(&kf);
+  km__pp_free(&k0);
+  km__pp_free(&kt);
+  return st;
+}
+
+/* Whether an event of the kind (curvature: kappa) changes the frame at t. */
+static bool kind_active(const km__repair *rp, double t, bool kappa) {
+  for (size_t i = 0; rp && i < rp->n; i++) {
+    const km__repair_event *e = &rp->ev[i];
+    if ((e->nk > 0) == kappa && e->nt >= 2 && t > e->t[0] &&
+        t < e->t[e->nt - 1])
+      return true;
+  }
+  return false;
+}
+
+bool km__repair_kappa_active(const km__repair *rp, double t) {
+  return kind_active(rp, t, true);
+}
+
+bool km__repair_displaces(const km__repair *rp, double t) {
+  return kind_active(rp, t, false);
+}
+
+km_status km__repair_kappa(const km__repair *rp, double t, size_t nev,
+                           km_pp *out) {
+  const km__repair_event *ev[MAX_EVENTS];
+  double buf[MAX_EVENTS][MAX_KB];
+  const double *a[MAX_EVENTS];
+  size_t n = 0;
+  km__pp_init(out);
+  for (size_t i = 0; rp && i < rp->n && i < nev; i++) {
+    const km__repair_event *e = &rp->ev[i];
+    if (e->nk == 0 || !coefficients_at(e, t, buf[n])) continue;
+    ev[n] = e;
+    a[n] = buf[n];
+    n++;
+  }
+  if (n == 0) return KM_OK;
+  return bumps_pp(ev, a, n, rp->closed, out);
+}
+
+/* Bumps over the two strands of e: KB_PER across each crossing's stretch
+ * widened by half its width and at least 1% of the length each side. */
+static void kappa_layout(km__repair_event *e) {
+  double c[2][2] = {{e->core.i0, e->core.i1}, {e->core.j0, e->core.j1}};
+  e->nk = 0;
+  for (int g = 0; g < 2; g++) {
+    double w = c[g][1] - c[g][0], mg = fmax(0.5 * w, 0.01);
+    double dr = (w + 2 * mg) / (KB_PER - 1);
+    for (int j = 0; j < KB_PER; j++) {
+      e->kc[e->nk] = c[g][0] - mg + j * dr;
+      e->kdr[e->nk] = dr;
+      e->nk++;
+    }
+  }
+  e->w = e->nk;
+}
+
+/* Positions (not placed) of the closed signature at normalised arc
+ * lengths r[0..n) (any order; order[] sorts them), by one walk. */
+static km_status sig_points(const km_signature *sig, const double *r,
+                            const size_t *order, size_t n, double (*out)[2]) {
+  km_pp kp, tp;
+  km_status st = km__build_theta(sig, &kp, &tp);
+  if (st) return st;
+  int dk = kp.degree, dt = tp.degree;
+  double x = sig->start[0], y = sig->start[1], L = sig->length;
+  size_t i = 0;
+  for (size_t q = 0; q < n; q++) {
+    double s = fmin(fmax(r[order[q]] * L, 0.0), L);
+    /* whole pieces before s */
+    while (i + 1 < tp.m && tp.x[i + 1] <= s) {
+      double h = tp.x[i + 1] - tp.x[i], kb[1], d[2];
+      km__kappa_bounds(kp.c + i * (size_t)(dk + 1), dk, h, 0.0, 1.0, 1, kb);
+      km__integrate_exp(tp.c + i * (size_t)(dt + 1), dt, h, 0.0, 1.0, kb[0], d);
+      x += d[0];
+      y += d[1];
+      i++;
+    }
+    double h = tp.x[i + 1] - tp.x[i], u = h > 0 ? (s - tp.x[i]) / h : 0.0;
+    u = fmin(fmax(u, 0.0), 1.0);
+    double kb[1], d[2] = {0, 0};
+    if (u > 0) {
+      km__kappa_bounds(kp.c + i * (size_t)(dk + 1), dk, h, 0.0, u, 1, kb);
+      km__integrate_exp(tp.c + i * (size_t)(dt + 1), dt, h, 0.0, u, kb[0], d);
+    }
+    out[order[q]][0] = x + d[0];
+    out[order[q]][1] = y + d[1];
+  }
+  km__pp_free(&kp);
+  km__pp_free(&tp);
+  return KM_OK;
+}
+
+/* The samples of a curvature fit: both strands' parameters (as
+ * strand_sample takes them, so e->side applies), their positions. */
+typedef struct kfit {
+  const km_morph *m;
+  km__repair_event *e;
+  double t;
+  size_t n[2], nn;
+  size_t nall;   /* nn and the ends of each strand's bumps (lo, hi) */
+  double *r;     /* nn = n[0] + n[1] parameters */
+  size_t *order; /* r sorted */
+  double (*y)[2], (*y1)[2], (*y0)[2];
+  double *g, *g1; /* residuals per sample (INFINITY: none) */
+  double reach;
+  km__poll *poll;
+} kfit;
+
+static int cmp_by_r(const void *a, const void *b, const double *r) {
+  double x = r[*(const size_t *)a], y = r[*(const size_t *)b];
+  return (x > y) - (x < y);
+}
+
+static void sort_order(size_t *ord, size_t n, const double *r) {
+  /* insertion sort: the two strands are each sorted already but for a
+   * wrap, so runs are long */
+  for (size_t i = 1; i < n; i++) {
+    size_t v = ord[i], j = i;
+    while (j > 0 && cmp_by_r(&ord[j - 1], &v, r) > 0) {
+      ord[j] = ord[j - 1];
+      j--;
+    }
+    ord[j] = v;
+  }
+}
+
+static void kfit_free(kfit *k) {
+  km__free(k->r);
+  km__free(k->order);
+  km__free(k->y);
+  km__free(k->y1);
+  km__free(k->y0);
+  km__free(k->g);
+  km__free(k->g1);
+}
+
+/* Positions of the samples of the frame at k->t with bumps a, into y. */
+static km_status kfit_eval(kfit *k, const double *a, double (*y)[2]) {
+  const km__repair_event *ev[1] = {k->e};
+  const double *aa[1] = {a};
+  km_pp dk;
+  km__pp_init(&dk);
+  km_signature sig;
+  km_signature_init(&sig);
+  km_status st = bumps_pp(ev, aa, 1, k->m->closed, &dk);
+  if (!st) st = km__morph_signature_kappa(k->m, k->t, &dk, k->poll, &sig, NULL);
+  if (!st) st = sig_points(&sig, k->r, k->order, k->nall, y);
+  km__pp_free(&dk);
+  km_signature_free(&sig);
+  return st;
+}
+
+/* One-sided residuals of positions y: per sample, sigma d - h against the
+ * other strand, INFINITY where none applies; the worst into *worst. With
+ * only (not NULL), just the samples whose only[] is negative (the
+ * violated ones, whose derivatives the fit takes): the projections are
+ * most of a fit's cost. */
+static void kfit_residuals(const kfit *k, double (*y)[2], double *g,
+                           const double *only, double *worst) {
+  const km__repair_event *e = k->e;
+  *worst = 0.0;
+  for (int s = 0; s < 2; s++) {
+    size_t off = s ? k->n[0] : 0, ooff = s ? 0 : k->n[0];
+    int whole = s ? e->sigma_j : e->sigma_i;
+    for (size_t i = 0; i < k->n[s]; i++) {
+      g[off + i] = INFINITY;
+      int sigma = e->side[s][i] ? e->side[s][i] : whole;
+      if (sigma == 0 || (only && !(only[off + i] < 0))) continue;
+      size_t q;
+      double lam, d2, nrm[2];
+      const double(*b)[2] = (const double(*)[2])(y + ooff);
+      if (!project(b, k->n[1 - s], y[off + i], &q, &lam, &d2)) continue;
+      double d = side_of(b, q, lam, y[off + i], nrm);
+      if (fabs(d) > k->reach) continue;
+      g[off + i] = sigma * d - e->h;
+      *worst = fmin(*worst, g[off + i]);
+    }
+  }
+}
+
+/* The move of each strand's bumps' far end beyond that of its near end
+ * (x, y of I, then of J), from the frame without bumps. */
+static void local_change(const kfit *k, double (*y)[2], double out[4]) {
+  for (int g = 0; g < 2; g++) {
+    size_t lo = k->nn + 2 * (size_t)g, hi = lo + 1;
+    for (int c = 0; c < 2; c++)
+      out[2 * g + c] = (y[hi][c] - k->y0[hi][c]) - (y[lo][c] - k->y0[lo][c]);
+  }
+}
+
+/* Fits the bumps at key time t into a (nk, warm start in a); *move
+ * receives the largest move of a strand sample. */
+static km_status kfit_at(const km_morph *m, km__repair_event *e, double t,
+                         double *a, double *move, km__poll *poll) {
+  kfit k;
+  memset(&k, 0, sizeof k);
+  k.m = m;
+  k.e = e;
+  k.t = t;
+  k.poll = poll;
+  double span[2][2] = {{e->pad.i0, e->pad.i1}, {e->pad.j0, e->pad.j1}};
+  for (int s = 0; s < 2; s++) {
+    size_t n =
+        (size_t)ceil((span[s][1] - span[s][0]) * (double)e->K * PER_DR) + 1;
+    k.n[s] = n < 8 ? 8 : n;
+  }
+  k.nn = k.n[0] + k.n[1];
+  k.nall = k.nn + 4;
+  size_t nn = k.nn, w = e->nk, na = k.nall;
+  k.r = km__malloc(na * sizeof *k.r);
+  k.order = km__malloc(na * sizeof *k.order);
+  k.y = km__malloc(na * sizeof *k.y);
+  k.y1 = km__malloc(na * sizeof *k.y1);
+  k.y0 = km__malloc(na * sizeof *k.y0);
+  k.g = km__malloc(nn * sizeof *k.g);
+  k.g1 = km__malloc(nn * sizeof *k.g1);
+  double *J = km__malloc(nn * w * sizeof *J);
+  km_status st = KM_ENOMEM;
+  if (!k.r || !k.order || !k.y || !k.y1 || !k.y0 || !k.g || !k.g1 || !J)
+    goto done;
+  for (int s = 0; s < 2; s++)
+    for (size_t i = 0; i < k.n[s]; i++) {
+      double r = span[s][0] +
+                 (span[s][1] - span[s][0]) * (double)i / (double)(k.n[s] - 1);
+      if (r < 0) r += 1.0;
+      if (r > 1) r -= 1.0;
+      k.r[(s ? k.n[0] : 0) + i] = r;
+    }
+  for (int g = 0; g < 2; g++)
+    for (int side = 0; side < 2; side++) {
+      size_t j = (size_t)g * KB_PER + (side ? KB_PER - 1 : 0);
+      double r = e->kc[j] + (side ? 2 : -2) * e->kdr[j];
+      r = m->closed ? r - floor(r) : fmin(fmax(r, 0.0), 1.0);
+      k.r[nn + 2 * (size_t)g + (size_t)side] = r;
+    }
+  for (size_t i = 0; i < na; i++) k.order[i] = i;
+  sort_order(k.order, na, k.r);
+  k.reach = 10 * e->h + 0.02 * e->size;
+  double zero[MAX_KB] = {0};
+  st = kfit_eval(&k, zero, k.y0);
+  if (st) goto done;
+  double worst;
+  st = kfit_eval(&k, a, k.y);
+  if (st) goto done;
+  kfit_residuals(&k, k.y, k.g, NULL, &worst);
+  for (int step = 0; step < KGN_STEPS && worst < -0.02 * e->h; step++) {
+    if (km__poll_stop(poll, (long)(nn * (w + 1)))) {
+      st = KM_ECANCELLED;
+      goto done;
+    }
+    /* the Jacobian of the violated residuals, by forward differences */
+    double lc[4], Jl[4][MAX_KB];
+    local_change(&k, k.y, lc);
+    for (size_t j = 0; j < w; j++) {
+      double b[MAX_KB], wj;
+      memcpy(b, a, w * sizeof *b);
+      b[j] += KEPS;
+      st = kfit_eval(&k, b, k.y1);
+      if (st) goto done;
+      kfit_residuals(&k, k.y1, k.g1, k.g, &wj);
+      double l1[4];
+      local_change(&k, k.y1, l1);
+      for (int q = 0; q < 4; q++) Jl[q][j] = (l1[q] - lc[q]) / KEPS;
+      for (size_t i = 0; i < nn; i++)
+        J[i * w + j] =
+            k.g[i] < 0 && isfinite(k.g1[i]) ? (k.g1[i] - k.g[i]) / KEPS : 0.0;
+    }
+    /* normal equations for the new a: least squares of g + J (a' - a) = 0
+     * over the violated samples, a ridge, second differences of the turns
+     * along each strand, and the total turn kept (a closed frame's
+     * tangent closes by itself only then) */
+    double M[MAX_KB * MAX_KB] = {0}, rhs[MAX_KB] = {0};
+    for (size_t i = 0; i < nn; i++) {
+      if (!(k.g[i] < 0)) continue;
+      double ja = 0.0;
+      for (size_t p = 0; p < w; p++) ja += J[i * w + p] * a[p];
+      for (size_t p = 0; p < w; p++) {
+        rhs[p] += J[i * w + p] * (ja - k.g[i]);
+        for (size_t q = 0; q < w; q++)
+          M[p * w + q] += J[i * w + p] * J[i * w + q];
+      }
+    }
+    double sc = e->size * e->size;
+    for (size_t p = 0; p < w; p++) M[p * w + p] += 1e-6 * sc;
+    for (size_t g0 = 0; g0 < w; g0 += KB_PER)
+      for (size_t j = 1; j + 1 < KB_PER; j++) {
+        size_t q[3] = {g0 + j - 1, g0 + j, g0 + j + 1};
+        double c3[3] = {1.0, -2.0, 1.0};
+        for (int u = 0; u < 3; u++)
+          for (int v = 0; v < 3; v++)
+            M[q[u] * w + q[v]] += 1e-5 * sc * c3[u] * c3[v];
+      }
+    /* the rest of the frame kept: each strand's bumps close by themselves
+     * (no turn, no move past them), so the closure has nothing new to
+     * spread */
+    for (int q = 0; q < 4 && KLOCAL > 0; q++) {
+      double ja = 0.0;
+      for (size_t p = 0; p < w; p++) ja += Jl[q][p] * a[p];
+      for (size_t p = 0; p < w; p++) {
+        rhs[p] += KLOCAL * Jl[q][p] * (ja - lc[q]);
+        for (size_t r = 0; r < w; r++)
+          M[p * w + r] += KLOCAL * Jl[q][p] * Jl[q][r];
+      }
+    }
+    for (size_t p = 0; p < w; p++)
+      for (size_t q = 0; q < w; q++)
+        if (KLOCAL == 0 || p / KB_PER == q / KB_PER) M[p * w + q] += 1e2 * sc;
+    if (!cholesky_solve(M, rhs, w)) break;
+    double mean[2] = {0.0, 0.0};
+    for (size_t p = 0; p < w; p++)
+      mean[KLOCAL > 0 ? p / KB_PER : 0] +=
+          rhs[p] / (double)(KLOCAL > 0 ? KB_PER : w);
+    double big = 0.0, dir[MAX_KB];
+    for (size_t p = 0; p < w; p++) {
+      dir[p] = rhs[p] - mean[KLOCAL > 0 ? p / KB_PER : 0] - a[p];
+      big = fmax(big, fabs(dir[p]));
+    }
+    double f = big > KSTEP ? KSTEP / big : 1.0;
+    /* a step that makes the worst residual worse is halved, twice */
+    double trial[MAX_KB], wt = 0.0;
+    bool took = false;
+    for (int half = 0; half < 3; half++, f *= 0.5) {
+      for (size_t p = 0; p < w; p++) trial[p] = a[p] + f * dir[p];
+      st = kfit_eval(&k, trial, k.y1);
+      if (st) goto done;
+      kfit_residuals(&k, k.y1, k.g1, NULL, &wt);
+      if (wt > worst) {
+        took = true;
+        break;
+      }
+    }
+    if (!took) break;
+    memcpy(a, trial, w * sizeof *a);
+    memcpy(k.y, k.y1, nn * sizeof *k.y);
+    memcpy(k.g, k.g1, nn * sizeof *k.g);
+    worst = wt;
+  }
+  *move = 0.0;
+  for (size_t i = 0; i < nn; i++)
+    *move = fmax(*move, hypot(k.y[i][0] - k.y0[i][0], k.y[i][1] - k.y0[i][1]));
+  st = KM_OK;
+done:
+  km__free(J);
+  kfit_free(&k);
+  return st;
+}
+
+/* Fits the coefficients at key time t into c (e->w, warm start in c);
+ * *move receives the curvature fit's largest move (0 for a displacement). */
+static km_status fit_at(const km_morph *m, km__repair *rp, km__repair_event *e,
+                        double t, double *c, double *move, km__poll *poll) {
+  if ((e->nk ? rp->kfits_left-- : rp->fits_left--) <= 0) return KM_ELIMIT;
+  *move = 0.0;
+  if (e->nk) return kfit_at(m, e, t, c, move, poll);
   km_curve f;
   km_status st = frame_at(m, t, poll, &f);
   fit ft;
@@ -787,10 +1283,13 @@ static km_status fit_at(const km_morph *m, km__repair *rp,
 }
 
 /* Inserts key time t (strictly between two keys) with coefficients c. */
-static bool insert_key(km__repair_event *e, double t, const double *c) {
-  size_t w = 2 * e->nb, k = 1;
+static bool insert_key(km__repair_event *e, double t, const double *c,
+                       double move) {
+  size_t w = e->w, k = 1;
   if (e->nt >= MAX_KEYS) return false;
   while (k < e->nt && e->t[k] < t) k++;
+  memmove(&e->kmove[k + 1], &e->kmove[k], (e->nt - k) * sizeof *e->kmove);
+  e->kmove[k] = move;
   memmove(&e->t[k + 1], &e->t[k], (e->nt - k) * sizeof *e->t);
   memmove(&e->c[(k + 1) * w], &e->c[k * w], (e->nt - k) * w * sizeof *e->c);
   e->t[k] = t;
@@ -803,10 +1302,23 @@ static bool insert_key(km__repair_event *e, double t, const double *c) {
 static km_status repaired_crossings(const km_morph *m, const km__repair *rp,
                                     double t, km__poll *poll, long *count) {
   km_curve f;
-  km_status st = frame_at(m, t, poll, &f);
+  km_curve_init(&f);
+  km_status st = KM_OK;
+  if (km__repair_kappa_active(rp, t)) {
+    km_pp dk;
+    st = km__repair_kappa(rp, t, rp->n, &dk);
+    if (!st && dk.m)
+      st = km__morph_frame_kappa(m, t, &dk, poll, &f, NULL);
+    else if (!st)
+      st = frame_at(m, t, poll, &f);
+    km__pp_free(&dk);
+  } else {
+    st = frame_at(m, t, poll, &f);
+  }
   double *c = NULL;
   for (size_t i = 0; !st && i < rp->n; i++) {
     const km__repair_event *e = &rp->ev[i];
+    if (e->nk) continue;
     km__free(c);
     c = km__malloc(2 * e->nb * sizeof *c);
     if (!c) {
@@ -828,6 +1340,10 @@ static km_status repaired_crossings(const km_morph *m, const km__repair *rp,
 /* The largest displacement over the event's key times. */
 static double largest_move(const km__repair_event *e) {
   double big = 0.0;
+  if (e->nk) {
+    for (size_t k = 0; k < e->nt; k++) big = fmax(big, e->kmove[k]);
+    return big;
+  }
   for (size_t k = 0; k < e->nt; k++)
     for (size_t q = 0; q < e->nb; q++)
       big = fmax(
@@ -854,7 +1370,7 @@ void km__repair_free(km__repair *rp) {
 static km_status event_fit(const km_morph *m, km__repair *rp,
                            km__repair_event *e, double tb, double ta,
                            km__poll *poll) {
-  size_t w = 2 * e->nb;
+  size_t w = e->w;
   e->c = km__calloc(MAX_KEYS * w, sizeof *e->c);
   e->slope = km__calloc(MAX_KEYS * w, sizeof *e->slope);
   double *c = km__calloc(w, sizeof *c);
@@ -866,8 +1382,9 @@ static km_status event_fit(const km_morph *m, km__repair *rp,
   for (long j = 0; j <= steps && e->nt < MAX_KEYS; j++) {
     double t = j == steps ? ta : tb + (ta - tb) * (double)j / (double)steps;
     e->t[e->nt] = t;
+    e->kmove[e->nt] = 0.0;
     if (j > 0 && j < steps) {
-      st = fit_at(m, rp, e, t, c, poll);
+      st = fit_at(m, rp, e, t, c, &e->kmove[e->nt], poll);
       if (st) goto done;
       memcpy(&e->c[e->nt * w], c, w * sizeof *c);
     }
@@ -886,7 +1403,7 @@ done:
 static km_status event_verify(const km_morph *m, km__repair *rp, km__poll *poll,
                               long *left, long *before) {
   km__repair_event *e = &rp->ev[rp->n - 1];
-  size_t w = 2 * e->nb;
+  size_t w = e->w;
   double *c = km__malloc(w * sizeof *c);
   if (!c) return KM_ENOMEM;
   km_status st = KM_OK;
@@ -914,13 +1431,14 @@ static km_status event_verify(const km_morph *m, km__repair *rp, km__poll *poll,
     if (*left == 0 || round == ROUNDS) break;
     for (size_t i = 0; i < nbad; i++) {
       if (!coefficients_at(e, bad[i], c)) memset(c, 0, w * sizeof *c);
-      st = fit_at(m, rp, e, bad[i], c, poll);
+      double mv;
+      st = fit_at(m, rp, e, bad[i], c, &mv, poll);
       if (st == KM_ELIMIT) {
         st = KM_OK;
         break;
       }
       if (st) goto done;
-      if (!insert_key(e, bad[i], c)) break;
+      if (!insert_key(e, bad[i], c, mv)) break;
     }
     hermite_slopes(e);
   }
@@ -979,7 +1497,8 @@ static km_status scan(const km_morph *m, km__poll *poll, scan_event *ev,
   return KM_OK;
 }
 
-km_status km__repair_crossings(km_morph *m, km__poll *poll) {
+km_status km__repair_crossings(km_morph *m, km__repair_method how,
+                               km__poll *poll) {
   scan_event sev[MAX_EVENTS];
   size_t nsev;
   long frames;
@@ -989,47 +1508,66 @@ km_status km__repair_crossings(km_morph *m, km__poll *poll) {
   km__repair *rp = km__calloc(1, sizeof *rp);
   if (!rp) return KM_ENOMEM;
   rp->degree = m->opt.degree;
-  rp->fits_left = FITS;
+  rp->closed = m->closed;
+  rp->fits_left = rp->kfits_left = FITS;
   long unrepaired = 0, left_total = 0;
-  for (size_t i = 0; i < nsev; i++) {
-    km__repair_event *e = &rp->ev[rp->n];
-    memset(e, 0, sizeof *e);
-    e->core = sev[i].s;
-    if (!event_layout(e, m->closed)) {
-      unrepaired++;
-      continue;
+  /* each event by curvature, by displacement, or by curvature and, where
+   * that is not kept, by displacement */
+  int tries = how == KM__REPAIR_BOTH ? 2 : 1;
+  bool stop = false;
+  for (size_t i = 0; i < nsev && !stop; i++) {
+    bool kept = false;
+    for (int attempt = 0; attempt < tries && !kept && !stop; attempt++) {
+      km__repair_event *e = &rp->ev[rp->n];
+      memset(e, 0, sizeof *e);
+      e->core = sev[i].s;
+      if (!event_layout(e, m->closed)) break;
+      e->w = 2 * e->nb;
+      if (how != KM__REPAIR_DISPLACEMENT && attempt == 0) kappa_layout(e);
+      double tb = 0.0, ta = 1.0;
+      bool ok;
+      st = event_sides(m, e, sev[i].first, sev[i].last, &tb, &ta, poll, &ok);
+      if (st || !ok) {
+        event_free(e);
+        stop = st != KM_OK;
+        break;
+      }
+      st = event_fit(m, rp, e, tb, ta, poll);
+      if (st == KM_ELIMIT && attempt + 1 < tries) {
+        /* the curvature fits' budget is spent: displacement */
+        event_free(e);
+        st = KM_OK;
+        continue;
+      }
+      if (st == KM_ELIMIT) { /* the budget is spent: no more events */
+        event_free(e);
+        unrepaired += (long)(nsev - i - 1);
+        st = KM_OK;
+        stop = true;
+        break;
+      }
+      if (st) {
+        event_free(e);
+        stop = true;
+        break;
+      }
+      rp->n++;
+      long left = 0, before = 0;
+      st = event_verify(m, rp, poll, &left, &before);
+      if (st) {
+        stop = true;
+        break;
+      }
+      /* kept when it helps and stays a local change */
+      if (left >= before || largest_move(e) > MAX_MOVE * e->size) {
+        event_free(e);
+        rp->n--;
+        continue;
+      }
+      left_total += left;
+      kept = true;
     }
-    double tb = 0.0, ta = 1.0;
-    bool ok;
-    st = event_sides(m, e, sev[i].first, sev[i].last, &tb, &ta, poll, &ok);
-    if (st) break;
-    if (!ok) {
-      unrepaired++;
-      continue;
-    }
-    st = event_fit(m, rp, e, tb, ta, poll);
-    if (st == KM_ELIMIT) { /* the budget is spent: no more events */
-      event_free(e);
-      unrepaired += (long)(nsev - i);
-      st = KM_OK;
-      break;
-    }
-    if (st) {
-      event_free(e);
-      break;
-    }
-    rp->n++;
-    long left = 0, before = 0;
-    st = event_verify(m, rp, poll, &left, &before);
-    if (st) break;
-    /* kept when it helps and stays a local change */
-    if (left >= before || largest_move(e) > MAX_MOVE * e->size) {
-      event_free(e);
-      rp->n--;
-      unrepaired++;
-      continue;
-    }
-    left_total += left;
+    if (!kept && !st) unrepaired++;
   }
   if (!st) {
     m->avoid.repair_events = (long)rp->n;
@@ -1046,6 +1584,14 @@ km_status km__repair_crossings(km_morph *m, km__poll *poll) {
 
 /* ---- frames ------------------------------------------------------------ */
 
+/* The curvature repair's largest move at t: the larger of the key times'
+ * either side (a strand's move, measured at the fit). */
+static double kappa_move(const km__repair_event *e, double t) {
+  size_t k = 0;
+  while (k + 2 < e->nt && t >= e->t[k + 1]) k++;
+  return fmax(e->kmove[k], e->kmove[k + 1]);
+}
+
 bool km__repair_active(const km__repair *rp, double t) {
   for (size_t i = 0; rp && i < rp->n; i++) {
     const km__repair_event *e = &rp->ev[i];
@@ -1059,7 +1605,7 @@ size_t km__repair_extra_points(const km__repair *rp, double t) {
   int p = rp ? rp->degree : 3;
   for (size_t i = 0; rp && i < rp->n; i++) {
     const km__repair_event *e = &rp->ev[i];
-    if (e->nt >= 2 && t > e->t[0] && t < e->t[e->nt - 1])
+    if (e->nk == 0 && e->nt >= 2 && t > e->t[0] && t < e->t[e->nt - 1])
       extra += event_knots(e) * (size_t)(p - 2);
   }
   return extra;
@@ -1072,7 +1618,7 @@ km_status km__repair_apply(const km__repair *rp, double t, km_curve *f,
   for (size_t i = 0; rp && !st && i < rp->n; i++) {
     const km__repair_event *e = &rp->ev[i];
     double c[MAX_BASIS * 2];
-    if (!coefficients_at(e, t, c)) continue;
+    if (e->nk || !coefficients_at(e, t, c)) continue;
     /* the largest displacement: D is a convex combination of its
      * coefficients, so their largest norm bounds it */
     for (size_t q = 0; q < e->nb; q++)
@@ -1088,6 +1634,10 @@ double km_morph_repaired(const km_morph *m, double t) {
     const km__repair_event *e = &m->repair->ev[i];
     double c[MAX_BASIS * 2];
     if (!coefficients_at(e, t, c)) continue;
+    if (e->nk) {
+      size = fmax(size, kappa_move(e, t));
+      continue;
+    }
     for (size_t q = 0; q < e->nb; q++)
       size = fmax(size, hypot(c[2 * q], c[2 * q + 1]));
   }
