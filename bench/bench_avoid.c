@@ -92,7 +92,7 @@ static int bench_fixture(const char *path, tally *tl) {
     const char *to = cJSON_GetObjectItemCaseSensitive(p, "to")->valuestring;
     const char *da = glyph_d(root, from), *db = glyph_d(root, to);
     km_curve a, b;
-    if (!da || !db || glyph_curve(da, &a) || glyph_curve(db, &b)) {
+    if (!da || !db || glyph_path_curve(da, &a) || glyph_path_curve(db, &b)) {
       fprintf(stderr, "%s -> %s: cannot build the glyphs\n", from, to);
       cJSON_Delete(root);
       return -1;

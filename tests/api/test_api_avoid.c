@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "api_testutil.h"
+#include "glyphs.h"
 #include "testmain.h"
 
 #define MORPH API_ROUTE_MORPH
@@ -28,30 +29,8 @@ static const cJSON *member(const cJSON *o, const char *key) {
   return v;
 }
 
-static char *read_file(const char *path) {
-  FILE *fp = fopen(path, "rb");
-  assert_non_null(fp);
-  fseek(fp, 0, SEEK_END);
-  long n = ftell(fp);
-  fseek(fp, 0, SEEK_SET);
-  char *s = malloc((size_t)n + 1);
-  assert_non_null(s);
-  assert_int_equal(fread(s, 1, (size_t)n, fp), (size_t)n);
-  s[n] = '\0';
-  fclose(fp);
-  return s;
-}
-
-static cJSON *fixture_at(const char *path) {
-  char *text = read_file(path);
-  cJSON *root = cJSON_Parse(text);
-  free(text);
-  assert_non_null(root);
-  return root;
-}
-
 static cJSON *fixture(void) {
-  return fixture_at("tests/fixtures/avoid/glyphs.json");
+  return tg_fixture(TG_AVOID_PATH);
 }
 
 static const char *glyph_d(const cJSON *root, const char *id) {
@@ -421,7 +400,7 @@ static void avoid_is_the_default(void **state) {
  * 40 are never repaired (they are the inputs). */
 static void the_repair_separates_pinches(void **state) {
   (void)state;
-  cJSON *root = fixture_at("tests/fixtures/avoid/repair.json");
+  cJSON *root = tg_fixture(TG_REPAIR_PATH);
   const cJSON *p;
   int total = 0, clean = 0, repaired = 0;
   cJSON_ArrayForEach(p, member(root, "pairs")) {

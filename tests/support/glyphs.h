@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "glyph_path.h"
 #include "km/kmorph.h"
 #include "testutil.h"
 
@@ -44,27 +45,7 @@ static inline void tg_glyph(const cJSON *root, const char *id, km_curve *out) {
       d = cJSON_GetObjectItemCaseSensitive(g, "d")->valuestring;
   }
   assert_non_null(d);
-  km_path p;
-  km_path_init(&p);
-  double v[4];
-  while (*d) {
-    while (*d == ' ') d++;
-    char op = *d;
-    if (!op) break;
-    d++;
-    int n = op == 'M' || op == 'L' ? 2 : op == 'Q' ? 4 : 0;
-    for (int i = 0; i < n; i++) v[i] = strtod(d, (char **)&d);
-    km_status st = op == 'M'   ? km_path_move_to(&p, v[0], v[1], NULL)
-                   : op == 'L' ? km_path_line_to(&p, v[0], v[1], NULL)
-                   : op == 'Q'
-                       ? km_path_quad_to(&p, v[0], v[1], v[2], v[3], NULL)
-                   : op == 'Z' ? km_path_close(&p, NULL)
-                               : KM_EINVAL;
-    assert_status(st, KM_OK);
-  }
-  km_curve_init(out);
-  assert_status(km_path_to_curve(&p, 0.0, out, NULL), KM_OK);
-  km_path_free(&p);
+  assert_int_equal(glyph_path_curve(d, out), 0);
 }
 
 #endif
