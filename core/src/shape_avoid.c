@@ -143,7 +143,18 @@ bool km__shape_fix_at(const km_shape_morph *m, size_t k, double t, double d[2],
  * their nesting failures into *fails. */
 static km_status preview(const km_shape_morph *m, int n, const km_stop *stop,
                          long *fails, km_error *err) {
-  return km__shape_preview(m, n, false, stop, fails, err);
+  km_status st = km__shape_preview(m, n, false, stop, fails, err);
+  /* and the ends' halves of the first and last gaps, where a vanishing
+   * contour meets a growing one (the dot of i and the stem of l) */
+  for (int e = 0; e < 2 && st == KM_OK; e++) {
+    km_shape_frame f;
+    km_shape_frame_init(&f);
+    double t = e == 0 ? 0.5 / (n + 1) : 1 - 0.5 / (n + 1);
+    st = km_shape_morph_frame_until(m, t, stop, &f, err);
+    if (st == KM_OK) *fails += f.mutual_intersections + (f.nesting_ok ? 0 : 1);
+    km_shape_frame_free(&f);
+  }
+  return st;
 }
 
 km_status km__shape_preview(const km_shape_morph *m, int n, bool between,
