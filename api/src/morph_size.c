@@ -50,7 +50,7 @@ static double frames_extent(const api_morph_plan *pl) {
 }
 
 /* Control points of the frames at most: the frames of a planned morph
- * share one count, known exactly; others are counted at the first, middle
+ * share one bound (each merges runs of the planned pieces); others are counted at the first, middle
  * and last requested times (without building the curves) and given a
  * quarter more, as the count moves smoothly with t. */
 static km_status frame_points(const api_morph_plan *pl, const km_stop *stop,
@@ -69,7 +69,7 @@ static km_status frame_points(const api_morph_plan *pl, const km_stop *stop,
     if (k == 2) last = n;
     most = n > most ? n : most;
   }
-  /* equal counts at both ends and the middle: a planned (constant) count */
+  /* equal counts at both ends and the middle: a planned (constant) bound */
   *points = most == first && most == last ? most : most + most / 4 + 8;
   return KM_OK;
 }

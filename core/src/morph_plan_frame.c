@@ -9,6 +9,15 @@
  * integral psi'^2 (the Gram matrix of their derivatives is Toeplitz with
  * entries 2/3, -1/8, -1/5, -1/120), so the seam stays G2; or, where the
  * plan says so, a turn of the frame's corners.
+ *   The plan's pieces are sized for the worst t, within their share of the
+ * tolerance; each frame then merges runs of them greedily into single
+ * cubics (end points and tangents kept, legs by the circular-arc formula)
+ * while a rigorous bound of the distance between the cubic and the pieces
+ * it replaces (merge_distance: Bernstein coefficients of their difference
+ * under a cubic reparametrisation) fits in the merge's share, never across
+ * a corner. So a frame is within the pieces' share plus the merge's of
+ * its exact curve, as point sets, and carries 1.0-2x fewer control
+ * points (the circle's arcs four to a cubic).
  */
 #include <math.h>
 #include <string.h>
@@ -358,39 +367,23 @@ static km_status frame_closure(const km__frame_plan *p, double t, double theta0,
   return st;
 }
 
-/* The frame's cubic Hermite control points into *f (initialised, empty):
- * P0, then Q1 Q2 of every piece, with the junction point itself at
- * corners (triple knots; double elsewhere); ends as km__frame_plan_curve.
- * *P the end point. KM_EINVAL (*msg) if the counts disagree. */
-static km_status hermite_points(const km__frame_plan *p, double t,
-                                double theta0, const double *c,
-                                const double *sum, const double *dp,
-                                km_curve *f, double *ends, double P[2],
-                                const char **msg) {
+/* The frame's cubic Hermite pieces: bz receives 8 values a piece (P0 Q1
+ * Q2 P3), X its np + 1 knots (arc length), ends (if not NULL) the pieces'
+ * end points from (0, 0) on, 2 (np + 1) values. */
+static void hermite_pieces(const km__frame_plan *p, double t, double theta0,
+                           const double *c, const double *sum, const double *dp,
+                           double *bz, double *X, double *ends) {
   double Lt = (1 - t) * p->La + t * p->Lb, al = 1 - t, be = t;
-  size_t np = p->np, ncorner = 0;
-  for (size_t k = 1; k < np; k++) ncorner += p->corner[k];
-  size_t ncp = 2 * np + 2 + ncorner, nknots = ncp + 4;
-  km_status st = km__curve_alloc(f, 3, ncp, false);
-  if (st) return st;
-  size_t cc = 0, kk = 0;
-  P[0] = P[1] = 0.0;
-  for (int r = 0; r < 4; r++) f->knots[kk++] = 0.0;
-  f->cp[cc++] = 0.0;
-  f->cp[cc++] = 0.0;
+  double P[2] = {0.0, 0.0};
   if (ends) ends[0] = ends[1] = 0.0;
   /* the tangent a piece ends with is the next one's start but at corners
    * (theta is continuous there to 1e-12, and so is the turn dp) */
   double c1 = 0.0, s1 = 0.0;
-  for (size_t k = 0; k < np; k++) {
-    double h = Lt * (p->x[k + 1] - p->x[k]);
+  for (size_t k = 0; k < p->np; k++) {
+    double h = Lt * (p->x[k + 1] - p->x[k]), *B = bz + 8 * k;
     double th1 = theta0 + al * p->ta_l[k + 1] + be * p->tb_l[k + 1] +
                  psi_at_break(p, c, k + 1) + dp[k];
     double Pn[2] = {P[0] + Lt * sum[2 * k], P[1] + Lt * sum[2 * k + 1]};
-    if (k > 0 && p->corner[k]) {
-      f->cp[cc++] = P[0];
-      f->cp[cc++] = P[1];
-    }
     double c0 = c1, s0 = s1;
     if (k == 0 || p->corner[k]) {
       double th0 = theta0 + al * p->ta_r[k] + be * p->tb_r[k] +
@@ -398,14 +391,15 @@ static km_status hermite_points(const km__frame_plan *p, double t,
       km__sincos(th0, &s0, &c0);
     }
     km__sincos(th1, &s1, &c1);
-    f->cp[cc++] = P[0] + h / 3.0 * c0;
-    f->cp[cc++] = P[1] + h / 3.0 * s0;
-    f->cp[cc++] = Pn[0] - h / 3.0 * c1;
-    f->cp[cc++] = Pn[1] - h / 3.0 * s1;
-    if (k + 1 < np) {
-      int mult = p->corner[k + 1] ? 3 : 2;
-      for (int r = 0; r < mult; r++) f->knots[kk++] = Lt * p->x[k + 1];
-    }
+    X[k] = Lt * p->x[k];
+    B[0] = P[0];
+    B[1] = P[1];
+    B[2] = P[0] + h / 3.0 * c0;
+    B[3] = P[1] + h / 3.0 * s0;
+    B[4] = Pn[0] - h / 3.0 * c1;
+    B[5] = Pn[1] - h / 3.0 * s1;
+    B[6] = Pn[0];
+    B[7] = Pn[1];
     P[0] = Pn[0];
     P[1] = Pn[1];
     if (ends) {
@@ -413,39 +407,289 @@ static km_status hermite_points(const km__frame_plan *p, double t,
       ends[2 * k + 3] = P[1];
     }
   }
-  f->cp[cc++] = P[0];
-  f->cp[cc++] = P[1];
-  for (int r = 0; r < 4; r++) f->knots[kk++] = Lt;
-  if (cc != 2 * ncp || kk != nknots) {
+  X[p->np] = Lt;
+}
+
+/* Bernstein coefficients of a polynomial of degree 3 and of degree 9 on
+ * [0, 1] from its values at i / 3, i / 9: inverses of the Bernstein
+ * collocation matrices (the rows of the second sum to at most 1368 in
+ * absolute value, which multiplies the rounding of the values). */
+static const double BERN3_FROM_VALUES[4][4] = {
+    {1, 0, 0, 0},
+    {-5.0 / 6, 3, -1.5, 1.0 / 3},
+    {1.0 / 3, -1.5, 3, -5.0 / 6},
+    {0, 0, 0, 1},
+};
+static const double BERN9_FROM_VALUES[10][10] = {
+    {1, 0, 0, 0, 0, 0, 0, 0, 0, 0},
+    {-1.8289682539682539, 9, -18, 28, -31.5, 25.199999999999999, -14,
+     5.1428571428571432, -1.125, 0.1111111111111111},
+    {2.6132688492063494, -19.036607142857143, 58.323214285714286,
+     -101.22499999999999, 119.784375, -98.662499999999994, 55.862499999999997,
+     -20.796428571428571, 4.5944196428571429, -0.45724206349206348},
+    {-2.9806866496598641, 25.449394132653062, -93.95070153061225, 195.46875,
+     -253.34196428571428, 220.18258928571427, -129.14598214285715,
+     49.292219387755104, -11.09359056122449, 1.1199723639455783},
+    {2.7285306831065759, -25.226977040816326, 102.69585459183673,
+     -240.13035714285715, 352.2314732142857, -333.24910714285716,
+     207.32901785714284, -82.586479591836735, 19.195169005102041,
+     -1.987124433106576},
+    {-1.987124433106576, 19.195169005102041, -82.586479591836735,
+     207.32901785714284, -333.24910714285716, 352.2314732142857,
+     -240.13035714285715, 102.69585459183673, -25.226977040816326,
+     2.7285306831065759},
+    {1.1199723639455783, -11.09359056122449, 49.292219387755104,
+     -129.14598214285715, 220.18258928571427, -253.34196428571428, 195.46875,
+     -93.95070153061225, 25.449394132653062, -2.9806866496598641},
+    {-0.45724206349206348, 4.5944196428571429, -20.796428571428571,
+     55.862499999999997, -98.662499999999994, 119.784375, -101.22499999999999,
+     58.323214285714286, -19.036607142857143, 2.6132688492063494},
+    {0.1111111111111111, -1.125, 5.1428571428571432, -14, 25.199999999999999,
+     -31.5, 28, -18, 9, -1.8289682539682539},
+    {0, 0, 0, 0, 0, 0, 0, 0, 0, 1},
+};
+
+/* A cubic's point at u from its control points C (8 values). */
+static inline void bez_point(const double *C, double u, double out[2]) {
+  double v = 1 - u, b0 = v * v * v, b1 = 3 * u * v * v, b2 = 3 * u * u * v,
+         b3 = u * u * u;
+  out[0] = b0 * C[0] + b1 * C[2] + b2 * C[4] + b3 * C[6];
+  out[1] = b0 * C[1] + b1 * C[3] + b2 * C[5] + b3 * C[7];
+}
+
+/* The parameter of the point of cubic M nearest q, by Newton from u
+ * (clamped to [0, 1]). */
+static double project(const double *M, const double q[2], double u) {
+  double a[2][4];
+  for (int d = 0; d < 2; d++) {
+    double m0 = M[d], m1 = M[2 + d], m2 = M[4 + d], m3 = M[6 + d];
+    a[d][0] = m0 - q[d];
+    a[d][1] = 3 * (m1 - m0);
+    a[d][2] = 3 * (m2 - 2 * m1 + m0);
+    a[d][3] = m3 - 3 * m2 + 3 * m1 - m0;
+  }
+  for (int it = 0; it < 8; it++) {
+    double f = 0.0, fp = 0.0;
+    for (int d = 0; d < 2; d++) {
+      double p = a[d][0] + u * (a[d][1] + u * (a[d][2] + u * a[d][3]));
+      double p1 = a[d][1] + u * (2 * a[d][2] + u * 3 * a[d][3]);
+      double p2 = 2 * a[d][2] + 6 * u * a[d][3];
+      f += p * p1;
+      fp += p1 * p1 + p * p2;
+    }
+    if (!(fp > 0)) break;
+    double du = f / fp;
+    u = fmin(fmax(u - du, 0.0), 1.0);
+    if (fabs(du) < 1e-13) break;
+  }
+  return u;
+}
+
+/* The end speeds (legs over a third of the knot span H) of the cubic in
+ * place of pieces a .. b - 1 by the arc formula: legs 2 c^2 / (3 (c +
+ * T.d)) for chord d, |d| = c, end tangent T (a circular arc's best); 1
+ * (the pieces' own, Hermite in arc length) for a single piece. False
+ * where an end turns too far from the chord. */
+static bool run_speeds(const double *bz, const double *X, size_t a, size_t b,
+                       double v[2]) {
+  v[0] = v[1] = 1.0;
+  if (b == a + 1) return true;
+  const double *A = bz + 8 * a, *B = bz + 8 * (b - 1);
+  double d[2] = {B[6] - A[0], B[7] - A[1]}, c = hypot(d[0], d[1]);
+  double t0[2] = {A[2] - A[0], A[3] - A[1]}, t1[2] = {B[6] - B[4], B[7] - B[5]};
+  double n0 = hypot(t0[0], t0[1]), n1 = hypot(t1[0], t1[1]);
+  if (!(c > 0 && n0 > 0 && n1 > 0)) return false;
+  double k0 = c + (t0[0] * d[0] + t0[1] * d[1]) / n0,
+         k1 = c + (t1[0] * d[0] + t1[1] * d[1]) / n1;
+  /* an end more than some 140 degrees off the chord */
+  if (k0 < 0.25 * c || k1 < 0.25 * c) return false;
+  double H = X[b] - X[a];
+  v[0] = 2 * c * c / (k0 * H);
+  v[1] = 2 * c * c / (k1 * H);
+  return true;
+}
+
+/* The cubic M (8 values, as bz) in place of pieces a .. b - 1: their end
+ * points and end tangents, legs v[0] H / 3 and v[1] H / 3 over its knot
+ * span H (speeds v in the arc-length knots). */
+static void merged_cubic(const double *bz, const double *X, size_t a, size_t b,
+                         const double v[2], double M[8]) {
+  const double *A = bz + 8 * a, *B = bz + 8 * (b - 1);
+  double H = X[b] - X[a], fa = v[0] * H / (X[a + 1] - X[a]),
+         fb = v[1] * H / (X[b] - X[b - 1]);
+  M[0] = A[0];
+  M[1] = A[1];
+  M[2] = A[0] + fa * (A[2] - A[0]);
+  M[3] = A[1] + fa * (A[3] - A[1]);
+  M[4] = B[6] + fb * (B[4] - B[6]);
+  M[5] = B[7] + fb * (B[5] - B[7]);
+  M[6] = B[6];
+  M[7] = B[7];
+}
+
+/* A bound on the distance between cubic M and pieces a .. b - 1 (Frechet,
+ * so both ways): piece k is matched with M over [u_k, u_k+1] by a cubic
+ * reparametrisation g through the parameters of M's points nearest the
+ * piece's points at 0, 1/3, 2/3 and 1 (increasing: its Bernstein
+ * coefficients are), the difference P_k(s) - M(g(s)) is a polynomial of
+ * degree 9, and its largest Bernstein coefficient bounds it (a quadratic
+ * g leaves a tangential mismatch of some 3x the normal distance). Stops
+ * (returning more) once past budget. */
+static double merge_distance(const double *bz, const double *X, size_t a,
+                             size_t b, const double M[8], double budget) {
+  double H = X[b] - X[a], worst = 0.0, u0 = 0.0;
+  for (size_t k = a; k < b && worst <= budget; k++) {
+    const double *Pk = bz + 8 * k;
+    double uv[4], gb[4], q[2];
+    uv[0] = u0;
+    uv[3] = k + 1 < b ? project(M, Pk + 6, (X[k + 1] - X[a]) / H) : 1.0;
+    for (int i = 1; i < 3; i++) {
+      bez_point(Pk, i / 3.0, q);
+      uv[i] = project(M, q, u0 + (uv[3] - u0) * i / 3.0);
+    }
+    for (int j = 0; j < 4; j++) {
+      gb[j] = 0.0;
+      for (int i = 0; i < 4; i++) gb[j] += BERN3_FROM_VALUES[j][i] * uv[i];
+    }
+    if (!(gb[0] < gb[1] && gb[1] < gb[2] && gb[2] < gb[3])) return INFINITY;
+    double D[10][2];
+    for (int i = 0; i <= 9; i++) {
+      double sg = i / 9.0, v = 1 - sg, pp[2], mp[2];
+      double g = v * v * v * gb[0] + 3 * sg * v * v * gb[1] +
+                 3 * sg * sg * v * gb[2] + sg * sg * sg * gb[3];
+      bez_point(Pk, sg, pp);
+      bez_point(M, g, mp);
+      D[i][0] = pp[0] - mp[0];
+      D[i][1] = pp[1] - mp[1];
+    }
+    for (int j = 0; j <= 9; j++) {
+      double cx = 0.0, cy = 0.0;
+      for (int i = 0; i <= 9; i++) {
+        cx += BERN9_FROM_VALUES[j][i] * D[i][0];
+        cy += BERN9_FROM_VALUES[j][i] * D[i][1];
+      }
+      worst = fmax(worst, hypot(cx, cy));
+    }
+    u0 = uv[3];
+  }
+  return worst;
+}
+
+/* The frame's pieces merged into runs, each one cubic with its own end
+ * speeds (run_speeds): run[j] the first piece of run j (run[nr] = np).
+ * Runs grow greedily while merge_distance stays within budget, never
+ * across a corner. Returns nr. */
+static size_t merge_runs(const km__frame_plan *p, const double *bz,
+                         const double *X, double budget, size_t *run) {
+  size_t np = p->np, nr = 0, a = 0;
+  /* the bound is computed in the frame's coordinates (within its length
+   * of the origin): rounding there is some units of the last place of
+   * the length, times the 1368 of BERN9_FROM_VALUES */
+  double slack = 1e-11 * X[np];
+  while (a < np) {
+    size_t b = a + 1;
+    while (b < np && !p->corner[b]) {
+      double M[8], v[2];
+      if (!run_speeds(bz, X, a, b + 1, v)) break;
+      merged_cubic(bz, X, a, b + 1, v, M);
+      if (merge_distance(bz, X, a, b + 1, M, budget) + slack > budget) break;
+      b++;
+    }
+    run[nr++] = a;
+    a = b;
+  }
+  run[nr] = np;
+  return nr;
+}
+
+/* The frame's control points into *f (initialised, empty) from its
+ * pieces bz at knots X merged by runs run[0 .. nr]: P0, then Q1 Q2 of
+ * every run, with the junction point itself at corners (triple knots;
+ * double elsewhere). A run's own end speeds differ from its neighbours',
+ * and the B-spline is C1 at a double knot: its legs either side are in
+ * the ratio of the knot spans. So the spans follow the legs (a run's span
+ * is 3 l0 / w for its first leg l0 and the speed w the join before it
+ * takes, the next join's speed w l1 / l0), from speed 1 at the start and
+ * after every corner, and all are then scaled to the frame's length: a
+ * circle's knots stay at arc length, others within the ratios of their
+ * runs' end speeds (a few percent at most). KM_EINVAL (*msg) if the
+ * counts disagree. */
+static km_status frame_points_of_runs(const km__frame_plan *p, const double *bz,
+                                      const double *X, const size_t *run,
+                                      size_t nr, km_curve *f,
+                                      const char **msg) {
+  size_t ncorner = 0;
+  for (size_t j = 1; j < nr; j++) ncorner += p->corner[run[j]];
+  size_t ncp = 2 * nr + 2 + ncorner, nknots = ncp + 4;
+  km_status st = km__curve_alloc(f, 3, ncp, false);
+  if (st) return st;
+  size_t cc = 0, kk = 0;
+  double w = 1.0, total = 0.0;
+  for (int r = 0; r < 4; r++) f->knots[kk++] = 0.0;
+  f->cp[cc++] = bz[0];
+  f->cp[cc++] = bz[1];
+  for (size_t j = 0; j < nr; j++) {
+    double M[8], v[2];
+    run_speeds(bz, X, run[j], run[j + 1], v);
+    merged_cubic(bz, X, run[j], run[j + 1], v, M);
+    if (j > 0 && p->corner[run[j]]) {
+      f->cp[cc++] = M[0];
+      f->cp[cc++] = M[1];
+      w = 1.0;
+    }
+    for (int q = 2; q < 6; q++) f->cp[cc++] = M[q];
+    double l0 = hypot(M[2] - M[0], M[3] - M[1]),
+           l1 = hypot(M[6] - M[4], M[7] - M[5]);
+    total += 3 * l0 / w;
+    w *= l1 / l0;
+    if (j + 1 < nr) {
+      int mult = p->corner[run[j + 1]] ? 3 : 2;
+      for (int r = 0; r < mult; r++) f->knots[kk++] = total;
+    }
+  }
+  f->cp[cc++] = bz[8 * p->np - 2];
+  f->cp[cc++] = bz[8 * p->np - 1];
+  for (int r = 0; r < 4; r++) f->knots[kk++] = X[p->np];
+  if (cc != 2 * ncp || kk != nknots || !(total > 0)) {
     *msg = "internal inconsistency building a frame";
     return KM_EINVAL;
   }
+  double scale = X[p->np] / total;
+  for (size_t i = 4; i + 4 < nknots; i++) f->knots[i] *= scale;
   return KM_OK;
 }
 
 km_status km__frame_plan_curve(const km__frame_plan *p, double t, double theta0,
                                bool close_lsq, km_curve *out, double *ends,
                                km__poll *poll, km_error *err) {
-  double c[NF] = {0}, P[2];
+  double c[NF] = {0};
   /* sums of the pieces, scratch of the nodes, and per corner its turn,
-   * its change and the stretch sums; per piece the turn added before it */
-  size_t nc = p->ncorners, scratch = km__plan_frame_scratch(p) + 4 * nc + 2;
-  double *sum = km__malloc((scratch + p->np) * sizeof(double));
+   * its change and the stretch sums; per piece the turn added before it,
+   * its Bezier points and knot, and the runs merged */
+  size_t np = p->np, nc = p->ncorners,
+         scratch = km__plan_frame_scratch(p) + 4 * nc + 2;
+  size_t ndouble = scratch + np + 8 * np + np + 1;
+  double *sum =
+      km__malloc(ndouble * sizeof(double) + (np + 1) * sizeof(size_t));
   if (!sum) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  double *dp = sum + scratch, *bz = dp + np, *X = bz + 8 * np;
+  size_t *run = (size_t *)(sum + ndouble);
   const char *msg = "closing the frame did not converge";
   km_curve f;
   km_curve_init(&f);
-  km_status st =
-      frame_closure(p, t, theta0, close_lsq, c, sum, sum + scratch, poll);
+  km_status st = frame_closure(p, t, theta0, close_lsq, c, sum, dp, poll);
   if (st == KM_ECANCELLED || (poll && poll->stopped)) {
     st = KM_ECANCELLED;
     goto done;
   }
   if (st) goto done;
   msg = NULL;
-  st = hermite_points(p, t, theta0, c, sum, sum + scratch, &f, ends, P, &msg);
+  hermite_pieces(p, t, theta0, c, sum, dp, bz, X, ends);
+  size_t nr = merge_runs(p, bz, X, KM__PLAN_MERGE_SHARE * p->tol, run);
+  st = frame_points_of_runs(p, bz, X, run, nr, &f, &msg);
   if (st) goto done;
   f.closed = false;
+  const double *P = bz + 8 * np - 2;
   if (p->closed && hypot(P[0], P[1]) <= p->tol) {
     size_t ncp = f.n;
     f.cp[2 * (ncp - 1)] = f.cp[0];
