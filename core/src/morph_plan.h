@@ -44,12 +44,13 @@ bool km__frame_plan_by_corners(const km__frame_plan *p);
  * length; the parameter leaves it between them: runs of the plan's pieces
  * merged into single cubics), starting at the origin with tangent angle
  * theta0. close_lsq: closes a closed pair by the
- * lsq correction of theta. The result is marked closed (end snapped to start) when
+ * lsq correction of theta; merge: merges runs of the pieces (else each
+ * piece is Hermite in arc length). The result is marked closed (end snapped to start) when
  * its gap is within the tolerance. ends (optional, 2 (pieces + 1) values)
  * receives the pieces' end points. Stops (KM_ECANCELLED) when poll says so
  * (NULL: never). */
 km_status km__frame_plan_curve(const km__frame_plan *p, double t, double theta0,
-                               bool close_lsq, km_curve *out, double *ends,
-                               km__poll *poll, km_error *err);
+                               bool close_lsq, bool merge, km_curve *out,
+                               double *ends, km__poll *poll, km_error *err);
 
 #endif

@@ -410,16 +410,10 @@ static void hermite_pieces(const km__frame_plan *p, double t, double theta0,
   X[p->np] = Lt;
 }
 
-/* Bernstein coefficients of a polynomial of degree 3 and of degree 9 on
- * [0, 1] from its values at i / 3, i / 9: inverses of the Bernstein
- * collocation matrices (the rows of the second sum to at most 1368 in
- * absolute value, which multiplies the rounding of the values). */
-static const double BERN3_FROM_VALUES[4][4] = {
-    {1, 0, 0, 0},
-    {-5.0 / 6, 3, -1.5, 1.0 / 3},
-    {1.0 / 3, -1.5, 3, -5.0 / 6},
-    {0, 0, 0, 1},
-};
+/* Bernstein coefficients of a polynomial of degree 9 on [0, 1] from its
+ * values at i / 9, i = 0..9: the inverse of the Bernstein collocation
+ * matrix (its rows sum to at most 1368 in absolute value, which
+ * multiplies the rounding of the values). */
 static const double BERN9_FROM_VALUES[10][10] = {
     {1, 0, 0, 0, 0, 0, 0, 0, 0, 0},
     {-1.8289682539682539, 9, -18, 28, -31.5, 25.199999999999999, -14,
@@ -449,39 +443,56 @@ static const double BERN9_FROM_VALUES[10][10] = {
     {0, 0, 0, 0, 0, 0, 0, 0, 0, 1},
 };
 
-/* A cubic's point at u from its control points C (8 values). */
-static inline void bez_point(const double *C, double u, double out[2]) {
-  double v = 1 - u, b0 = v * v * v, b1 = 3 * u * v * v, b2 = 3 * u * u * v,
-         b3 = u * u * u;
-  out[0] = b0 * C[0] + b1 * C[2] + b2 * C[4] + b3 * C[6];
-  out[1] = b0 * C[1] + b1 * C[3] + b2 * C[5] + b3 * C[7];
-}
+/* A cubic in power form about u = 0: c[d][k] the coefficient of u^k of
+ * coordinate d. */
+typedef struct cubic {
+  double c[2][4];
+} cubic;
 
-/* The parameter of the point of cubic M nearest q, by Newton from u
- * (clamped to [0, 1]). */
-static double project(const double *M, const double q[2], double u) {
-  double a[2][4];
+static void cubic_of(const double *M, cubic *q) {
   for (int d = 0; d < 2; d++) {
     double m0 = M[d], m1 = M[2 + d], m2 = M[4 + d], m3 = M[6 + d];
-    a[d][0] = m0 - q[d];
-    a[d][1] = 3 * (m1 - m0);
-    a[d][2] = 3 * (m2 - 2 * m1 + m0);
-    a[d][3] = m3 - 3 * m2 + 3 * m1 - m0;
+    q->c[d][0] = m0;
+    q->c[d][1] = 3 * (m1 - m0);
+    q->c[d][2] = 3 * (m2 - 2 * m1 + m0);
+    q->c[d][3] = m3 - 3 * m2 + 3 * m1 - m0;
   }
-  for (int it = 0; it < 8; it++) {
+}
+
+static inline void cubic_at(const cubic *q, double u, double out[2]) {
+  for (int d = 0; d < 2; d++)
+    out[d] = q->c[d][0] + u * (q->c[d][1] + u * (q->c[d][2] + u * q->c[d][3]));
+}
+
+/* The parameter of the point of cubic q nearest point x, by Newton from u
+ * (clamped to [0, 1]); *speed2 receives |q'|^2 there, *dist2 the squared
+ * distance. */
+static double project(const cubic *q, const double x[2], double u,
+                      double *speed2, double *dist2) {
+  double p[2], p1[2];
+  /* any increasing match keeps merge_distance a bound: two steps from a
+   * guess near the point make it close enough to be tight */
+  for (int it = 0; it < 2; it++) {
     double f = 0.0, fp = 0.0;
     for (int d = 0; d < 2; d++) {
-      double p = a[d][0] + u * (a[d][1] + u * (a[d][2] + u * a[d][3]));
-      double p1 = a[d][1] + u * (2 * a[d][2] + u * 3 * a[d][3]);
-      double p2 = 2 * a[d][2] + 6 * u * a[d][3];
-      f += p * p1;
-      fp += p1 * p1 + p * p2;
+      const double *c = q->c[d];
+      p[d] = c[0] - x[d] + u * (c[1] + u * (c[2] + u * c[3]));
+      p1[d] = c[1] + u * (2 * c[2] + u * 3 * c[3]);
+      double p2 = 2 * c[2] + 6 * u * c[3];
+      f += p[d] * p1[d];
+      fp += p1[d] * p1[d] + p[d] * p2;
     }
     if (!(fp > 0)) break;
     double du = f / fp;
     u = fmin(fmax(u - du, 0.0), 1.0);
-    if (fabs(du) < 1e-13) break;
   }
+  for (int d = 0; d < 2; d++) {
+    const double *c = q->c[d];
+    p[d] = c[0] - x[d] + u * (c[1] + u * (c[2] + u * c[3]));
+    p1[d] = c[1] + u * (2 * c[2] + u * 3 * c[3]);
+  }
+  *speed2 = p1[0] * p1[0] + p1[1] * p1[1];
+  *dist2 = p[0] * p[0] + p[1] * p[1];
   return u;
 }
 
@@ -495,9 +506,10 @@ static bool run_speeds(const double *bz, const double *X, size_t a, size_t b,
   v[0] = v[1] = 1.0;
   if (b == a + 1) return true;
   const double *A = bz + 8 * a, *B = bz + 8 * (b - 1);
-  double d[2] = {B[6] - A[0], B[7] - A[1]}, c = hypot(d[0], d[1]);
+  double d[2] = {B[6] - A[0], B[7] - A[1]}, c = sqrt(d[0] * d[0] + d[1] * d[1]);
   double t0[2] = {A[2] - A[0], A[3] - A[1]}, t1[2] = {B[6] - B[4], B[7] - B[5]};
-  double n0 = hypot(t0[0], t0[1]), n1 = hypot(t1[0], t1[1]);
+  double n0 = sqrt(t0[0] * t0[0] + t0[1] * t0[1]),
+         n1 = sqrt(t1[0] * t1[0] + t1[1] * t1[1]);
   if (!(c > 0 && n0 > 0 && n1 > 0)) return false;
   double k0 = c + (t0[0] * d[0] + t0[1] * d[1]) / n0,
          k1 = c + (t1[0] * d[0] + t1[1] * d[1]) / n1;
@@ -527,40 +539,80 @@ static void merged_cubic(const double *bz, const double *X, size_t a, size_t b,
   M[7] = B[7];
 }
 
-/* A bound on the distance between cubic M and pieces a .. b - 1 (Frechet,
- * so both ways): piece k is matched with M over [u_k, u_k+1] by a cubic
- * reparametrisation g through the parameters of M's points nearest the
- * piece's points at 0, 1/3, 2/3 and 1 (increasing: its Bernstein
- * coefficients are), the difference P_k(s) - M(g(s)) is a polynomial of
- * degree 9, and its largest Bernstein coefficient bounds it (a quadratic
- * g leaves a tangential mismatch of some 3x the normal distance). Stops
- * (returning more) once past budget. */
+/* The Bernstein weights of a cubic at i / 9, i = 0..9 */
+static const double BERN3_AT_NINTHS[10][4] = {
+    {1, 0, 0, 0},
+    {512.0 / 729, 192.0 / 729, 24.0 / 729, 1.0 / 729},
+    {343.0 / 729, 294.0 / 729, 84.0 / 729, 8.0 / 729},
+    {216.0 / 729, 324.0 / 729, 162.0 / 729, 27.0 / 729},
+    {125.0 / 729, 300.0 / 729, 240.0 / 729, 64.0 / 729},
+    {64.0 / 729, 240.0 / 729, 300.0 / 729, 125.0 / 729},
+    {27.0 / 729, 162.0 / 729, 324.0 / 729, 216.0 / 729},
+    {8.0 / 729, 84.0 / 729, 294.0 / 729, 343.0 / 729},
+    {1.0 / 729, 24.0 / 729, 192.0 / 729, 512.0 / 729},
+    {0, 0, 0, 1}};
+
+/* The parameters u[k - a] of M's points nearest the junctions of pieces
+ * a .. b - 1 (u[0] = 0, u[b - a] = 1) and M's speed there over the
+ * pieces' (slope[k - a], du / ds in the knot parameter s), from a first
+ * guess in proportion to arc length; false if they do not increase.
+ * *est receives the largest distance from a junction to M. */
+static bool match_junctions(const double *bz, const double *X, size_t a,
+                            size_t b, const cubic *q, double *u, double *slope,
+                            double *est) {
+  double H = X[b] - X[a], sp2, d2, worst = 0.0;
+  u[0] = 0.0;
+  u[b - a] = 1.0;
+  for (size_t k = a + 1; k < b; k++) {
+    u[k - a] = project(q, bz + 8 * k, (X[k] - X[a]) / H, &sp2, &d2);
+    if (!(u[k - a] > u[k - a - 1] && sp2 > 0)) return false;
+    /* the pieces' speed at a junction is 1 in s (legs a third of the
+     * span): du / ds = 1 / |M'(u)| */
+    slope[k - a] = 1.0 / sqrt(sp2);
+    worst = fmax(worst, d2);
+  }
+  if (!(u[b - a] > u[b - a - 1])) return false;
+  for (size_t e = 0; e < 2; e++) {
+    size_t i = e ? b - a : 0;
+    double uu = u[i],
+           p1x = q->c[0][1] + uu * (2 * q->c[0][2] + uu * 3 * q->c[0][3]),
+           p1y = q->c[1][1] + uu * (2 * q->c[1][2] + uu * 3 * q->c[1][3]);
+    double sp = sqrt(p1x * p1x + p1y * p1y);
+    if (!(sp > 0)) return false;
+    slope[i] = 1.0 / sp;
+  }
+  *est = sqrt(worst);
+  return true;
+}
+
+/* A bound on the distance between cubic M (power form q) and pieces a ..
+ * b - 1 (Frechet, so both ways), junctions matched by match_junctions:
+ * piece k is matched with M over [u_k, u_k+1] by the cubic Hermite
+ * reparametrisation g with those ends and slopes (increasing: its
+ * Bernstein coefficients are), the difference P_k(s) - M(g(s)) is a
+ * polynomial of degree 9, and its largest Bernstein coefficient bounds it
+ * (a quadratic g left a tangential mismatch of some 3x the normal
+ * distance). Stops (returning more) once past budget. */
 static double merge_distance(const double *bz, const double *X, size_t a,
-                             size_t b, const double M[8], double budget) {
-  double H = X[b] - X[a], worst = 0.0, u0 = 0.0;
-  for (size_t k = a; k < b && worst <= budget; k++) {
+                             size_t b, const cubic *q, const double *u,
+                             const double *slope, double budget) {
+  double worst = 0.0, b2 = budget * budget;
+  for (size_t k = a; k < b && worst <= b2; k++) {
     const double *Pk = bz + 8 * k;
-    double uv[4], gb[4], q[2];
-    uv[0] = u0;
-    uv[3] = k + 1 < b ? project(M, Pk + 6, (X[k + 1] - X[a]) / H) : 1.0;
-    for (int i = 1; i < 3; i++) {
-      bez_point(Pk, i / 3.0, q);
-      uv[i] = project(M, q, u0 + (uv[3] - u0) * i / 3.0);
-    }
-    for (int j = 0; j < 4; j++) {
-      gb[j] = 0.0;
-      for (int i = 0; i < 4; i++) gb[j] += BERN3_FROM_VALUES[j][i] * uv[i];
-    }
-    if (!(gb[0] < gb[1] && gb[1] < gb[2] && gb[2] < gb[3])) return INFINITY;
+    double h = X[k + 1] - X[k], u0 = u[k - a], u1 = u[k - a + 1];
+    double gb[4] = {u0, u0 + slope[k - a] * h / 3,
+                    u1 - slope[k - a + 1] * h / 3, u1};
+    if (!(gb[0] <= gb[1] && gb[1] <= gb[2] && gb[2] <= gb[3])) return INFINITY;
     double D[10][2];
     for (int i = 0; i <= 9; i++) {
-      double sg = i / 9.0, v = 1 - sg, pp[2], mp[2];
-      double g = v * v * v * gb[0] + 3 * sg * v * v * gb[1] +
-                 3 * sg * sg * v * gb[2] + sg * sg * sg * gb[3];
-      bez_point(Pk, sg, pp);
-      bez_point(M, g, mp);
-      D[i][0] = pp[0] - mp[0];
-      D[i][1] = pp[1] - mp[1];
+      const double *w = BERN3_AT_NINTHS[i];
+      double g = w[0] * gb[0] + w[1] * gb[1] + w[2] * gb[2] + w[3] * gb[3],
+             m[2];
+      cubic_at(q, g, m);
+      D[i][0] =
+          w[0] * Pk[0] + w[1] * Pk[2] + w[2] * Pk[4] + w[3] * Pk[6] - m[0];
+      D[i][1] =
+          w[0] * Pk[1] + w[1] * Pk[3] + w[2] * Pk[5] + w[3] * Pk[7] - m[1];
     }
     for (int j = 0; j <= 9; j++) {
       double cx = 0.0, cy = 0.0;
@@ -568,34 +620,51 @@ static double merge_distance(const double *bz, const double *X, size_t a,
         cx += BERN9_FROM_VALUES[j][i] * D[i][0];
         cy += BERN9_FROM_VALUES[j][i] * D[i][1];
       }
-      worst = fmax(worst, hypot(cx, cy));
+      worst = fmax(worst, cx * cx + cy * cy);
     }
-    u0 = uv[3];
   }
-  return worst;
+  return sqrt(worst);
+}
+
+/* Whether pieces a .. b - 1 merge into one cubic within budget
+ * (merge_distance). u and slope are scratch (b - a + 1 each). */
+static bool merges(const double *bz, const double *X, size_t a, size_t b,
+                   double budget, double slack, double *u, double *slope) {
+  double M[8], v[2], est;
+  cubic q;
+  if (!run_speeds(bz, X, a, b, v)) return false;
+  merged_cubic(bz, X, a, b, v, M);
+  cubic_of(M, &q);
+  if (!match_junctions(bz, X, a, b, &q, u, slope, &est) || est + slack > budget)
+    return false;
+  return merge_distance(bz, X, a, b, &q, u, slope, budget) + slack <= budget;
 }
 
 /* The frame's pieces merged into runs, each one cubic with its own end
  * speeds (run_speeds): run[j] the first piece of run j (run[nr] = np).
- * Runs grow greedily while merge_distance stays within budget, never
- * across a corner. Returns nr. */
+ * Runs grow greedily while the bound allows (merges), never across a
+ * corner. Returns nr. u, slope:
+ * scratch, np + 1 each. */
 static size_t merge_runs(const km__frame_plan *p, const double *bz,
-                         const double *X, double budget, size_t *run) {
+                         const double *X, double budget, size_t *run, double *u,
+                         double *slope) {
   size_t np = p->np, nr = 0, a = 0;
   /* the bound is computed in the frame's coordinates (within its length
    * of the origin): rounding there is some units of the last place of
    * the length, times the 1368 of BERN9_FROM_VALUES */
   double slack = 1e-11 * X[np];
+  /* runs of a frame are of similar lengths: each starts from the last
+   * one's and grows or shrinks by the bound */
+  size_t guess = 2;
   while (a < np) {
-    size_t b = a + 1;
-    while (b < np && !p->corner[b]) {
-      double M[8], v[2];
-      if (!run_speeds(bz, X, a, b + 1, v)) break;
-      merged_cubic(bz, X, a, b + 1, v, M);
-      if (merge_distance(bz, X, a, b + 1, M, budget) + slack > budget) break;
-      b++;
-    }
+    size_t stop = a + 1;
+    while (stop < np && !p->corner[stop]) stop++;
+    size_t b = a + guess < stop ? a + guess : stop;
+    while (b > a + 1 && !merges(bz, X, a, b, budget, slack, u, slope)) b--;
+    if (b == a + guess)
+      while (b < stop && merges(bz, X, a, b + 1, budget, slack, u, slope)) b++;
     run[nr++] = a;
+    guess = b - a + 1;
     a = b;
   }
   run[nr] = np;
@@ -660,19 +729,20 @@ static km_status frame_points_of_runs(const km__frame_plan *p, const double *bz,
 }
 
 km_status km__frame_plan_curve(const km__frame_plan *p, double t, double theta0,
-                               bool close_lsq, km_curve *out, double *ends,
-                               km__poll *poll, km_error *err) {
+                               bool close_lsq, bool merge, km_curve *out,
+                               double *ends, km__poll *poll, km_error *err) {
   double c[NF] = {0};
   /* sums of the pieces, scratch of the nodes, and per corner its turn,
    * its change and the stretch sums; per piece the turn added before it,
    * its Bezier points and knot, and the runs merged */
   size_t np = p->np, nc = p->ncorners,
          scratch = km__plan_frame_scratch(p) + 4 * nc + 2;
-  size_t ndouble = scratch + np + 8 * np + np + 1;
+  size_t ndouble = scratch + np + 8 * np + 3 * (np + 1);
   double *sum =
       km__malloc(ndouble * sizeof(double) + (np + 1) * sizeof(size_t));
   if (!sum) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
-  double *dp = sum + scratch, *bz = dp + np, *X = bz + 8 * np;
+  double *dp = sum + scratch, *bz = dp + np, *X = bz + 8 * np, *u = X + np + 1,
+         *slope = u + np + 1;
   size_t *run = (size_t *)(sum + ndouble);
   const char *msg = "closing the frame did not converge";
   km_curve f;
@@ -685,7 +755,11 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t, double theta0,
   if (st) goto done;
   msg = NULL;
   hermite_pieces(p, t, theta0, c, sum, dp, bz, X, ends);
-  size_t nr = merge_runs(p, bz, X, KM__PLAN_MERGE_SHARE * p->tol, run);
+  size_t nr = np;
+  if (merge)
+    nr = merge_runs(p, bz, X, KM__PLAN_MERGE_SHARE * p->tol, run, u, slope);
+  else
+    for (size_t k = 0; k <= np; k++) run[k] = k;
   st = frame_points_of_runs(p, bz, X, run, nr, &f, &msg);
   if (st) goto done;
   f.closed = false;
