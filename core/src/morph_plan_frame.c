@@ -411,36 +411,31 @@ static void hermite_pieces(const km__frame_plan *p, double t, double theta0,
 }
 
 /* Bernstein coefficients of a polynomial of degree 9 on [0, 1] from its
- * values at i / 9, i = 0..9: the inverse of the Bernstein collocation
+ * values at i / 9, i = 0..9, by the inverse of the Bernstein collocation
  * matrix (its rows sum to at most 1368 in absolute value, which
- * multiplies the rounding of the values). */
-static const double BERN9_FROM_VALUES[10][10] = {
-    {1, 0, 0, 0, 0, 0, 0, 0, 0, 0},
-    {-1.8289682539682539, 9, -18, 28, -31.5, 25.199999999999999, -14,
-     5.1428571428571432, -1.125, 0.1111111111111111},
-    {2.6132688492063494, -19.036607142857143, 58.323214285714286,
-     -101.22499999999999, 119.784375, -98.662499999999994, 55.862499999999997,
-     -20.796428571428571, 4.5944196428571429, -0.45724206349206348},
-    {-2.9806866496598641, 25.449394132653062, -93.95070153061225, 195.46875,
-     -253.34196428571428, 220.18258928571427, -129.14598214285715,
-     49.292219387755104, -11.09359056122449, 1.1199723639455783},
-    {2.7285306831065759, -25.226977040816326, 102.69585459183673,
-     -240.13035714285715, 352.2314732142857, -333.24910714285716,
-     207.32901785714284, -82.586479591836735, 19.195169005102041,
-     -1.987124433106576},
-    {-1.987124433106576, 19.195169005102041, -82.586479591836735,
-     207.32901785714284, -333.24910714285716, 352.2314732142857,
-     -240.13035714285715, 102.69585459183673, -25.226977040816326,
-     2.7285306831065759},
-    {1.1199723639455783, -11.09359056122449, 49.292219387755104,
-     -129.14598214285715, 220.18258928571427, -253.34196428571428, 195.46875,
-     -93.95070153061225, 25.449394132653062, -2.9806866496598641},
-    {-0.45724206349206348, 4.5944196428571429, -20.796428571428571,
-     55.862499999999997, -98.662499999999994, 119.784375, -101.22499999999999,
-     58.323214285714286, -19.036607142857143, 2.6132688492063494},
-    {0.1111111111111111, -1.125, 5.1428571428571432, -14, 25.199999999999999,
-     -31.5, 28, -18, 9, -1.8289682539682539},
-    {0, 0, 0, 0, 0, 0, 0, 0, 0, 1},
+ * multiplies the rounding of the values). Its first and last rows pick
+ * the end values; row 9 - j is row j reversed, so rows 1..4 are kept as
+ * their halves on the sums v_i + v_(9-i) (EVEN) and the differences v_i -
+ * v_(9-i) (ODD), i = 0..4: coefficient j is EVEN.sum + ODD.diff, 9 - j
+ * EVEN.sum - ODD.diff. */
+static const double BERN9_EVEN[4][5] = {
+    {-0.85892857142857137, 3.9375, -6.4285714285714288, 7, -3.1499999999999999},
+    {1.0780133928571429, -7.2210937499999996, 18.763392857142858,
+     -22.681249999999999, 10.5609375},
+    {-0.93035714285714288, 7.1779017857142859, -22.329241071428573,
+     33.161383928571432, -16.579687499999999},
+    {0.37070312500000002, -3.0159040178571428, 10.0546875, -16.400669642857142,
+     9.4911830357142861},
+};
+static const double BERN9_ODD[4][5] = {
+    {-0.97003968253968254, 5.0625, -11.571428571428571, 21,
+     -28.350000000000001},
+    {1.5352554563492065, -11.815513392857143, 39.559821428571432,
+     -78.543750000000003, 109.2234375},
+    {-2.0503295068027212, 18.271492346938775, -71.62146045918368,
+     162.30736607142856, -236.76227678571428},
+    {2.357827558106576, -22.211073022959184, 92.641167091836735,
+     -223.72968750000001, 342.74029017857146},
 };
 
 /* A cubic in power form about u = 0: c[d][k] the coefficient of u^k of
@@ -614,16 +609,36 @@ static double merge_distance(const double *bz, const double *X, size_t a,
       D[i][1] =
           w[0] * Pk[1] + w[1] * Pk[3] + w[2] * Pk[5] + w[3] * Pk[7] - m[1];
     }
-    for (int j = 0; j <= 9; j++) {
-      double cx = 0.0, cy = 0.0;
-      for (int i = 0; i <= 9; i++) {
-        cx += BERN9_FROM_VALUES[j][i] * D[i][0];
-        cy += BERN9_FROM_VALUES[j][i] * D[i][1];
+    double S[5][2], T[5][2];
+    for (int i = 0; i < 5; i++)
+      for (int d = 0; d < 2; d++) {
+        S[i][d] = D[i][d] + D[9 - i][d];
+        T[i][d] = D[i][d] - D[9 - i][d];
       }
-      worst = fmax(worst, cx * cx + cy * cy);
+    worst = fmax(worst, fmax(D[0][0] * D[0][0] + D[0][1] * D[0][1],
+                             D[9][0] * D[9][0] + D[9][1] * D[9][1]));
+    for (int j = 0; j < 4; j++) {
+      double e[2] = {0.0, 0.0}, o[2] = {0.0, 0.0};
+      for (int i = 0; i < 5; i++)
+        for (int d = 0; d < 2; d++) {
+          e[d] += BERN9_EVEN[j][i] * S[i][d];
+          o[d] += BERN9_ODD[j][i] * T[i][d];
+        }
+      double lx = e[0] + o[0], ly = e[1] + o[1], rx = e[0] - o[0],
+             ry = e[1] - o[1];
+      worst = fmax(worst, fmax(lx * lx + ly * ly, rx * rx + ry * ry));
     }
   }
   return sqrt(worst);
+}
+
+/* Whether the frame's tangent is continuous at a corner k of the plan
+ * (one input's, which this frame does not turn at: frames 0 and 1). */
+static bool turns_not(const double *bz, size_t k) {
+  const double *A = bz + 8 * (k - 1), *B = bz + 8 * k;
+  double ax = A[6] - A[4], ay = A[7] - A[5], bx = B[2] - B[0], by = B[3] - B[1];
+  double cross = ax * by - ay * bx, dot = ax * bx + ay * by;
+  return dot > 0 && fabs(cross) <= 1e-12 * dot;
 }
 
 /* Whether pieces a .. b - 1 merge into one cubic within budget
@@ -643,7 +658,7 @@ static bool merges(const double *bz, const double *X, size_t a, size_t b,
 /* The frame's pieces merged into runs, each one cubic with its own end
  * speeds (run_speeds): run[j] the first piece of run j (run[nr] = np).
  * Runs grow greedily while the bound allows (merges), never across a
- * corner. Returns nr. u, slope:
+ * corner the frame turns at. Returns nr. u, slope:
  * scratch, np + 1 each. */
 static size_t merge_runs(const km__frame_plan *p, const double *bz,
                          const double *X, double budget, size_t *run, double *u,
@@ -651,14 +666,15 @@ static size_t merge_runs(const km__frame_plan *p, const double *bz,
   size_t np = p->np, nr = 0, a = 0;
   /* the bound is computed in the frame's coordinates (within its length
    * of the origin): rounding there is some units of the last place of
-   * the length, times the 1368 of BERN9_FROM_VALUES */
+   * the length, times the 1368 of the collocation inverse (BERN9_EVEN,
+   * BERN9_ODD) */
   double slack = 1e-11 * X[np];
   /* runs of a frame are of similar lengths: each starts from the last
    * one's and grows or shrinks by the bound */
   size_t guess = 2;
   while (a < np) {
     size_t stop = a + 1;
-    while (stop < np && !p->corner[stop]) stop++;
+    while (stop < np && (!p->corner[stop] || turns_not(bz, stop))) stop++;
     size_t b = a + guess < stop ? a + guess : stop;
     while (b > a + 1 && !merges(bz, X, a, b, budget, slack, u, slope)) b--;
     if (b == a + guess)
