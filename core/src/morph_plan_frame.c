@@ -438,6 +438,12 @@ static const double BERN9_ODD[4][5] = {
      -223.72968750000001, 342.74029017857146},
 };
 
+/* The larger of w and e, NaN once either is: comparisons, not fmax (a
+ * call into libm here, 4% of a frame), and a NaN fails the merge. */
+static inline double max_nan(double w, double e) {
+  return (isnan(w) || e <= w) ? w : e;
+}
+
 /* A cubic in power form about u = 0: c[d][k] the coefficient of u^k of
  * coordinate d. */
 typedef struct cubic {
@@ -479,7 +485,8 @@ static double project(const cubic *q, const double x[2], double u,
     }
     if (!(fp > 0)) break;
     double du = f / fp;
-    u = fmin(fmax(u - du, 0.0), 1.0);
+    u -= du;
+    u = u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
   }
   for (int d = 0; d < 2; d++) {
     const double *c = q->c[d];
@@ -564,7 +571,7 @@ static bool match_junctions(const double *bz, const double *X, size_t a,
     /* the pieces' speed at a junction is 1 in s (legs a third of the
      * span): du / ds = 1 / |M'(u)| */
     slope[k - a] = 1.0 / sqrt(sp2);
-    worst = fmax(worst, d2);
+    worst = max_nan(worst, d2);
   }
   if (!(u[b - a] > u[b - a - 1])) return false;
   for (size_t e = 0; e < 2; e++) {
@@ -615,8 +622,8 @@ static double merge_distance(const double *bz, const double *X, size_t a,
         S[i][d] = D[i][d] + D[9 - i][d];
         T[i][d] = D[i][d] - D[9 - i][d];
       }
-    worst = fmax(worst, fmax(D[0][0] * D[0][0] + D[0][1] * D[0][1],
-                             D[9][0] * D[9][0] + D[9][1] * D[9][1]));
+    worst = max_nan(worst, D[0][0] * D[0][0] + D[0][1] * D[0][1]);
+    worst = max_nan(worst, D[9][0] * D[9][0] + D[9][1] * D[9][1]);
     for (int j = 0; j < 4; j++) {
       double e[2] = {0.0, 0.0}, o[2] = {0.0, 0.0};
       for (int i = 0; i < 5; i++)
@@ -626,7 +633,8 @@ static double merge_distance(const double *bz, const double *X, size_t a,
         }
       double lx = e[0] + o[0], ly = e[1] + o[1], rx = e[0] - o[0],
              ry = e[1] - o[1];
-      worst = fmax(worst, fmax(lx * lx + ly * ly, rx * rx + ry * ry));
+      worst = max_nan(worst, lx * lx + ly * ly);
+      worst = max_nan(worst, rx * rx + ry * ry);
     }
   }
   return sqrt(worst);
