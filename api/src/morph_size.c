@@ -49,8 +49,7 @@ static double frames_extent(const api_morph_plan *pl) {
   return m + pl->from.length + pl->to.length;
 }
 
-/* Control points of the frames at most: the frames of a planned morph
- * share one count, known exactly; others are counted at the first, middle
+/* Control points of the frames at most: the frames of a morph are counted at the first, middle
  * and last requested times (without building the curves) and given a
  * quarter more, as the count moves smoothly with t. */
 static km_status frame_points(const api_morph_plan *pl, const km_stop *stop,
@@ -69,7 +68,7 @@ static km_status frame_points(const api_morph_plan *pl, const km_stop *stop,
     if (k == 2) last = n;
     most = n > most ? n : most;
   }
-  /* equal counts at both ends and the middle: a planned (constant) count */
+  /* equal counts at both ends and the middle: a constant count */
   *points = most == first && most == last ? most : most + most / 4 + 8;
   return KM_OK;
 }

@@ -448,9 +448,13 @@ static km_status planned_frame(const km_morph *m, double t, km_closure how,
   double(*P)[2] = (double(*)[2])buf;
   km_curve f;
   km_curve_init(&f);
+  /* a frame the crossing repair moves keeps the planned pieces: the
+   * repair's displacement lives in arc length, which merged runs leave
+   * between their knots */
+  bool merge = !km__repair_active(m->repair, t);
   km_status st =
       km__frame_plan_curve(m->plan, t, (1 - t) * phia + t * phib,
-                           how == KM_CLOSURE_LSQ, &f, buf, poll, err);
+                           how == KM_CLOSURE_LSQ, merge, &f, buf, poll, err);
   if (st) goto done;
   if (m->closed && !f.closed && how != KM_CLOSURE_NONE)
     km__close_polygon(&f, how == KM_CLOSURE_LSQ ? KM_CLOSURE_C0 : how);
@@ -751,12 +755,20 @@ km_status km_morph_frame_points(const km_morph *m, double t,
   }
   bool kappa = km__repair_kappa_active(m->repair, t);
   size_t extra = km__repair_extra_points(m->repair, t);
-  if (m->plan && parts != KM_FRAME_WITH_SIGNATURE && !kappa) {
-    *points = km__frame_plan_points(m->plan) + extra;
-    return KM_OK;
-  }
   km__poll poll;
   km__poll_init(&poll, stop);
+  if (m->plan && parts != KM_FRAME_WITH_SIGNATURE && !kappa) {
+    /* the count of the frame itself: each merges runs of the plan's
+     * pieces as it can */
+    km_closure how =
+        m->opt.closure == KM_CLOSURE_AUTO ? KM_CLOSURE_LSQ : m->opt.closure;
+    km_curve f;
+    km_curve_init(&f);
+    km_status st = planned_frame(m, t, how, &poll, &f, err);
+    if (!st) *points = f.n + extra;
+    km_curve_free(&f);
+    return st;
+  }
   km_signature sig;
   km_signature_init(&sig);
   size_t n = 0;

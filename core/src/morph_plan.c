@@ -10,9 +10,12 @@
  *     stays within a tenth of the tolerance over L of them (km__pp_merge:
  *     a bound from Bernstein coefficients), so that breaks at knots where
  *     nothing happens cost no nodes.
- *   - The output pieces: cubic Hermite pieces in r. The derivatives of
- *     theta_t are convex combinations of the inputs', so the larger of the
- *     two inputs' bounds holds for every t (and L_t <= max(La, Lb)); the
+ *   - The output pieces: cubic Hermite pieces in r, within a share of the
+ *     tolerance (KM__PLAN_PIECE_SHARE), so that each frame can merge runs
+ *     of them into single cubics within the rest (morph_plan_frame.c).
+ *     The derivatives of theta_t are convex combinations of the inputs',
+ *     so the larger of the two inputs' bounds holds for every t (and L_t
+ *     <= max(La, Lb)); the
  *     pieces are sized with the remainder bound of reconstruct.c
  *     (h^4 / 384 * B_3, plus jump terms where a piece spans a breakpoint of
  *     either input's curvature), so every frame meets the tolerance.
@@ -609,8 +612,9 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2],
   b.atoms.size = sizeof(atom);
   b.nodes.size = sizeof(gnode);
   b.Lmax = fmax(length[0], length[1]);
-  /* the Hermite pieces take half the tolerance (per unit of r) */
-  double tolp = 0.5 * tol / b.Lmax;
+  /* the Hermite pieces take their share of the tolerance (per unit of
+   * r), the frames' merging of them the rest of half of it */
+  double tolp = KM__PLAN_PIECE_SHARE * tol / b.Lmax;
   size_t np = 0;
   km_status st = KM_OK;
   b.g = km__malloc(sizeof *b.g);
@@ -662,7 +666,8 @@ size_t km__frame_plan_nodes(const km__frame_plan *p) {
 size_t km__frame_plan_points(const km__frame_plan *p) {
   size_t ncorner = 0;
   for (size_t k = 1; k < p->np; k++) ncorner += p->corner[k];
-  return 2 * p->np + 2 + ncorner; /* as km__frame_plan_curve builds them */
+  /* as km__frame_plan_curve builds them before merging runs: at most */
+  return 2 * p->np + 2 + ncorner;
 }
 const double *km__frame_plan_breaks(const km__frame_plan *p) {
   return p->x;

@@ -31,7 +31,8 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2],
 void km__frame_plan_free(km__frame_plan *p);
 size_t km__frame_plan_pieces(const km__frame_plan *p);
 size_t km__frame_plan_nodes(const km__frame_plan *p);
-/* Control points of every frame km__frame_plan_curve builds. */
+/* Control points of every frame km__frame_plan_curve builds, at most (it
+ * merges runs of the pieces). */
 size_t km__frame_plan_points(const km__frame_plan *p);
 /* The pieces' ends in normalised arc length r (pieces + 1 of them). */
 const double *km__frame_plan_breaks(const km__frame_plan *p);
@@ -39,15 +40,18 @@ const double *km__frame_plan_breaks(const km__frame_plan *p);
  * (decided once per morph, see morph_plan.c). */
 bool km__frame_plan_by_corners(const km__frame_plan *p);
 
-/* The frame at t as a cubic B-spline in its arc length, starting at the
- * origin with tangent angle theta0. close_lsq: closes a closed pair by the
- * lsq correction of theta. The result is marked closed (end snapped to start) when
+/* The frame at t as a cubic B-spline over its arc length (knots near arc
+ * length; the parameter leaves it between them: runs of the plan's pieces
+ * merged into single cubics), starting at the origin with tangent angle
+ * theta0. close_lsq: closes a closed pair by the
+ * lsq correction of theta; merge: merges runs of the pieces (else each
+ * piece is Hermite in arc length). The result is marked closed (end snapped to start) when
  * its gap is within the tolerance. ends (optional, 2 (pieces + 1) values)
  * receives the pieces' end points. Stops (KM_ECANCELLED) when poll says so
  * (NULL: never). */
 km_status km__frame_plan_curve(const km__frame_plan *p, double t, double theta0,
-                               bool close_lsq, km_curve *out, double *ends,
-                               km__poll *poll, km_error *err);
+                               bool close_lsq, bool merge, km_curve *out,
+                               double *ends, km__poll *poll, km_error *err);
 
 /* The closure of the frame at t as km__frame_plan_curve makes it: the
  * coefficients c of the lsq closure's basis (KM__CLOSURE_INTERVALS - 3 of

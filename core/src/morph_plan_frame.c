@@ -9,6 +9,18 @@
  * integral psi'^2 (the Gram matrix of their derivatives is Toeplitz with
  * entries 2/3, -1/8, -1/5, -1/120), so the seam stays G2; or, where the
  * plan says so, a turn of the frame's corners.
+ *   The plan's pieces are sized for the worst t, within their share of the
+ * tolerance; each frame then merges runs of them greedily into single
+ * cubics (end points and tangents kept, legs by the circular-arc formula)
+ * while a rigorous bound of the distance between the cubic and the pieces
+ * it replaces (merge_distance: Bernstein coefficients of their difference
+ * under a cubic reparametrisation) fits in the merge's share, never across
+ * a corner the frame turns at. So a frame is within the pieces' share
+ * plus the merge's of its exact curve, as point sets, and carries 1.0-2.6x
+ * fewer control points than its pieces (the circle's arcs four to a
+ * cubic). The bound costs some 1,800 instructions an evaluation, two
+ * evaluations a run: more than printing the points it saves through the
+ * CLI (bench/RESULTS.md).
  */
 #include <math.h>
 #include <string.h>
@@ -358,39 +370,23 @@ static km_status frame_closure(const km__frame_plan *p, double t, double theta0,
   return st;
 }
 
-/* The frame's cubic Hermite control points into *f (initialised, empty):
- * P0, then Q1 Q2 of every piece, with the junction point itself at
- * corners (triple knots; double elsewhere); ends as km__frame_plan_curve.
- * *P the end point. KM_EINVAL (*msg) if the counts disagree. */
-static km_status hermite_points(const km__frame_plan *p, double t,
-                                double theta0, const double *c,
-                                const double *sum, const double *dp,
-                                km_curve *f, double *ends, double P[2],
-                                const char **msg) {
+/* The frame's cubic Hermite pieces: bz receives 8 values a piece (P0 Q1
+ * Q2 P3), X its np + 1 knots (arc length), ends (if not NULL) the pieces'
+ * end points from (0, 0) on, 2 (np + 1) values. */
+static void hermite_pieces(const km__frame_plan *p, double t, double theta0,
+                           const double *c, const double *sum, const double *dp,
+                           double *bz, double *X, double *ends) {
   double Lt = (1 - t) * p->La + t * p->Lb, al = 1 - t, be = t;
-  size_t np = p->np, ncorner = 0;
-  for (size_t k = 1; k < np; k++) ncorner += p->corner[k];
-  size_t ncp = 2 * np + 2 + ncorner, nknots = ncp + 4;
-  km_status st = km__curve_alloc(f, 3, ncp, false);
-  if (st) return st;
-  size_t cc = 0, kk = 0;
-  P[0] = P[1] = 0.0;
-  for (int r = 0; r < 4; r++) f->knots[kk++] = 0.0;
-  f->cp[cc++] = 0.0;
-  f->cp[cc++] = 0.0;
+  double P[2] = {0.0, 0.0};
   if (ends) ends[0] = ends[1] = 0.0;
   /* the tangent a piece ends with is the next one's start but at corners
    * (theta is continuous there to 1e-12, and so is the turn dp) */
   double c1 = 0.0, s1 = 0.0;
-  for (size_t k = 0; k < np; k++) {
-    double h = Lt * (p->x[k + 1] - p->x[k]);
+  for (size_t k = 0; k < p->np; k++) {
+    double h = Lt * (p->x[k + 1] - p->x[k]), *B = bz + 8 * k;
     double th1 = theta0 + al * p->ta_l[k + 1] + be * p->tb_l[k + 1] +
                  psi_at_break(p, c, k + 1) + dp[k];
     double Pn[2] = {P[0] + Lt * sum[2 * k], P[1] + Lt * sum[2 * k + 1]};
-    if (k > 0 && p->corner[k]) {
-      f->cp[cc++] = P[0];
-      f->cp[cc++] = P[1];
-    }
     double c0 = c1, s0 = s1;
     if (k == 0 || p->corner[k]) {
       double th0 = theta0 + al * p->ta_r[k] + be * p->tb_r[k] +
@@ -398,14 +394,15 @@ static km_status hermite_points(const km__frame_plan *p, double t,
       km__sincos(th0, &s0, &c0);
     }
     km__sincos(th1, &s1, &c1);
-    f->cp[cc++] = P[0] + h / 3.0 * c0;
-    f->cp[cc++] = P[1] + h / 3.0 * s0;
-    f->cp[cc++] = Pn[0] - h / 3.0 * c1;
-    f->cp[cc++] = Pn[1] - h / 3.0 * s1;
-    if (k + 1 < np) {
-      int mult = p->corner[k + 1] ? 3 : 2;
-      for (int r = 0; r < mult; r++) f->knots[kk++] = Lt * p->x[k + 1];
-    }
+    X[k] = Lt * p->x[k];
+    B[0] = P[0];
+    B[1] = P[1];
+    B[2] = P[0] + h / 3.0 * c0;
+    B[3] = P[1] + h / 3.0 * s0;
+    B[4] = Pn[0] - h / 3.0 * c1;
+    B[5] = Pn[1] - h / 3.0 * s1;
+    B[6] = Pn[0];
+    B[7] = Pn[1];
     P[0] = Pn[0];
     P[1] = Pn[1];
     if (ends) {
@@ -413,39 +410,387 @@ static km_status hermite_points(const km__frame_plan *p, double t,
       ends[2 * k + 3] = P[1];
     }
   }
-  f->cp[cc++] = P[0];
-  f->cp[cc++] = P[1];
-  for (int r = 0; r < 4; r++) f->knots[kk++] = Lt;
-  if (cc != 2 * ncp || kk != nknots) {
+  X[p->np] = Lt;
+}
+
+/* Bernstein coefficients of a polynomial of degree 9 on [0, 1] from its
+ * values at i / 9, i = 0..9, by the inverse of the Bernstein collocation
+ * matrix (its rows sum to at most 1368 in absolute value, which
+ * multiplies the rounding of the values). Its first and last rows pick
+ * the end values; row 9 - j is row j reversed, so rows 1..4 are kept as
+ * their halves on the sums v_i + v_(9-i) (EVEN) and the differences v_i -
+ * v_(9-i) (ODD), i = 0..4: coefficient j is EVEN.sum + ODD.diff, 9 - j
+ * EVEN.sum - ODD.diff. */
+static const double BERN9_EVEN[4][5] = {
+    {-0.85892857142857137, 3.9375, -6.4285714285714288, 7, -3.1499999999999999},
+    {1.0780133928571429, -7.2210937499999996, 18.763392857142858,
+     -22.681249999999999, 10.5609375},
+    {-0.93035714285714288, 7.1779017857142859, -22.329241071428573,
+     33.161383928571432, -16.579687499999999},
+    {0.37070312500000002, -3.0159040178571428, 10.0546875, -16.400669642857142,
+     9.4911830357142861},
+};
+static const double BERN9_ODD[4][5] = {
+    {-0.97003968253968254, 5.0625, -11.571428571428571, 21,
+     -28.350000000000001},
+    {1.5352554563492065, -11.815513392857143, 39.559821428571432,
+     -78.543750000000003, 109.2234375},
+    {-2.0503295068027212, 18.271492346938775, -71.62146045918368,
+     162.30736607142856, -236.76227678571428},
+    {2.357827558106576, -22.211073022959184, 92.641167091836735,
+     -223.72968750000001, 342.74029017857146},
+};
+
+/* The larger of w and e, NaN once either is: comparisons, not fmax (a
+ * call into libm here, 4% of a frame), and a NaN fails the merge. */
+static inline double max_nan(double w, double e) {
+  return (isnan(w) || e <= w) ? w : e;
+}
+
+/* A cubic in power form about u = 0: c[d][k] the coefficient of u^k of
+ * coordinate d. */
+typedef struct cubic {
+  double c[2][4];
+} cubic;
+
+static void cubic_of(const double *M, cubic *q) {
+  for (int d = 0; d < 2; d++) {
+    double m0 = M[d], m1 = M[2 + d], m2 = M[4 + d], m3 = M[6 + d];
+    q->c[d][0] = m0;
+    q->c[d][1] = 3 * (m1 - m0);
+    q->c[d][2] = 3 * (m2 - 2 * m1 + m0);
+    q->c[d][3] = m3 - 3 * m2 + 3 * m1 - m0;
+  }
+}
+
+static inline void cubic_at(const cubic *q, double u, double out[2]) {
+  for (int d = 0; d < 2; d++)
+    out[d] = q->c[d][0] + u * (q->c[d][1] + u * (q->c[d][2] + u * q->c[d][3]));
+}
+
+/* The parameter of the point of cubic q nearest point x, by Newton from u
+ * (clamped to [0, 1]); *speed2 receives |q'|^2 there, *dist2 the squared
+ * distance. */
+static double project(const cubic *q, const double x[2], double u,
+                      double *speed2, double *dist2) {
+  double p[2], p1[2];
+  /* any increasing match keeps merge_distance a bound: two steps from a
+   * guess near the point make it close enough to be tight */
+  for (int it = 0; it < 2; it++) {
+    double f = 0.0, fp = 0.0;
+    for (int d = 0; d < 2; d++) {
+      const double *c = q->c[d];
+      p[d] = c[0] - x[d] + u * (c[1] + u * (c[2] + u * c[3]));
+      p1[d] = c[1] + u * (2 * c[2] + u * 3 * c[3]);
+      double p2 = 2 * c[2] + 6 * u * c[3];
+      f += p[d] * p1[d];
+      fp += p1[d] * p1[d] + p[d] * p2;
+    }
+    if (!(fp > 0)) break;
+    double du = f / fp;
+    u -= du;
+    u = u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
+  }
+  for (int d = 0; d < 2; d++) {
+    const double *c = q->c[d];
+    p[d] = c[0] - x[d] + u * (c[1] + u * (c[2] + u * c[3]));
+    p1[d] = c[1] + u * (2 * c[2] + u * 3 * c[3]);
+  }
+  *speed2 = p1[0] * p1[0] + p1[1] * p1[1];
+  *dist2 = p[0] * p[0] + p[1] * p[1];
+  return u;
+}
+
+/* The end speeds (legs over a third of the knot span H) of the cubic in
+ * place of pieces a .. b - 1 by the arc formula: legs 2 c^2 / (3 (c +
+ * T.d)) for chord d, |d| = c, end tangent T (a circular arc's best); 1
+ * (the pieces' own, Hermite in arc length) for a single piece. False
+ * where an end turns too far from the chord. */
+static bool run_speeds(const double *bz, const double *X, size_t a, size_t b,
+                       double v[2]) {
+  v[0] = v[1] = 1.0;
+  if (b == a + 1) return true;
+  const double *A = bz + 8 * a, *B = bz + 8 * (b - 1);
+  double d[2] = {B[6] - A[0], B[7] - A[1]}, c = sqrt(d[0] * d[0] + d[1] * d[1]);
+  double t0[2] = {A[2] - A[0], A[3] - A[1]}, t1[2] = {B[6] - B[4], B[7] - B[5]};
+  double n0 = sqrt(t0[0] * t0[0] + t0[1] * t0[1]),
+         n1 = sqrt(t1[0] * t1[0] + t1[1] * t1[1]);
+  if (!(c > 0 && n0 > 0 && n1 > 0)) return false;
+  double k0 = c + (t0[0] * d[0] + t0[1] * d[1]) / n0,
+         k1 = c + (t1[0] * d[0] + t1[1] * d[1]) / n1;
+  /* an end more than some 140 degrees off the chord */
+  if (k0 < 0.25 * c || k1 < 0.25 * c) return false;
+  double H = X[b] - X[a];
+  v[0] = 2 * c * c / (k0 * H);
+  v[1] = 2 * c * c / (k1 * H);
+  return true;
+}
+
+/* The cubic M (8 values, as bz) in place of pieces a .. b - 1: their end
+ * points and end tangents, legs v[0] H / 3 and v[1] H / 3 over its knot
+ * span H (speeds v in the arc-length knots). */
+static void merged_cubic(const double *bz, const double *X, size_t a, size_t b,
+                         const double v[2], double M[8]) {
+  const double *A = bz + 8 * a, *B = bz + 8 * (b - 1);
+  double H = X[b] - X[a], fa = v[0] * H / (X[a + 1] - X[a]),
+         fb = v[1] * H / (X[b] - X[b - 1]);
+  M[0] = A[0];
+  M[1] = A[1];
+  M[2] = A[0] + fa * (A[2] - A[0]);
+  M[3] = A[1] + fa * (A[3] - A[1]);
+  M[4] = B[6] + fb * (B[4] - B[6]);
+  M[5] = B[7] + fb * (B[5] - B[7]);
+  M[6] = B[6];
+  M[7] = B[7];
+}
+
+/* The Bernstein weights of a cubic at i / 9, i = 0..9 */
+static const double BERN3_AT_NINTHS[10][4] = {
+    {1, 0, 0, 0},
+    {512.0 / 729, 192.0 / 729, 24.0 / 729, 1.0 / 729},
+    {343.0 / 729, 294.0 / 729, 84.0 / 729, 8.0 / 729},
+    {216.0 / 729, 324.0 / 729, 162.0 / 729, 27.0 / 729},
+    {125.0 / 729, 300.0 / 729, 240.0 / 729, 64.0 / 729},
+    {64.0 / 729, 240.0 / 729, 300.0 / 729, 125.0 / 729},
+    {27.0 / 729, 162.0 / 729, 324.0 / 729, 216.0 / 729},
+    {8.0 / 729, 84.0 / 729, 294.0 / 729, 343.0 / 729},
+    {1.0 / 729, 24.0 / 729, 192.0 / 729, 512.0 / 729},
+    {0, 0, 0, 1}};
+
+/* The parameters u[k - a] of M's points nearest the junctions of pieces
+ * a .. b - 1 (u[0] = 0, u[b - a] = 1) and M's speed there over the
+ * pieces' (slope[k - a], du / ds in the knot parameter s), from a first
+ * guess in proportion to arc length; false if they do not increase.
+ * *est receives the largest distance from a junction to M. */
+static bool match_junctions(const double *bz, const double *X, size_t a,
+                            size_t b, const cubic *q, double *u, double *slope,
+                            double *est) {
+  double H = X[b] - X[a], sp2, d2, worst = 0.0;
+  u[0] = 0.0;
+  u[b - a] = 1.0;
+  for (size_t k = a + 1; k < b; k++) {
+    u[k - a] = project(q, bz + 8 * k, (X[k] - X[a]) / H, &sp2, &d2);
+    if (!(u[k - a] > u[k - a - 1] && sp2 > 0)) return false;
+    /* the pieces' speed at a junction is 1 in s (legs a third of the
+     * span): du / ds = 1 / |M'(u)| */
+    slope[k - a] = 1.0 / sqrt(sp2);
+    worst = max_nan(worst, d2);
+  }
+  if (!(u[b - a] > u[b - a - 1])) return false;
+  for (size_t e = 0; e < 2; e++) {
+    size_t i = e ? b - a : 0;
+    double uu = u[i],
+           p1x = q->c[0][1] + uu * (2 * q->c[0][2] + uu * 3 * q->c[0][3]),
+           p1y = q->c[1][1] + uu * (2 * q->c[1][2] + uu * 3 * q->c[1][3]);
+    double sp = sqrt(p1x * p1x + p1y * p1y);
+    if (!(sp > 0)) return false;
+    slope[i] = 1.0 / sp;
+  }
+  *est = sqrt(worst);
+  return true;
+}
+
+/* A bound on the distance between cubic M (power form q) and pieces a ..
+ * b - 1 (Frechet, so both ways), junctions matched by match_junctions:
+ * piece k is matched with M over [u_k, u_k+1] by the cubic Hermite
+ * reparametrisation g with those ends and slopes (increasing: its
+ * Bernstein coefficients are), the difference P_k(s) - M(g(s)) is a
+ * polynomial of degree 9, and its largest Bernstein coefficient bounds it
+ * (a quadratic g left a tangential mismatch of some 3x the normal
+ * distance). Stops (returning more) once past budget. */
+static double merge_distance(const double *bz, const double *X, size_t a,
+                             size_t b, const cubic *q, const double *u,
+                             const double *slope, double budget) {
+  double worst = 0.0, b2 = budget * budget;
+  for (size_t k = a; k < b && worst <= b2; k++) {
+    const double *Pk = bz + 8 * k;
+    double h = X[k + 1] - X[k], u0 = u[k - a], u1 = u[k - a + 1];
+    double gb[4] = {u0, u0 + slope[k - a] * h / 3,
+                    u1 - slope[k - a + 1] * h / 3, u1};
+    if (!(gb[0] <= gb[1] && gb[1] <= gb[2] && gb[2] <= gb[3])) return INFINITY;
+    double D[10][2];
+    for (int i = 0; i <= 9; i++) {
+      const double *w = BERN3_AT_NINTHS[i];
+      double g = w[0] * gb[0] + w[1] * gb[1] + w[2] * gb[2] + w[3] * gb[3],
+             m[2];
+      cubic_at(q, g, m);
+      D[i][0] =
+          w[0] * Pk[0] + w[1] * Pk[2] + w[2] * Pk[4] + w[3] * Pk[6] - m[0];
+      D[i][1] =
+          w[0] * Pk[1] + w[1] * Pk[3] + w[2] * Pk[5] + w[3] * Pk[7] - m[1];
+    }
+    double S[5][2], T[5][2];
+    for (int i = 0; i < 5; i++)
+      for (int d = 0; d < 2; d++) {
+        S[i][d] = D[i][d] + D[9 - i][d];
+        T[i][d] = D[i][d] - D[9 - i][d];
+      }
+    worst = max_nan(worst, D[0][0] * D[0][0] + D[0][1] * D[0][1]);
+    worst = max_nan(worst, D[9][0] * D[9][0] + D[9][1] * D[9][1]);
+    for (int j = 0; j < 4; j++) {
+      double e[2] = {0.0, 0.0}, o[2] = {0.0, 0.0};
+      for (int i = 0; i < 5; i++)
+        for (int d = 0; d < 2; d++) {
+          e[d] += BERN9_EVEN[j][i] * S[i][d];
+          o[d] += BERN9_ODD[j][i] * T[i][d];
+        }
+      double lx = e[0] + o[0], ly = e[1] + o[1], rx = e[0] - o[0],
+             ry = e[1] - o[1];
+      worst = max_nan(worst, lx * lx + ly * ly);
+      worst = max_nan(worst, rx * rx + ry * ry);
+    }
+  }
+  return sqrt(worst);
+}
+
+/* Whether the frame's tangent is continuous at a corner k of the plan
+ * (one input's, which this frame does not turn at: frames 0 and 1). */
+static bool turns_not(const double *bz, size_t k) {
+  const double *A = bz + 8 * (k - 1), *B = bz + 8 * k;
+  double ax = A[6] - A[4], ay = A[7] - A[5], bx = B[2] - B[0], by = B[3] - B[1];
+  double cross = ax * by - ay * bx, dot = ax * bx + ay * by;
+  return dot > 0 && fabs(cross) <= 1e-12 * dot;
+}
+
+/* Whether pieces a .. b - 1 merge into one cubic within budget
+ * (merge_distance). u and slope are scratch (b - a + 1 each). */
+static bool merges(const double *bz, const double *X, size_t a, size_t b,
+                   double budget, double slack, double *u, double *slope) {
+  double M[8], v[2], est;
+  cubic q;
+  if (!run_speeds(bz, X, a, b, v)) return false;
+  merged_cubic(bz, X, a, b, v, M);
+  cubic_of(M, &q);
+  if (!match_junctions(bz, X, a, b, &q, u, slope, &est) || est + slack > budget)
+    return false;
+  return merge_distance(bz, X, a, b, &q, u, slope, budget) + slack <= budget;
+}
+
+/* The frame's pieces merged into runs, each one cubic with its own end
+ * speeds (run_speeds): run[j] the first piece of run j (run[nr] = np).
+ * Runs grow greedily while the bound allows (merges), never across a
+ * corner the frame turns at. Returns nr. u, slope:
+ * scratch, np + 1 each. */
+static size_t merge_runs(const km__frame_plan *p, const double *bz,
+                         const double *X, double budget, size_t *run, double *u,
+                         double *slope) {
+  size_t np = p->np, nr = 0, a = 0;
+  /* the bound is computed in the frame's coordinates (within its length
+   * of the origin): rounding there is some units of the last place of
+   * the length, times the 1368 of the collocation inverse (BERN9_EVEN,
+   * BERN9_ODD) */
+  double slack = 1e-11 * X[np];
+  /* runs of a frame are of similar lengths: each starts from the last
+   * one's and grows or shrinks by the bound */
+  size_t guess = 2;
+  while (a < np) {
+    size_t stop = a + 1;
+    while (stop < np && (!p->corner[stop] || turns_not(bz, stop))) stop++;
+    size_t b = a + guess < stop ? a + guess : stop;
+    while (b > a + 1 && !merges(bz, X, a, b, budget, slack, u, slope)) b--;
+    if (b == a + guess)
+      while (b < stop && merges(bz, X, a, b + 1, budget, slack, u, slope)) b++;
+    run[nr++] = a;
+    guess = b - a + 1;
+    a = b;
+  }
+  run[nr] = np;
+  return nr;
+}
+
+/* The frame's control points into *f (initialised, empty) from its
+ * pieces bz at knots X merged by runs run[0 .. nr]: P0, then Q1 Q2 of
+ * every run, with the junction point itself at corners (triple knots;
+ * double elsewhere). A run's own end speeds differ from its neighbours',
+ * and the B-spline is C1 at a double knot: its legs either side are in
+ * the ratio of the knot spans. So the spans follow the legs (a run's span
+ * is 3 l0 / w for its first leg l0 and the speed w the join before it
+ * takes, the next join's speed w l1 / l0), from speed 1 at the start and
+ * after every corner, and all are then scaled to the frame's length: a
+ * circle's knots stay at arc length, others within the ratios of their
+ * runs' end speeds (a few percent at most). KM_EINVAL (*msg) if the
+ * counts disagree. */
+static km_status frame_points_of_runs(const km__frame_plan *p, const double *bz,
+                                      const double *X, const size_t *run,
+                                      size_t nr, km_curve *f,
+                                      const char **msg) {
+  size_t ncorner = 0;
+  for (size_t j = 1; j < nr; j++) ncorner += p->corner[run[j]];
+  size_t ncp = 2 * nr + 2 + ncorner, nknots = ncp + 4;
+  km_status st = km__curve_alloc(f, 3, ncp, false);
+  if (st) return st;
+  size_t cc = 0, kk = 0;
+  double w = 1.0, total = 0.0;
+  for (int r = 0; r < 4; r++) f->knots[kk++] = 0.0;
+  f->cp[cc++] = bz[0];
+  f->cp[cc++] = bz[1];
+  for (size_t j = 0; j < nr; j++) {
+    double M[8], v[2];
+    run_speeds(bz, X, run[j], run[j + 1], v);
+    merged_cubic(bz, X, run[j], run[j + 1], v, M);
+    if (j > 0 && p->corner[run[j]]) {
+      f->cp[cc++] = M[0];
+      f->cp[cc++] = M[1];
+      w = 1.0;
+    }
+    for (int q = 2; q < 6; q++) f->cp[cc++] = M[q];
+    double l0 = hypot(M[2] - M[0], M[3] - M[1]),
+           l1 = hypot(M[6] - M[4], M[7] - M[5]);
+    total += 3 * l0 / w;
+    w *= l1 / l0;
+    if (j + 1 < nr) {
+      int mult = p->corner[run[j + 1]] ? 3 : 2;
+      for (int r = 0; r < mult; r++) f->knots[kk++] = total;
+    }
+  }
+  f->cp[cc++] = bz[8 * p->np - 2];
+  f->cp[cc++] = bz[8 * p->np - 1];
+  for (int r = 0; r < 4; r++) f->knots[kk++] = X[p->np];
+  if (cc != 2 * ncp || kk != nknots || !(total > 0)) {
     *msg = "internal inconsistency building a frame";
     return KM_EINVAL;
   }
+  double scale = X[p->np] / total;
+  for (size_t i = 4; i + 4 < nknots; i++) f->knots[i] *= scale;
   return KM_OK;
 }
 
 km_status km__frame_plan_curve(const km__frame_plan *p, double t, double theta0,
-                               bool close_lsq, km_curve *out, double *ends,
-                               km__poll *poll, km_error *err) {
-  double c[NF] = {0}, P[2];
+                               bool close_lsq, bool merge, km_curve *out,
+                               double *ends, km__poll *poll, km_error *err) {
+  double c[NF] = {0};
   /* sums of the pieces, scratch of the nodes, and per corner its turn,
-   * its change and the stretch sums; per piece the turn added before it */
-  size_t nc = p->ncorners, scratch = km__plan_frame_scratch(p) + 4 * nc + 2;
-  double *sum = km__malloc((scratch + p->np) * sizeof(double));
+   * its change and the stretch sums; per piece the turn added before it,
+   * its Bezier points and knot, and the runs merged */
+  size_t np = p->np, nc = p->ncorners,
+         scratch = km__plan_frame_scratch(p) + 4 * nc + 2;
+  size_t ndouble = scratch + np + 8 * np + 3 * (np + 1);
+  double *sum =
+      km__malloc(ndouble * sizeof(double) + (np + 1) * sizeof(size_t));
   if (!sum) return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  double *dp = sum + scratch, *bz = dp + np, *X = bz + 8 * np, *u = X + np + 1,
+         *slope = u + np + 1;
+  size_t *run = (size_t *)(sum + ndouble);
   const char *msg = "closing the frame did not converge";
   km_curve f;
   km_curve_init(&f);
-  km_status st =
-      frame_closure(p, t, theta0, close_lsq, c, sum, sum + scratch, poll);
+  km_status st = frame_closure(p, t, theta0, close_lsq, c, sum, dp, poll);
   if (st == KM_ECANCELLED || (poll && poll->stopped)) {
     st = KM_ECANCELLED;
     goto done;
   }
   if (st) goto done;
   msg = NULL;
-  st = hermite_points(p, t, theta0, c, sum, sum + scratch, &f, ends, P, &msg);
+  hermite_pieces(p, t, theta0, c, sum, dp, bz, X, ends);
+  size_t nr = np;
+  if (merge)
+    nr = merge_runs(p, bz, X, KM__PLAN_MERGE_SHARE * p->tol, run, u, slope);
+  else
+    for (size_t k = 0; k <= np; k++) run[k] = k;
+  st = frame_points_of_runs(p, bz, X, run, nr, &f, &msg);
   if (st) goto done;
   f.closed = false;
+  const double *P = bz + 8 * np - 2;
   if (p->closed && hypot(P[0], P[1]) <= p->tol) {
     size_t ncp = f.n;
     f.cp[2 * (ncp - 1)] = f.cp[0];

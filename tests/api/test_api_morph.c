@@ -147,18 +147,27 @@ static double metric(const cJSON *frame, const char *key) {
 }
 
 /* Largest deviation of a frame's curve from a circle of radius r about
- * the centroid of its sampled points. */
+ * the centroid of its sampled polyline. */
 static double circle_deviation(const cJSON *frame, double r) {
   at_curve c;
-  double cx = 0, cy = 0, dev = 0, p[2];
-  const int m = 400;
+  double cx = 0, cy = 0, len = 0, dev = 0, p[2], q[2];
+  const int m = 2000;
   at_curve_from_json(cJSON_GetObjectItem(frame, "curve"), &c);
   double t0 = c.knots[c.degree], t1 = c.knots[c.n];
-  for (int k = 0; k < m; k++) {
+  /* the centroid of the polyline's chords, weighted by their lengths (the
+   * parameter need not be arc length) */
+  at_curve_point(&c, t0, q);
+  for (int k = 1; k <= m; k++) {
     at_curve_point(&c, t0 + (t1 - t0) * k / m, p);
-    cx += p[0] / m;
-    cy += p[1] / m;
+    double w = hypot(p[0] - q[0], p[1] - q[1]);
+    cx += w * 0.5 * (p[0] + q[0]);
+    cy += w * 0.5 * (p[1] + q[1]);
+    len += w;
+    q[0] = p[0];
+    q[1] = p[1];
   }
+  cx /= len;
+  cy /= len;
   for (int k = 0; k <= m; k++) {
     at_curve_point(&c, t0 + (t1 - t0) * k / m, p);
     dev = fmax(dev, fabs(hypot(p[0] - cx, p[1] - cy) - r));

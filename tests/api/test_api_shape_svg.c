@@ -303,13 +303,17 @@ static void animate_d_keeps_one_structure(void **state) {
  * its parent's partner (O -> C: the C; the icons: the ring or the die
  * that held it at the other end) or, for a top-level contour, inside a
  * paired one (i -> l: the l), and the live frames next to that end close
- * in on that point. */
+ * in on that point. That is the placement of "allow"; under "avoid" a
+ * top-level contour may vanish where its host's mapping puts it instead
+ * (km_shape_morph_create), as the dot of i does: pulled into the l it
+ * meets the stem growing into it. */
 static void collapsed_contour_is_a_point_inside_its_host(void **state) {
   (void)state;
   const int nframes = 21;
   for (size_t c = 0; c < sizeof CASES / sizeof CASES[0]; c++) {
     char *body = pair_request(CASES[c].from, CASES[c].to,
-                              ",\"frames\":21,\"include\":[\"animate_d\"]");
+                              ",\"frames\":21,\"include\":[\"animate_d\"],"
+                              "\"intersections\":\"allow\"");
     cJSON *j = at_expect_json(MORPH, body);
     const cJSON *ad = member(j, "animate_d");
     const cJSON *used = member(j, "contour_matches_used");
@@ -601,11 +605,15 @@ static char **split_values(const char *v, size_t *n) {
 /* The animate layout: one <animate> of "d" with a value a frame and as
  * many key times, every value of the first one's commands and numbers,
  * one subpath a slot, the collapsed slot one point inside a paired
- * contour. */
+ * contour (under "allow": see collapsed_contour_is_a_point_inside_its_host
+ * for "avoid"). */
 static void animation_values_share_one_structure(void **state) {
   (void)state;
   for (size_t c = 0; c < sizeof CASES / sizeof CASES[0]; c++) {
-    char *body = layout_request(&CASES[c], "animate", 9);
+    char *body = pair_request(CASES[c].from, CASES[c].to,
+                              ",\"frames\":9,\"format\":\"svg\",\"svg\":"
+                              "{\"layout\":\"animate\"},"
+                              "\"intersections\":\"allow\"");
     char *doc = svg_answer(body);
     assert_int_equal(count(doc, "<animate attributeName=\"d\""), 1);
     const char *a = strstr(doc, "<animate attributeName=\"d\"");

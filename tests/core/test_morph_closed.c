@@ -994,9 +994,10 @@ static void planned_default_frames_of_the_fixture_pairs(void **state) {
 }
 
 /* Planned and blended-and-reconstructed frames are both within the
- * tolerance of the same exact frame, so within twice of each other (anchor
- * start and closure none: both then place and close nothing of their own,
- * and arc length is the parameter of both). */
+ * tolerance of the same exact frame, so within twice of each other as
+ * point sets (anchor start and closure none: both then place and close
+ * nothing of their own; neither keeps arc length as its parameter between
+ * knots). */
 static void planned_and_reconstructed_frames_agree(void **state) {
   (void)state;
   for (int p = 0; p < 6; p++) {
@@ -1013,18 +1014,12 @@ static void planned_and_reconstructed_frames_agree(void **state) {
     km_morph_inputs(m, len, turning);
     double tol = 1e-5 * fmax(len[0], len[1]);
     for (int i = 1; i <= 3; i++) {
-      double t = i / 4.0, t0, t1, worst = 0.0;
+      double t = i / 4.0;
       km_curve f;
       frame g;
       planned_frame(m, t, &f);
       frame_get(m, t, &g);
-      km_curve_domain(&f, &t0, &t1);
-      for (int j = 0; j <= 400; j++) {
-        double s = (t1 - t0) * j / 400, q[1][2], r[1][2];
-        km_curve_eval(&f, t0 + s, 0, q);
-        km_curve_eval(&g.c, s, 0, r);
-        worst = fmax(worst, hypot(q[0][0] - r[0][0], q[0][1] - r[0][1]));
-      }
+      double worst = curves_distance(&f, &g.c, 1200);
       if (worst > 2 * tol)
         print_error("%s, t = %g: planned and reconstructed frames %.3g apart "
                     "(tolerance %.3g)\n",
@@ -1070,14 +1065,15 @@ static void curve_bending(const km_curve *c, double *energy, double *kmax) {
 
 /* A default frame with metrics (planned, closed by the lsq correction)
  * reports the bending energy and curvature of the curve it returns,
- * measured here from the curve's own derivatives: energy within 2e-3,
+ * measured here from the curve's own derivatives: energy within 2%
+ * (merged cubics within the tolerance bend a little differently),
  * and the largest |kappa| under the reported bound (a bound from Bernstein
  * coefficients, so above the true largest) with 2% to spare for the cubic
  * within the tolerance of the frame, which overshoots its curvature a
  * little. Before the metrics were taken
  * from the planned frame's own closure they came from a second closure
- * solve that can settle elsewhere: on O -> C-like pairs 43% off the
- * returned frame's energy. */
+ * solve that can settle elsewhere: 7% off on U_to_S at t = 1/2, 43% on
+ * DejaVu O -> C. */
 static void metrics_describe_the_returned_frame(void **state) {
   (void)state;
   double worst_e = 0.0, worst_k = 0.0;
@@ -1101,12 +1097,12 @@ static void metrics_describe_the_returned_frame(void **state) {
       double de =
           fabs(energy - mt.bending_energy) / fmax(mt.bending_energy, 1e-9);
       double dk = (kmax - mt.max_abs_kappa) / mt.max_abs_kappa;
-      if (de > 2e-3 || dk > 0.02)
+      if (de > 0.02 || dk > 0.02)
         print_error("%s, t = %g: energy %.6g, reported %.6g; max |kappa| "
                     "%.6g, reported %.6g\n",
                     PAIRS[p], t, energy, mt.bending_energy, kmax,
                     mt.max_abs_kappa);
-      assert_le(de, 2e-3);
+      assert_le(de, 0.02);
       assert_le(dk, 0.02);
       worst_e = fmax(worst_e, de);
       worst_k = fmax(worst_k, dk);

@@ -211,10 +211,11 @@ typedef enum km_frame_parts {
 } km_frame_parts;
 
 /* Control points the curve of the frame at t will have (km_morph_frame
- * with what parts says asked for), into *points (out, on KM_OK only), without
- * building it: exact, and free for a linear morph and for a planned
- * morph's curves; otherwise at the cost of the frame's blend and closure
- * (a third to a half of the frame). Stops as km_morph_frame_until (stop
+ * with what parts says asked for), into *points (out, on KM_OK only):
+ * exact; free for a linear morph, at the cost of the frame for a planned
+ * morph's curves (each frame merges runs of the plan's pieces as it can,
+ * so counts differ between frames), otherwise at the cost of the frame's
+ * blend and closure (a third to a half of the frame). Stops as km_morph_frame_until (stop
  * may be NULL). Statuses as km_morph_frame_until. Thread-safe. */
 KM_API km_status km_morph_frame_points(const km_morph *m, double t,
                                        km_frame_parts parts,
