@@ -451,7 +451,7 @@ static km_status planned_frame(const km_morph *m, double t, km_closure how,
   /* a frame the crossing repair moves keeps the planned pieces: the
    * repair's displacement lives in arc length, which merged runs leave
    * between their knots */
-  bool merge = !km__repair_active(m->repair, t);
+  bool merge = !m->keep_pieces && !km__repair_active(m->repair, t);
   km_status st =
       km__frame_plan_curve(m->plan, t, (1 - t) * phia + t * phib,
                            how == KM_CLOSURE_LSQ, merge, &f, buf, poll, err);
@@ -468,6 +468,10 @@ done:
   km_curve_free(&f);
   km__free(buf);
   return st;
+}
+
+void km__morph_keep_pieces(km_morph *m) {
+  m->keep_pieces = true;
 }
 
 km_status km__morph_frame(const km_morph *m, double t, km__poll *poll,

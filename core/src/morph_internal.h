@@ -60,6 +60,9 @@ struct km_morph {
   double place_w_sum, place_qa[2], place_qb[2];
   km_morph_avoidance avoid; /* what intersections AVOID did */
   km__repair *repair;       /* frames repaired (morph_repair.c), or NULL */
+  bool keep_pieces; /* planned frames keep the plan's pieces (no merging):
+                       contours of compound shapes, whose frames are
+                       placed and checked against each other by samples */
   /* the caller's stop condition while km_morph_create runs, NULL after:
    * frames take their own (km_morph_frame_until) */
   km__poll *poll;
@@ -128,6 +131,9 @@ km_status km__avoid_crossings(km_morph **mp, km__poll *poll);
  * as how says), kept in m->repair (NULL when nothing
  * crosses) with the report in m->avoid. KM_OK, KM_ENOMEM or
  * KM_ECANCELLED (then m is as it was). */
+/* Planned frames of m keep the plan's pieces from here on, unmerged (the
+ * contours of a compound morph, shape_morph.c). */
+void km__morph_keep_pieces(km_morph *m);
 km_status km__repair_crossings(km_morph *m, km__repair_method how,
                                km__poll *poll);
 void km__repair_free(km__repair *rp);

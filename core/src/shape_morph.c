@@ -21,6 +21,7 @@
 #include "km/alloc.h"
 #include "km/shape.h"
 #include "kernels.h"
+#include "morph_internal.h"
 #include "shape_internal.h"
 #include "status_internal.h"
 
@@ -174,6 +175,10 @@ static km_status morph_pair(km_shape_morph *m, size_t k, const km_shape *a,
                            i >= 0 ? &ci_in : &c_in, mo, err);
   }
   km_curve_free(&circ);
+  /* contours keep their frames' planned pieces: the placement, the
+   * corrections and the checks between contours sample each contour
+   * by its parameter, which merged runs no longer keep in arc length */
+  if (st == KM_OK) km__morph_keep_pieces(m->morphs[k]);
   if (st != KM_OK && err && st != KM_ECANCELLED) err->index = (long)k;
   return st;
 }
