@@ -417,7 +417,9 @@ void km__poly_interior_point(const km__poly_index *ix, const double x[2],
       double q[2] = {0.5 * (a[0] + b[0]) - side * delta * dy / l,
                      0.5 * (a[1] + b[1]) + side * delta * dx / l};
       double d = hypot(q[0] - x[0], q[1] - x[1]);
-      if (d < best && km__poly_index_winding(ix, q) != 0) {
+      /* of points at the same distance within rounding (x on a symmetry
+       * axis of P) the last, whatever the rounding of x */
+      if (d <= best * (1.0 + 1e-9) && km__poly_index_winding(ix, q) != 0) {
         best = d;
         out[0] = q[0];
         out[1] = q[1];
