@@ -76,9 +76,10 @@ void km__poly_interior_point(const km__poly_index *ix, const double x[2],
                              double out[2]);
 
 /* Signed area (counter-clockwise positive) and area centroid of a closed
- * curve by Gauss-Legendre quadrature of Green's formulas, exact up to
- * rounding for polynomial curves of degree <= 4 (8 points on 4 panels a
- * span). */
+ * curve by Gauss-Legendre quadrature of Green's formulas: for a polynomial
+ * curve ceil(3p / 2) points a span in its Bezier form, exact up to
+ * rounding at any degree; for a rational one 8 points on each quarter of
+ * a span (not exact: the integrands are rational). */
 void km__curve_area(const km_curve *c, double *area, double centroid[2]);
 
 /* Number of proper crossings between polylines P (np points) and Q (nq
