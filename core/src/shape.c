@@ -23,26 +23,27 @@
 /* ---- polyline kernels --------------------------------------------------- */
 
 km_status km__shape_flatten(const km_curve *c, double **pts, size_t *np) {
-  size_t spans = 0;
+  size_t spans = 0, last = (size_t)c->degree;
   for (size_t i = (size_t)c->degree; i < c->n; i++)
     if (c->knots[i + 1] > c->knots[i]) spans++;
   size_t n = spans * KM_SHAPE_FLAT + 1, k = 0;
   double *p = km__malloc(2 * n * sizeof *p);
   if (!p) return KM_ENOMEM;
+  /* each span's points on that span, not searched for point by point */
   for (size_t i = (size_t)c->degree; i < c->n; i++) {
     double a = c->knots[i], b = c->knots[i + 1];
     if (!(b > a)) continue;
     for (size_t j = 0; j < KM_SHAPE_FLAT; j++) {
       double d[1][2];
-      km_curve_eval(c, a + (b - a) * (double)j / KM_SHAPE_FLAT, 0, d);
+      km__curve_eval_span(c, i, a + (b - a) * (double)j / KM_SHAPE_FLAT, 0, d);
       p[2 * k] = d[0][0];
       p[2 * k + 1] = d[0][1];
       k++;
     }
+    last = i;
   }
-  double t0, t1, d[1][2];
-  km_curve_domain(c, &t0, &t1);
-  km_curve_eval(c, t1, 0, d);
+  double d[1][2];
+  km__curve_eval_span(c, last, c->knots[c->n], 0, d);
   p[2 * k] = d[0][0];
   p[2 * k + 1] = d[0][1];
   *pts = p;
@@ -178,7 +179,7 @@ static void rational_green(const km_curve *c, const double o[2], double s[3]) {
       double lo = a + (b - a) * panel / 4.0, h = (b - a) / 4.0;
       for (int k = 0; k < 8; k++) {
         double d[2][2];
-        km_curve_eval(c, lo + 0.5 * h * (GL_X[k] + 1.0), 1, d);
+        km__curve_eval_span(c, i, lo + 0.5 * h * (GL_X[k] + 1.0), 1, d);
         double wk = 0.5 * h * GL_W[k];
         double x = d[0][0] - o[0], y = d[0][1] - o[1];
         double dx = d[1][0], dy = d[1][1];
