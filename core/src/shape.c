@@ -23,29 +23,22 @@
 /* ---- polyline kernels --------------------------------------------------- */
 
 km_status km__shape_flatten(const km_curve *c, double **pts, size_t *np) {
-  size_t spans = 0, last = (size_t)c->degree;
+  size_t spans = 0;
   for (size_t i = (size_t)c->degree; i < c->n; i++)
     if (c->knots[i + 1] > c->knots[i]) spans++;
   size_t n = spans * KM_SHAPE_FLAT + 1, k = 0;
-  double *p = km__malloc(2 * n * sizeof *p);
+  double *p = km__malloc(2 * n * sizeof *p), der[2];
   if (!p) return KM_ENOMEM;
-  /* each span's points on that span, not searched for point by point */
+  /* each span once in Bezier form, its points by Horner there (a valid
+   * curve has a non-empty span, so sp is set at the end) */
+  km__bspan sp = {0};
   for (size_t i = (size_t)c->degree; i < c->n; i++) {
-    double a = c->knots[i], b = c->knots[i + 1];
-    if (!(b > a)) continue;
-    for (size_t j = 0; j < KM_SHAPE_FLAT; j++) {
-      double d[1][2];
-      km__curve_eval_span(c, i, a + (b - a) * (double)j / KM_SHAPE_FLAT, 0, d);
-      p[2 * k] = d[0][0];
-      p[2 * k + 1] = d[0][1];
-      k++;
-    }
-    last = i;
+    if (!(c->knots[i + 1] > c->knots[i])) continue;
+    km__bspan_make(&sp, c, i);
+    for (size_t j = 0; j < KM_SHAPE_FLAT; j++, k++)
+      km__bspan_eval_u(&sp, (double)j / KM_SHAPE_FLAT, p + 2 * k, der);
   }
-  double d[1][2];
-  km__curve_eval_span(c, last, c->knots[c->n], 0, d);
-  p[2 * k] = d[0][0];
-  p[2 * k + 1] = d[0][1];
+  km__bspan_eval_u(&sp, 1.0, p + 2 * k, der);
   *pts = p;
   *np = k + 1;
   return KM_OK;
