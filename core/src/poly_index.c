@@ -33,13 +33,23 @@ static const double *vertex(const km__poly_index *ix, size_t i) {
   return ix->P + 2 * (i == ix->np ? 0 : i);
 }
 
+/* The smaller and larger of two numbers that are not NaN, as fmin and
+ * fmax give them but inline (a zero's sign does not matter to band_of). */
+static double lower(double a, double b) {
+  return b < a ? b : a;
+}
+static double upper(double a, double b) {
+  return b > a ? b : a;
+}
+
 /* Entries the listing takes with nbands bands (SIZE_MAX past limit). */
 static size_t count_entries(km__poly_index *ix, size_t limit) {
   size_t total = 0;
   for (size_t i = 0; i < ix->np; i++) {
     const double *a = vertex(ix, i), *b = vertex(ix, i + 1);
     if (!(a[1] == a[1] && b[1] == b[1])) continue; /* NaN: never counts */
-    total += band_of(ix, fmax(a[1], b[1])) - band_of(ix, fmin(a[1], b[1])) + 1;
+    total +=
+        band_of(ix, upper(a[1], b[1])) - band_of(ix, lower(a[1], b[1])) + 1;
     if (total > limit) return SIZE_MAX;
   }
   return total;
@@ -62,8 +72,9 @@ km_status km__poly_index_build(km__poly_index *ix, const double *P, size_t np) {
   ix->np = np;
   double y0 = INFINITY, y1 = -INFINITY;
   for (size_t i = 0; i < np; i++) {
-    y0 = fmin(y0, P[2 * i + 1]);
-    y1 = fmax(y1, P[2 * i + 1]);
+    double y = P[2 * i + 1]; /* a NaN is skipped, as fmin and fmax do */
+    if (y < y0) y0 = y;
+    if (y > y1) y1 = y;
   }
   ix->y0 = y0;
   ix->y1 = y1;
@@ -89,8 +100,8 @@ km_status km__poly_index_build(km__poly_index *ix, const double *P, size_t np) {
     for (size_t i = 0; i < np; i++) {
       const double *a = vertex(ix, i), *b = vertex(ix, i + 1);
       if (!(a[1] == a[1] && b[1] == b[1])) continue;
-      size_t lo = band_of(ix, fmin(a[1], b[1]));
-      size_t hi = band_of(ix, fmax(a[1], b[1]));
+      size_t lo = band_of(ix, lower(a[1], b[1]));
+      size_t hi = band_of(ix, upper(a[1], b[1]));
       for (size_t k = lo; k <= hi; k++)
         if (pass == 0)
           ix->start[k + 1]++;
