@@ -25,7 +25,7 @@
 static size_t band_of(const km__poly_index *ix, double y) {
   double u = (y - ix->y0) * ix->inv_h;
   if (!(u >= 0.0)) return 0;
-  if (u >= (double)ix->nbands) return ix->nbands - 1;
+  if (u >= ix->nbands_f) return ix->nbands - 1;
   return (size_t)u;
 }
 
@@ -82,7 +82,8 @@ km_status km__poly_index_build(km__poly_index *ix, const double *P, size_t np) {
   if (ix->nbands > ((size_t)1 << 16)) ix->nbands = (size_t)1 << 16;
   size_t total;
   for (;;) {
-    ix->inv_h = y1 > y0 ? (double)ix->nbands / (y1 - y0) : 0.0;
+    ix->nbands_f = (double)ix->nbands;
+    ix->inv_h = y1 > y0 ? ix->nbands_f / (y1 - y0) : 0.0;
     total = count_entries(ix, 8 * np + ix->nbands);
     if (total != SIZE_MAX || ix->nbands == 1) break;
     ix->nbands /= 2;
@@ -126,7 +127,8 @@ int km__poly_index_winding(const km__poly_index *ix, const double p[2]) {
   int w = 0;
   for (size_t e = ix->start[k]; e < ix->start[k + 1]; e++) {
     size_t i = ix->edge[e];
-    w += km__edge_winding(vertex(ix, i), vertex(ix, i + 1), p);
+    const double *a = ix->P + 2 * i, *b = i + 1 == ix->np ? ix->P : a + 2;
+    w += km__edge_winding(a, b, p);
   }
   return w;
 }

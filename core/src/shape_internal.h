@@ -55,8 +55,9 @@ typedef struct km__poly_index {
   size_t np;
   double y0, y1, inv_h; /* P's height range; bands per unit of height */
   size_t nbands;
-  size_t *start;  /* nbands + 1: band k lists edge[start[k] .. start[k+1]) */
-  uint32_t *edge; /* edge i joins point i to point i + 1 (mod np) */
+  double nbands_f; /* nbands as a double: band_of compares with it */
+  size_t *start;   /* nbands + 1: band k lists edge[start[k] .. start[k+1]) */
+  uint32_t *edge;  /* edge i joins point i to point i + 1 (mod np) */
   size_t *seen, stamp; /* crossings: an edge once for each edge of the other */
 } km__poly_index;
 
