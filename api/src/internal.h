@@ -331,7 +331,6 @@ bool api__add_item(api_ctx *ctx, cJSON *obj, const char *key, cJSON *item);
 cJSON *api__number(double v);
 cJSON *api__num_array_json(api_ctx *ctx, const double *v, size_t n,
                            size_t stride);
-cJSON *api__curve_json(api_ctx *ctx, const km_curve *c, bool svg_d, double tol);
 cJSON *api__signature_json(api_ctx *ctx, const km_signature *sig);
 
 /* Render root into a 2xx JSON response; takes ownership of root. */

@@ -106,46 +106,6 @@ static bool add_array(api_ctx *ctx, cJSON *obj, const char *key,
   return api__add_item(ctx, obj, key, a);
 }
 
-cJSON *api__curve_json(api_ctx *ctx, const km_curve *c, bool svg_d,
-                       double tol) {
-  cJSON *o = cJSON_CreateObject();
-  double length;
-  if (o == NULL) {
-    api__oom(ctx);
-    return NULL;
-  }
-  if (!api__add_num(ctx, o, "degree", c->degree) ||
-      !add_array(ctx, o, "knots", c->knots, c->n + (size_t)c->degree + 1, 1) ||
-      !add_array(ctx, o, "control_points", c->cp, c->n, 2))
-    goto fail;
-  if (c->w != NULL && !add_array(ctx, o, "weights", c->w, c->n, 1)) goto fail;
-  if (cJSON_AddBoolToObject(o, "closed", c->closed) == NULL) {
-    api__oom(ctx);
-    goto fail;
-  }
-  length = km_curve_length_within(c, LENGTH_REL_TOL);
-  if (!api__add_num(ctx, o, "length", length)) goto fail;
-  if (svg_d) {
-    /* Default tolerance as everywhere: 1e-5 of the curve's length. */
-    char *d = api_svg_path_d(c, tol > 0 ? tol : 1e-5 * length, NULL);
-    if (d == NULL) {
-      api__oom(ctx);
-      goto fail;
-    }
-    cJSON *s = cJSON_CreateString(d);
-    km__free(d);
-    if (s == NULL) {
-      api__oom(ctx);
-      goto fail;
-    }
-    if (!api__add_item(ctx, o, "svg_d", s)) goto fail;
-  }
-  return o;
-fail:
-  cJSON_Delete(o);
-  return NULL;
-}
-
 cJSON *api__signature_json(api_ctx *ctx, const km_signature *sig) {
   cJSON *o = cJSON_CreateObject();
   cJSON *start, *kappa, *corners;

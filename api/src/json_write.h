@@ -41,9 +41,10 @@ typedef struct api_grid {
  * points, with or without (positive, unrounded) weights. */
 api_grid api__tolerance_grid(double tol);
 
-/* A curve as the contract's Curve (output) object, as api__curve_json,
- * its control points on grid (NULL: exact) with the length of the curve
- * so printed. *moved (may be NULL) receives the largest distance a
+/* A curve as the contract's Curve (output) object (degree, knots,
+ * control_points, weights when rational, closed, length, svg_d when
+ * asked), its control points on grid (NULL: exact) with the length of
+ * the curve so printed. *moved (may be NULL) receives the largest distance a
  * control point moved by printing (0 when exact). Knots, weights and
  * length are always exact: rounding a knot or a weight moves the curve
  * by more than its share. */

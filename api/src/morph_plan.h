@@ -90,8 +90,8 @@ bool api__morph_read_request(api_ctx *ctx, const cJSON *root,
 bool api__morph_check_size(api_ctx *ctx, api_morph_plan *pl,
                            const km_stop *stop);
 
-/* A frame's metrics object (morph_result.c). */
-cJSON *api__metrics_json(api_ctx *ctx, const km_frame_metrics *m);
+/* A frame's metrics object (morph_result.c), as json_write.h writes. */
+bool api__json_metrics(api_ctx *ctx, api_svg_buf *b, const km_frame_metrics *m);
 /* The "intersections" object of an answer that asked to avoid crossings
  * (morph_crossings.c): frames rendered. NULL with the error in ctx. */
 cJSON *api__intersections_json(api_ctx *ctx, const api_morph_plan *pl);
@@ -125,17 +125,20 @@ void api__shape_render(api_morph_plan *pl, api_frame_slot *f,
 bool api__shape_check_size(api_ctx *ctx, api_morph_plan *pl,
                            const km_stop *stop);
 
-/* The JSON answer's frame of a compound morph: t, contours (null for an
- * absent one), svg_d when asked, metrics when asked. */
-cJSON *api__shape_frame_json(api_ctx *ctx, const api_morph_plan *pl,
-                             const api_frame_slot *f);
+/* The JSON answer's frame of a compound morph, written into b as
+ * json_write.h writes: t, contours (null for an absent one), svg_d when
+ * asked, metrics when asked. False with the error in ctx. */
+bool api__shape_frame_write(api_ctx *ctx, api_svg_buf *b,
+                            const api_morph_plan *pl, const api_frame_slot *f);
 
-/* "contour_matches_used": the pairs of the morph. */
-cJSON *api__shape_pairs_json(api_ctx *ctx, const api_morph_plan *pl);
+/* "contour_matches_used": the pairs of the morph, into b. */
+bool api__shape_pairs_write(api_ctx *ctx, api_svg_buf *b,
+                            const api_morph_plan *pl);
 
-/* "animate_d" of a compound morph: every frame as one path of the present
- * contours, each slot with one common number of pieces. */
-cJSON *api__shape_animate_json(api_ctx *ctx, const api_morph_plan *pl);
+/* "animate_d" of a compound morph, into b: every frame as one path of the
+ * present contours, each slot with one common number of pieces. */
+bool api__shape_animate_write(api_ctx *ctx, api_svg_buf *b,
+                              const api_morph_plan *pl);
 
 /* The SVG document of a compound morph's rendered frames in the request's
  * layout, each frame filled under the fill rule of the nearer end

@@ -32,27 +32,8 @@ size_t api__count_pieces(const char *d) {
   return numbers > 2 ? (numbers - 2) / 6 : 1;
 }
 
-cJSON *api__metrics_json(api_ctx *ctx, const km_frame_metrics *m) {
-  cJSON *o = cJSON_CreateObject();
-  if (o == NULL) {
-    api__oom(ctx);
-    return NULL;
-  }
-  if (!api__add_num(ctx, o, "length", m->length) ||
-      !api__add_num(ctx, o, "max_abs_kappa", m->max_abs_kappa) ||
-      !api__add_num(ctx, o, "bending_energy", m->bending_energy) ||
-      !api__add_num(ctx, o, "self_intersections",
-                    (double)m->self_intersections) ||
-      !api__add_num(ctx, o, "closure_gap", m->closure_gap)) {
-    cJSON_Delete(o);
-    return NULL;
-  }
-  return o;
-}
-
-/* The metrics object as api__metrics_json builds it. */
-static bool metrics_write(api_ctx *ctx, api_svg_buf *b,
-                          const km_frame_metrics *m) {
+bool api__json_metrics(api_ctx *ctx, api_svg_buf *b,
+                       const km_frame_metrics *m) {
   API_JSON_LIT(b, "{\"length\":");
   if (!api__json_num(ctx, b, m->length, "length")) return false;
   API_JSON_LIT(b, ",\"max_abs_kappa\":");
@@ -96,8 +77,7 @@ static bool animate_write(api_ctx *ctx, api_svg_buf *b,
 /* One frame's object: its t, its curve, its metrics when asked for. */
 static bool frame_write(api_ctx *ctx, api_svg_buf *b, const api_morph_plan *pl,
                         const api_frame_slot *f, const api_grid *grid) {
-  if (pl->shapes)
-    return api__json_tree(ctx, b, api__shape_frame_json(ctx, pl, f));
+  if (pl->shapes) return api__shape_frame_write(ctx, b, pl, f);
   API_JSON_LIT(b, "{\"t\":");
   if (!api__json_num(ctx, b, f->t, "t")) return false;
   API_JSON_LIT(b, ",\"curve\":");
@@ -105,7 +85,7 @@ static bool frame_write(api_ctx *ctx, api_svg_buf *b, const api_morph_plan *pl,
     return false;
   if (pl->metrics) {
     API_JSON_LIT(b, ",\"metrics\":");
-    if (!metrics_write(ctx, b, &f->metrics)) return false;
+    if (!api__json_metrics(ctx, b, &f->metrics)) return false;
   }
   API_JSON_LIT(b, "}");
   return true;
@@ -126,8 +106,8 @@ static bool matches_used_write(api_ctx *ctx, api_svg_buf *b,
 }
 
 /* The JSON answer written straight into one buffer, frame after frame;
- * the compound morph's parts that are still built as trees (morph_shape.c)
- * are printed into it as they come. */
+ * only "intersections" (morph_crossings.c), once an answer, is still
+ * built as a tree and printed into it. */
 static api_status result_json(api_ctx *ctx, api_morph_plan *pl,
                               api_response *out) {
   api_svg_buf b;
@@ -144,7 +124,7 @@ static api_status result_json(api_ctx *ctx, api_morph_plan *pl,
   }
   if (pl->shapes) {
     API_JSON_LIT(&b, "],\"contour_matches_used\":");
-    if (!api__json_tree(ctx, &b, api__shape_pairs_json(ctx, pl))) goto fail;
+    if (!api__shape_pairs_write(ctx, &b, pl)) goto fail;
   } else {
     API_JSON_LIT(&b, "],\"matches_used\":");
     if (!matches_used_write(ctx, &b, pl->morph)) goto fail;
@@ -155,7 +135,7 @@ static api_status result_json(api_ctx *ctx, api_morph_plan *pl,
   }
   if (pl->inc.animate_d) {
     API_JSON_LIT(&b, ",\"animate_d\":");
-    if (pl->shapes ? !api__json_tree(ctx, &b, api__shape_animate_json(ctx, pl))
+    if (pl->shapes ? !api__shape_animate_write(ctx, &b, pl)
                    : !animate_write(ctx, &b, pl))
       goto fail;
   }

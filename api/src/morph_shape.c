@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "json_write.h"
 #include "km/alloc.h"
 #include "morph_plan.h"
 
@@ -412,131 +413,105 @@ done:
 
 /* ------------------------------------------------------------- printing */
 
-/* The paths of the frame's present contours joined into one "d". */
-static cJSON *joined_d(api_ctx *ctx, const km_shape_frame *sf, double tol) {
-  api_svg_buf b;
-  cJSON *s = NULL;
-  api__svg_buf_init(&b);
+/* The paths of the frame's present contours joined into one "d", as a
+ * JSON string. */
+static bool joined_d_write(api_ctx *ctx, api_svg_buf *b,
+                           const km_shape_frame *sf, double tol) {
+  api_svg_buf all;
+  api__svg_buf_init(&all);
   for (size_t k = 0; k < sf->ncontours; k++) {
     if (!sf->present[k]) continue;
     char *d = api_svg_path_d(&sf->contours[k], tol, NULL);
     if (d == NULL) {
-      b.failed = true;
-      break;
+      api__svg_buf_free(&all);
+      return api__oom(ctx);
     }
-    if (b.len > 0) api__svg_buf_put(&b, " ");
-    api__svg_buf_put(&b, d);
+    if (all.len > 0) api__svg_buf_put(&all, " ");
+    api__svg_buf_put(&all, d);
     km__free(d);
   }
-  char *all = api__svg_buf_take(&b);
-  if (all != NULL) s = cJSON_CreateString(all);
-  km__free(all);
-  if (s == NULL) api__oom(ctx);
-  return s;
+  char *s = api__svg_buf_take(&all);
+  if (s == NULL) return api__oom(ctx);
+  api__json_string(b, s);
+  km__free(s);
+  return true;
 }
 
 /* {"contours": [Metrics | null], "mutual_intersections", "nesting_ok"} */
-static cJSON *shape_metrics_json(api_ctx *ctx, const km_shape_frame *sf) {
-  cJSON *o = cJSON_CreateObject(), *a = cJSON_CreateArray(), *m;
-  if (o == NULL || a == NULL) {
-    cJSON_Delete(o);
-    cJSON_Delete(a);
-    api__oom(ctx);
-    return NULL;
-  }
-  if (!api__add_item(ctx, o, "contours", a)) goto fail;
+static bool shape_metrics_write(api_ctx *ctx, api_svg_buf *b,
+                                const km_shape_frame *sf) {
+  API_JSON_LIT(b, "{\"contours\":[");
   for (size_t k = 0; k < sf->ncontours; k++) {
-    m = sf->present[k] ? api__metrics_json(ctx, &sf->metrics[k])
-                       : cJSON_CreateNull();
-    if (m == NULL || !cJSON_AddItemToArray(a, m)) {
-      cJSON_Delete(m);
-      api__oom(ctx);
-      goto fail;
-    }
+    if (k > 0) API_JSON_LIT(b, ",");
+    if (!sf->present[k])
+      API_JSON_LIT(b, "null");
+    else if (!api__json_metrics(ctx, b, &sf->metrics[k]))
+      return false;
   }
-  if (!api__add_num(ctx, o, "mutual_intersections",
-                    (double)sf->mutual_intersections))
-    goto fail;
-  if (cJSON_AddBoolToObject(o, "nesting_ok", sf->nesting_ok) == NULL) {
-    api__oom(ctx);
-    goto fail;
-  }
-  return o;
-fail:
-  cJSON_Delete(o);
-  return NULL;
+  API_JSON_LIT(b, "],\"mutual_intersections\":");
+  if (!api__json_num(ctx, b, (double)sf->mutual_intersections,
+                     "mutual_intersections"))
+    return false;
+  if (sf->nesting_ok)
+    API_JSON_LIT(b, ",\"nesting_ok\":true}");
+  else
+    API_JSON_LIT(b, ",\"nesting_ok\":false}");
+  return true;
 }
 
-cJSON *api__shape_frame_json(api_ctx *ctx, const api_morph_plan *pl,
-                             const api_frame_slot *f) {
+bool api__shape_frame_write(api_ctx *ctx, api_svg_buf *b,
+                            const api_morph_plan *pl, const api_frame_slot *f) {
   const km_shape_frame *sf = &f->shape;
-  cJSON *fo = cJSON_CreateObject(), *a = cJSON_CreateArray(), *c;
-  if (fo == NULL || a == NULL) {
-    cJSON_Delete(fo);
-    cJSON_Delete(a);
-    api__oom(ctx);
-    return NULL;
-  }
-  if (!api__add_num(ctx, fo, "t", f->t)) {
-    cJSON_Delete(a);
-    goto fail;
-  }
-  if (!api__add_item(ctx, fo, "contours", a)) goto fail;
+  API_JSON_LIT(b, "{\"t\":");
+  if (!api__json_num(ctx, b, f->t, "t")) return false;
+  API_JSON_LIT(b, ",\"contours\":[");
   for (size_t k = 0; k < sf->ncontours; k++) {
-    c = sf->present[k] ? api__curve_json(ctx, &sf->contours[k], false, pl->tol)
-                       : cJSON_CreateNull();
-    if (c == NULL || !cJSON_AddItemToArray(a, c)) {
-      cJSON_Delete(c);
-      api__oom(ctx);
-      goto fail;
-    }
+    if (k > 0) API_JSON_LIT(b, ",");
+    if (!sf->present[k])
+      API_JSON_LIT(b, "null");
+    else if (!api__json_curve(ctx, b, &sf->contours[k], false, pl->tol, NULL,
+                              NULL))
+      return false;
   }
-  if (pl->inc.svg_d && ((c = joined_d(ctx, sf, pl->tol)) == NULL ||
-                        !api__add_item(ctx, fo, "svg_d", c)))
-    goto fail;
-  if (pl->metrics && ((c = shape_metrics_json(ctx, sf)) == NULL ||
-                      !api__add_item(ctx, fo, "metrics", c)))
-    goto fail;
-  return fo;
-fail:
-  cJSON_Delete(fo);
-  return NULL;
+  API_JSON_LIT(b, "]");
+  if (pl->inc.svg_d) {
+    API_JSON_LIT(b, ",\"svg_d\":");
+    if (!joined_d_write(ctx, b, sf, pl->tol)) return false;
+  }
+  if (pl->metrics) {
+    API_JSON_LIT(b, ",\"metrics\":");
+    if (!shape_metrics_write(ctx, b, sf)) return false;
+  }
+  API_JSON_LIT(b, "}");
+  return true;
 }
 
 /* A contour index of a pair, or null. */
-static cJSON *index_json(long i) {
-  return i >= 0 ? cJSON_CreateNumber((double)i) : cJSON_CreateNull();
+static void index_write(api_ctx *ctx, api_svg_buf *b, long i) {
+  if (i < 0)
+    API_JSON_LIT(b, "null");
+  else
+    api__json_num(ctx, b, (double)i, "contour index");
 }
 
-cJSON *api__shape_pairs_json(api_ctx *ctx, const api_morph_plan *pl) {
+bool api__shape_pairs_write(api_ctx *ctx, api_svg_buf *b,
+                            const api_morph_plan *pl) {
   size_t n = km_shape_morph_pairs(pl->smorph, NULL, 0);
   km_shape_pair *pairs = km__malloc((n ? n : 1) * sizeof *pairs);
-  cJSON *a = cJSON_CreateArray();
-  if (pairs == NULL || a == NULL) goto oom;
+  if (pairs == NULL) return api__oom(ctx);
   n = km_shape_morph_pairs(pl->smorph, pairs, n);
+  API_JSON_LIT(b, "[");
   for (size_t k = 0; k < n; k++) {
-    cJSON *pr = cJSON_CreateArray();
-    cJSON *i = index_json(pairs[k].from), *j = index_json(pairs[k].to);
-    bool ok =
-        pr != NULL && i != NULL && j != NULL && cJSON_AddItemToArray(pr, i);
-    if (ok) i = NULL;
-    ok = ok && cJSON_AddItemToArray(pr, j);
-    if (ok) j = NULL;
-    ok = ok && cJSON_AddItemToArray(a, pr);
-    if (!ok) {
-      cJSON_Delete(i);
-      cJSON_Delete(j);
-      cJSON_Delete(pr);
-      goto oom;
-    }
+    if (k > 0) API_JSON_LIT(b, ",");
+    API_JSON_LIT(b, "[");
+    index_write(ctx, b, pairs[k].from);
+    API_JSON_LIT(b, ",");
+    index_write(ctx, b, pairs[k].to);
+    API_JSON_LIT(b, "]");
   }
+  API_JSON_LIT(b, "]");
   km__free(pairs);
-  return a;
-oom:
-  km__free(pairs);
-  cJSON_Delete(a);
-  api__oom(ctx);
-  return NULL;
+  return true;
 }
 
 /* Where each slot's contour is a point while collapsed, 2 doubles a slot
@@ -549,12 +524,13 @@ static double *collapse_points(const km_shape_morph *m, size_t n) {
   return p;
 }
 
-cJSON *api__shape_animate_json(api_ctx *ctx, const api_morph_plan *pl) {
+bool api__shape_animate_write(api_ctx *ctx, api_svg_buf *b,
+                              const api_morph_plan *pl) {
   size_t n = km_shape_morph_pairs(pl->smorph, NULL, 0);
   size_t *pieces = km__malloc((n ? n : 1) * sizeof *pieces);
   double *collapse = collapse_points(pl->smorph, n);
-  cJSON *a = NULL, *s;
-  if (pieces == NULL || collapse == NULL) goto oom;
+  bool ok = false;
+  if (pieces == NULL || collapse == NULL) goto done;
   for (size_t k = 0; k < n; k++) pieces[k] = 1;
   /* one piece count per slot, the most any frame needs, and a collapsed
    * contour drawn as a point with its slot's pieces: then every frame
@@ -564,31 +540,27 @@ cJSON *api__shape_animate_json(api_ctx *ctx, const api_morph_plan *pl) {
     for (size_t k = 0; k < n && k < sf->ncontours; k++) {
       if (!sf->present[k]) continue;
       char *d = api_svg_path_d(&sf->contours[k], pl->tol, NULL);
-      if (d == NULL) goto oom;
+      if (d == NULL) goto done;
       size_t p = api__count_pieces(d);
       pieces[k] = p > pieces[k] ? p : pieces[k];
       km__free(d);
     }
   }
-  if ((a = cJSON_CreateArray()) == NULL) goto oom;
+  API_JSON_LIT(b, "[");
   for (size_t i = 0; i < pl->nframes; i++) {
     char *d = api_svg_shape_frame_d(&pl->frames[i].shape, pieces, collapse);
-    s = d != NULL ? cJSON_CreateString(d) : NULL;
+    if (d == NULL) goto done;
+    if (i > 0) API_JSON_LIT(b, ",");
+    api__json_string(b, d);
     km__free(d);
-    if (s == NULL || !cJSON_AddItemToArray(a, s)) {
-      cJSON_Delete(s);
-      goto oom;
-    }
   }
+  API_JSON_LIT(b, "]");
+  ok = true;
+done:
+  if (!ok) api__oom(ctx);
   km__free(pieces);
   km__free(collapse);
-  return a;
-oom:
-  api__oom(ctx);
-  km__free(pieces);
-  km__free(collapse);
-  cJSON_Delete(a);
-  return NULL;
+  return ok;
 }
 
 char *api__shape_svg(const api_morph_plan *pl) {

@@ -64,6 +64,10 @@ double km__bspan_noise(const km__bspan *sp);
 /* Span index i with knots[i] <= t < knots[i+1] (last non-empty span at the
  * domain end); side < 0 picks knots[i] < t <= knots[i+1]. */
 size_t km__find_span(const km_curve *c, double t, int side);
+/* km_curve_eval_side on span i, found by the caller (the same digits as
+ * when km__find_span finds it): t in the span's closure, nder in 0..3. */
+void km__curve_eval_span(const km_curve *c, size_t i, double t, int nder,
+                         double out[][2]);
 
 /* km_curve_transform on c itself (a valid curve): rotation about the
  * origin by rot, then translation; KM_ERANGE past KM_MAX_COORDINATE (c is

@@ -280,8 +280,12 @@ void km_curve_eval_side(const km_curve *c, double t, int side, int nder,
   if (t > t1) t = t1;
   if (nder > 3) nder = 3;
   if (nder < 0) nder = 0;
+  km__curve_eval_span(c, km__find_span(c, t, side), t, nder, out);
+}
+
+void km__curve_eval_span(const km_curve *c, size_t i, double t, int nder,
+                         double out[][2]) {
   int p = c->degree;
-  size_t i = km__find_span(c, t, side);
   double ders[4][KM_MAX_DEGREE + 1];
   int nd = nder < p ? nder : p;
   basis_ders(c->knots, i, p, t, nd, ders);

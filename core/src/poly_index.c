@@ -25,7 +25,7 @@
 static size_t band_of(const km__poly_index *ix, double y) {
   double u = (y - ix->y0) * ix->inv_h;
   if (!(u >= 0.0)) return 0;
-  if (u >= (double)ix->nbands) return ix->nbands - 1;
+  if (u >= ix->nbands_f) return ix->nbands - 1;
   return (size_t)u;
 }
 
@@ -33,13 +33,31 @@ static const double *vertex(const km__poly_index *ix, size_t i) {
   return ix->P + 2 * (i == ix->np ? 0 : i);
 }
 
-/* Entries the listing takes with nbands bands (SIZE_MAX past limit). */
-static size_t count_entries(km__poly_index *ix, size_t limit) {
+/* The smaller and larger of two numbers that are not NaN, as fmin and
+ * fmax give them but inline (a zero's sign does not matter to band_of). */
+static double lower(double a, double b) {
+  return b < a ? b : a;
+}
+static double upper(double a, double b) {
+  return b > a ? b : a;
+}
+
+/* Entries the listing takes with nbands bands (SIZE_MAX past limit), and
+ * each edge's first and last band in range[2 i], range[2 i + 1]
+ * (UINT32_MAX first for an edge with a NaN, which never counts). */
+static size_t count_entries(km__poly_index *ix, size_t limit, uint32_t *range) {
   size_t total = 0;
   for (size_t i = 0; i < ix->np; i++) {
     const double *a = vertex(ix, i), *b = vertex(ix, i + 1);
-    if (!(a[1] == a[1] && b[1] == b[1])) continue; /* NaN: never counts */
-    total += band_of(ix, fmax(a[1], b[1])) - band_of(ix, fmin(a[1], b[1])) + 1;
+    if (!(a[1] == a[1] && b[1] == b[1])) {
+      range[2 * i] = UINT32_MAX;
+      continue;
+    }
+    size_t lo = band_of(ix, lower(a[1], b[1]));
+    size_t hi = band_of(ix, upper(a[1], b[1]));
+    range[2 * i] = (uint32_t)lo;
+    range[2 * i + 1] = (uint32_t)hi;
+    total += hi - lo + 1;
     if (total > limit) return SIZE_MAX;
   }
   return total;
@@ -62,36 +80,42 @@ km_status km__poly_index_build(km__poly_index *ix, const double *P, size_t np) {
   ix->np = np;
   double y0 = INFINITY, y1 = -INFINITY;
   for (size_t i = 0; i < np; i++) {
-    y0 = fmin(y0, P[2 * i + 1]);
-    y1 = fmax(y1, P[2 * i + 1]);
+    double y = P[2 * i + 1]; /* a NaN is skipped, as fmin and fmax do */
+    if (y < y0) y0 = y;
+    if (y > y1) y1 = y;
   }
   ix->y0 = y0;
   ix->y1 = y1;
   ix->nbands = np / 4 > 1 ? np / 4 : 1;
   if (ix->nbands > ((size_t)1 << 16)) ix->nbands = (size_t)1 << 16;
+  /* bands are at most 2^16: an edge's range fits in two uint32_t */
+  uint32_t *range = km__malloc((np ? 2 * np : 2) * sizeof *range);
+  if (!range) {
+    km__poly_index_free(ix);
+    return KM_ENOMEM;
+  }
   size_t total;
   for (;;) {
-    ix->inv_h = y1 > y0 ? (double)ix->nbands / (y1 - y0) : 0.0;
-    total = count_entries(ix, 8 * np + ix->nbands);
+    ix->nbands_f = (double)ix->nbands;
+    ix->inv_h = y1 > y0 ? ix->nbands_f / (y1 - y0) : 0.0;
+    total = count_entries(ix, 8 * np + ix->nbands, range);
     if (total != SIZE_MAX || ix->nbands == 1) break;
     ix->nbands /= 2;
   }
-  if (total == SIZE_MAX) total = count_entries(ix, SIZE_MAX - 1);
+  if (total == SIZE_MAX) total = count_entries(ix, SIZE_MAX - 1, range);
   ix->start = km__calloc(ix->nbands + 1, sizeof *ix->start);
   ix->edge = km__malloc((total ? total : 1) * sizeof *ix->edge);
   ix->seen = km__calloc(np ? np : 1, sizeof *ix->seen);
   if (!ix->start || !ix->edge || !ix->seen) {
+    km__free(range);
     km__poly_index_free(ix);
     return KM_ENOMEM;
   }
   /* counting sort of (band, edge): counts, offsets, then places */
   for (int pass = 0; pass < 2; pass++) {
     for (size_t i = 0; i < np; i++) {
-      const double *a = vertex(ix, i), *b = vertex(ix, i + 1);
-      if (!(a[1] == a[1] && b[1] == b[1])) continue;
-      size_t lo = band_of(ix, fmin(a[1], b[1]));
-      size_t hi = band_of(ix, fmax(a[1], b[1]));
-      for (size_t k = lo; k <= hi; k++)
+      if (range[2 * i] == UINT32_MAX) continue;
+      for (size_t k = range[2 * i]; k <= range[2 * i + 1]; k++)
         if (pass == 0)
           ix->start[k + 1]++;
         else
@@ -105,6 +129,7 @@ km_status km__poly_index_build(km__poly_index *ix, const double *P, size_t np) {
       ix->start[0] = 0;
     }
   }
+  km__free(range);
   return KM_OK;
 }
 
@@ -115,7 +140,8 @@ int km__poly_index_winding(const km__poly_index *ix, const double p[2]) {
   int w = 0;
   for (size_t e = ix->start[k]; e < ix->start[k + 1]; e++) {
     size_t i = ix->edge[e];
-    w += km__edge_winding(vertex(ix, i), vertex(ix, i + 1), p);
+    const double *a = ix->P + 2 * i, *b = i + 1 == ix->np ? ix->P : a + 2;
+    w += km__edge_winding(a, b, p);
   }
   return w;
 }

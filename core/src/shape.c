@@ -13,6 +13,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "bspline_internal.h"
 #include "km/alloc.h"
 #include "km/limits.h"
 #include "km/shape.h"
@@ -26,24 +27,18 @@ km_status km__shape_flatten(const km_curve *c, double **pts, size_t *np) {
   for (size_t i = (size_t)c->degree; i < c->n; i++)
     if (c->knots[i + 1] > c->knots[i]) spans++;
   size_t n = spans * KM_SHAPE_FLAT + 1, k = 0;
-  double *p = km__malloc(2 * n * sizeof *p);
+  double *p = km__malloc(2 * n * sizeof *p), der[2];
   if (!p) return KM_ENOMEM;
+  /* each span once in Bezier form, its points by Horner there (a valid
+   * curve has a non-empty span, so sp is set at the end) */
+  km__bspan sp = {0};
   for (size_t i = (size_t)c->degree; i < c->n; i++) {
-    double a = c->knots[i], b = c->knots[i + 1];
-    if (!(b > a)) continue;
-    for (size_t j = 0; j < KM_SHAPE_FLAT; j++) {
-      double d[1][2];
-      km_curve_eval(c, a + (b - a) * (double)j / KM_SHAPE_FLAT, 0, d);
-      p[2 * k] = d[0][0];
-      p[2 * k + 1] = d[0][1];
-      k++;
-    }
+    if (!(c->knots[i + 1] > c->knots[i])) continue;
+    km__bspan_make(&sp, c, i);
+    for (size_t j = 0; j < KM_SHAPE_FLAT; j++, k++)
+      km__bspan_eval_u(&sp, (double)j / KM_SHAPE_FLAT, p + 2 * k, der);
   }
-  double t0, t1, d[1][2];
-  km_curve_domain(c, &t0, &t1);
-  km_curve_eval(c, t1, 0, d);
-  p[2 * k] = d[0][0];
-  p[2 * k + 1] = d[0][1];
+  km__bspan_eval_u(&sp, 1.0, p + 2 * k, der);
   *pts = p;
   *np = k + 1;
   return KM_OK;
@@ -65,10 +60,111 @@ static const double GL_W[8] = {0.1012285362903763, 0.2223810344533745,
                                0.3626837833783620, 0.3137066458778873,
                                0.2223810344533745, 0.1012285362903763};
 
-/* Green: A = 1/2 closed integral (x dy - y dx), A cx = 1/2 integral x^2 dy,
- * A cy = -1/2 integral y^2 dx. */
-void km__curve_area(const km_curve *c, double *area, double centroid[2]) {
-  double a2 = 0.0, mx = 0.0, my = 0.0;
+/* Gauss-Legendre rules on [0, 1] for a polynomial span of degree p: the
+ * ceil(3p / 2) points GLU_X[GLU_AT[p] .. GLU_AT[p + 1]), exact for
+ * polynomials of degree 3p - 1, the highest of Green's integrands
+ * (x^2 dy). Nodes and weights correctly rounded from 40 digits. */
+/* clang-format off */
+static const double GLU_X[70] = {
+    /* p = 1: 2 points */
+    0.21132486540518711, 0.78867513459481287,
+    /* p = 2: 3 points */
+    0.11270166537925831, 0.5, 0.8872983346207417,
+    /* p = 3: 5 points */
+    0.046910077030668004, 0.23076534494715845, 0.5, 0.7692346550528415,
+    0.95308992296933204,
+    /* p = 4: 6 points */
+    0.033765242898423989, 0.16939530676686773, 0.38069040695840156,
+    0.61930959304159849, 0.83060469323313224, 0.96623475710157603,
+    /* p = 5: 8 points */
+    0.019855071751231884, 0.10166676129318664, 0.2372337950418355,
+    0.40828267875217511, 0.59171732124782495, 0.7627662049581645,
+    0.89833323870681336, 0.98014492824876809,
+    /* p = 6: 9 points */
+    0.015919880246186954, 0.081984446336682101, 0.19331428364970479,
+    0.33787328829809554, 0.5, 0.66212671170190451, 0.80668571635029518,
+    0.91801555366331788, 0.98408011975381304,
+    /* p = 7: 11 points */
+    0.010885670926971503, 0.056468700115952349, 0.13492399721297535,
+    0.2404519353965941, 0.36522842202382749, 0.5, 0.63477157797617245,
+    0.75954806460340596, 0.86507600278702468, 0.9435312998840476,
+    0.98911432907302854,
+    /* p = 8: 12 points */
+    0.0092196828766403748, 0.047941371814762573, 0.11504866290284765,
+    0.20634102285669129, 0.31608425050090988, 0.43738329574426554,
+    0.56261670425573451, 0.68391574949909006, 0.79365897714330869,
+    0.88495133709715235, 0.95205862818523745, 0.99078031712335968,
+    /* p = 9: 14 points */
+    0.0068580956515938308, 0.035782558168213241, 0.086399342465117504,
+    0.15635354759415726, 0.24237568182092295, 0.34044381553605513,
+    0.44597252564632817, 0.55402747435367183, 0.65955618446394493,
+    0.75762431817907705, 0.84364645240584268, 0.91360065753488251,
+    0.9642174418317867, 0.99314190434840621
+};
+static const double GLU_W[70] = {
+    /* p = 1: 2 points */
+    0.5, 0.5,
+    /* p = 2: 3 points */
+    0.27777777777777779, 0.44444444444444442, 0.27777777777777779,
+    /* p = 3: 5 points */
+    0.11846344252809454, 0.23931433524968324, 0.28444444444444444,
+    0.23931433524968324, 0.11846344252809454,
+    /* p = 4: 6 points */
+    0.085662246189585178, 0.1803807865240693, 0.23395696728634552,
+    0.23395696728634552, 0.1803807865240693, 0.085662246189585178,
+    /* p = 5: 8 points */
+    0.050614268145188129, 0.11119051722668724, 0.15685332293894363,
+    0.181341891689181, 0.181341891689181, 0.15685332293894363,
+    0.11119051722668724, 0.050614268145188129,
+    /* p = 6: 9 points */
+    0.040637194180787206, 0.090324080347428698, 0.13030534820146772,
+    0.15617353852000143, 0.16511967750062989, 0.15617353852000143,
+    0.13030534820146772, 0.090324080347428698, 0.040637194180787206,
+    /* p = 7: 11 points */
+    0.027834283558086832, 0.062790184732452306, 0.093145105463867131,
+    0.11659688229599524, 0.13140227225512333, 0.13646254338895031,
+    0.13140227225512333, 0.11659688229599524, 0.093145105463867131,
+    0.062790184732452306, 0.027834283558086832,
+    /* p = 8: 12 points */
+    0.023587668193255914, 0.053469662997659213, 0.080039164271673111,
+    0.10158371336153296, 0.1167462682691774, 0.12457352290670139,
+    0.12457352290670139, 0.1167462682691774, 0.10158371336153296,
+    0.080039164271673111, 0.053469662997659213, 0.023587668193255914,
+    /* p = 9: 14 points */
+    0.01755973016587593, 0.040079043579880104, 0.060759285343951593,
+    0.078601583579096773, 0.092769198738968911, 0.1025992318606478,
+    0.1076319267315789, 0.1076319267315789, 0.1025992318606478,
+    0.092769198738968911, 0.078601583579096773, 0.060759285343951593,
+    0.040079043579880104, 0.01755973016587593
+};
+static const unsigned char GLU_AT[KM_MAX_DEGREE + 2] = {
+    0, 0, 2, 5, 10, 16, 24, 33, 44, 56, 70};
+/* clang-format on */
+
+/* The sums of Green's integrands over a polynomial curve about the point
+ * o, span by span in Bezier form: exact up to rounding. */
+static void polynomial_green(const km_curve *c, const double o[2],
+                             double s[3]) {
+  int p = c->degree;
+  const double *gx = GLU_X + GLU_AT[p], *gw = GLU_W + GLU_AT[p];
+  int m = GLU_AT[p + 1] - GLU_AT[p];
+  for (size_t i = (size_t)p; i < c->n; i++) {
+    if (!(c->knots[i + 1] > c->knots[i])) continue;
+    km__bspan sp;
+    km__bspan_make(&sp, c, i);
+    for (int k = 0; k < m; k++) {
+      double pos[2], der[2];
+      km__bspan_eval_u(&sp, gx[k], pos, der);
+      double x = pos[0] - o[0], y = pos[1] - o[1], dx = der[0], dy = der[1];
+      s[0] += gw[k] * (x * dy - y * dx);
+      s[1] += gw[k] * x * x * dy;
+      s[2] -= gw[k] * y * y * dx;
+    }
+  }
+}
+
+/* The same for a rational curve: 8 points on each quarter of a span. */
+static void rational_green(const km_curve *c, const double o[2], double s[3]) {
   for (size_t i = (size_t)c->degree; i < c->n; i++) {
     double a = c->knots[i], b = c->knots[i + 1];
     if (!(b > a)) continue;
@@ -76,18 +172,33 @@ void km__curve_area(const km_curve *c, double *area, double centroid[2]) {
       double lo = a + (b - a) * panel / 4.0, h = (b - a) / 4.0;
       for (int k = 0; k < 8; k++) {
         double d[2][2];
-        km_curve_eval(c, lo + 0.5 * h * (GL_X[k] + 1.0), 1, d);
+        km__curve_eval_span(c, i, lo + 0.5 * h * (GL_X[k] + 1.0), 1, d);
         double wk = 0.5 * h * GL_W[k];
-        double x = d[0][0], y = d[0][1], dx = d[1][0], dy = d[1][1];
-        a2 += wk * (x * dy - y * dx);
-        mx += wk * x * x * dy;
-        my -= wk * y * y * dx;
+        double x = d[0][0] - o[0], y = d[0][1] - o[1];
+        double dx = d[1][0], dy = d[1][1];
+        s[0] += wk * (x * dy - y * dx);
+        s[1] += wk * x * x * dy;
+        s[2] -= wk * y * y * dx;
       }
     }
   }
+}
+
+/* Green: A = 1/2 closed integral (x dy - y dx), A cx = 1/2 integral x^2 dy,
+ * A cy = -1/2 integral y^2 dx, with x and y taken from the start point:
+ * the same on a closed curve (the integrals of dx and dy vanish), a
+ * chord's closing of a small gap otherwise, and without the cancellation
+ * of coordinates far larger than the contour (one that is vanishing). */
+void km__curve_area(const km_curve *c, double *area, double centroid[2]) {
+  double s[3] = {0.0, 0.0, 0.0}, o[2] = {c->cp[0], c->cp[1]};
+  if (c->w)
+    rational_green(c, o, s);
+  else
+    polynomial_green(c, o, s);
+  double a2 = s[0];
   *area = 0.5 * a2;
-  centroid[0] = a2 != 0.0 ? mx / a2 : NAN;
-  centroid[1] = a2 != 0.0 ? my / a2 : NAN;
+  centroid[0] = a2 != 0.0 ? o[0] + s[1] / a2 : NAN;
+  centroid[1] = a2 != 0.0 ? o[1] + s[2] / a2 : NAN;
 }
 
 long km__poly_crossings(const double *P, size_t np, const double *Q, size_t nq,
@@ -417,7 +528,9 @@ void km__poly_interior_point(const km__poly_index *ix, const double x[2],
       double q[2] = {0.5 * (a[0] + b[0]) - side * delta * dy / l,
                      0.5 * (a[1] + b[1]) + side * delta * dx / l};
       double d = hypot(q[0] - x[0], q[1] - x[1]);
-      if (d < best && km__poly_index_winding(ix, q) != 0) {
+      /* of points at the same distance within rounding (x on a symmetry
+       * axis of P) the last, whatever the rounding of x */
+      if (d <= best * (1.0 + 1e-9) && km__poly_index_winding(ix, q) != 0) {
         best = d;
         out[0] = q[0];
         out[1] = q[1];

@@ -376,7 +376,8 @@ static void apply_fix(const km_shape_morph *m, double t, km_shape_frame *f,
   if (d[0] != 0.0 || d[1] != 0.0) translate(f, k, fs, d);
 }
 
-/* Placement and nesting adjustment parents first, then the metrics. */
+/* Placement and nesting adjustment parents first, then the metrics
+ * unless only the sizes are asked for (ratio not NULL). */
 static km_status finish(const km_shape_morph *m, double t, km_shape_frame *f,
                         flats *fs, km__poll *poll, double *ratio) {
   int maxd = 0;
@@ -401,6 +402,8 @@ static km_status finish(const km_shape_morph *m, double t, km_shape_frame *f,
       if (ratio) ratio[k] = r;
       if (moved) f->adjusted++;
     }
+  /* the sizes alone (km__shape_frame_ratios) need no frame metrics */
+  if (ratio) return KM_OK;
   f->nesting_ok = true;
   for (size_t k = 0; k < f->ncontours; k++) {
     long p = f->parent[k];

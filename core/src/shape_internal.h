@@ -55,8 +55,9 @@ typedef struct km__poly_index {
   size_t np;
   double y0, y1, inv_h; /* P's height range; bands per unit of height */
   size_t nbands;
-  size_t *start;  /* nbands + 1: band k lists edge[start[k] .. start[k+1]) */
-  uint32_t *edge; /* edge i joins point i to point i + 1 (mod np) */
+  double nbands_f; /* nbands as a double: band_of compares with it */
+  size_t *start;   /* nbands + 1: band k lists edge[start[k] .. start[k+1]) */
+  uint32_t *edge;  /* edge i joins point i to point i + 1 (mod np) */
   size_t *seen, stamp; /* crossings: an edge once for each edge of the other */
 } km__poly_index;
 
@@ -76,9 +77,10 @@ void km__poly_interior_point(const km__poly_index *ix, const double x[2],
                              double out[2]);
 
 /* Signed area (counter-clockwise positive) and area centroid of a closed
- * curve by Gauss-Legendre quadrature of Green's formulas, exact up to
- * rounding for polynomial curves of degree <= 4 (8 points on 4 panels a
- * span). */
+ * curve by Gauss-Legendre quadrature of Green's formulas: for a polynomial
+ * curve ceil(3p / 2) points a span in its Bezier form, exact up to
+ * rounding at any degree; for a rational one 8 points on each quarter of
+ * a span (not exact: the integrands are rational). */
 void km__curve_area(const km_curve *c, double *area, double centroid[2]);
 
 /* Number of proper crossings between polylines P (np points) and Q (nq

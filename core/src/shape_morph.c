@@ -94,7 +94,9 @@ static long nearest_host(const km_shape_morph *m, const km_shape *s,
     long i = from ? m->pairs[k].from : m->pairs[k].to;
     if (s->parent[i] >= 0) continue;
     double d = hypot(s->centroid[2 * i] - c[0], s->centroid[2 * i + 1] - c[1]);
-    if (d < bd) {
+    /* hosts at the same distance (a symmetric shape's) within rounding:
+     * the first, whatever the rounding of the centroids */
+    if (d < bd * (1.0 - 1e-9)) {
       bd = d;
       best = (long)k;
     }
