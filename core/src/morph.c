@@ -106,8 +106,9 @@ static km_status plan_frames(km_morph *m, km_error *err) {
   size_t max_pieces = 0;
   if (m->opt.max_points > 0)
     max_pieces = m->opt.max_points >= 4 ? (m->opt.max_points - 2) / 2 : 1;
+  double share = m->keep_pieces ? KM__PLAN_KEPT_SHARE : KM__PLAN_PIECE_SHARE;
   km_status st = km__frame_plan_build(&m->plan, tp, len, ang, m->closed, m->tol,
-                                      max_pieces, m->poll, err);
+                                      share, max_pieces, m->poll, err);
   if (st == KM_ELIMIT && max_pieces > 0)
     return km__fail(err, KM_ELIMIT, KM_FIELD_TOLERANCE, -1, NAN,
                     "the frames need more than %zu control points at this "
@@ -470,8 +471,16 @@ done:
   return st;
 }
 
-void km__morph_keep_pieces(km_morph *m) {
+km_status km__morph_keep_pieces(km_morph *m, km_error *err) {
   m->keep_pieces = true;
+  if (!m->plan) return KM_OK;
+  /* planned again with the pieces' share of unmerged frames: fewer
+   * pieces, the same frames within the tolerance */
+  km__frame_plan_free(m->plan);
+  m->plan = NULL;
+  km__free(m->place_ab);
+  m->place_ab = NULL;
+  return plan_frames(m, err);
 }
 
 km_status km__morph_frame(const km_morph *m, double t, km__poll *poll,

@@ -132,8 +132,10 @@ km_status km__avoid_crossings(km_morph **mp, km__poll *poll);
  * crosses) with the report in m->avoid. KM_OK, KM_ENOMEM or
  * KM_ECANCELLED (then m is as it was). */
 /* Planned frames of m keep the plan's pieces from here on, unmerged (the
- * contours of a compound morph, shape_morph.c). */
-void km__morph_keep_pieces(km_morph *m);
+ * contours of a compound morph, shape_morph.c), planned again within
+ * KM__PLAN_KEPT_SHARE of the tolerance. KM_OK, KM_ENOMEM (m then has no
+ * plan: its frames take the general path). */
+km_status km__morph_keep_pieces(km_morph *m, km_error *err);
 km_status km__repair_crossings(km_morph *m, km__repair_method how,
                                km__poll *poll);
 void km__repair_free(km__repair *rp);

@@ -601,8 +601,9 @@ static km_status warm_corrections(km__frame_plan *p, km__poll *poll) {
 
 km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2],
                                const double length[2], const double angle[2],
-                               bool closed, double tol, size_t max_pieces,
-                               km__poll *poll, km_error *err) {
+                               bool closed, double tol, double piece_share,
+                               size_t max_pieces, km__poll *poll,
+                               km_error *err) {
   builder b;
   memset(&b, 0, sizeof b);
   for (int w = 0; w < 2; w++) {
@@ -614,7 +615,7 @@ km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2],
   b.Lmax = fmax(length[0], length[1]);
   /* the Hermite pieces take their share of the tolerance (per unit of
    * r), the frames' merging of them the rest of half of it */
-  double tolp = KM__PLAN_PIECE_SHARE * tol / b.Lmax;
+  double tolp = piece_share * tol / b.Lmax;
   size_t np = 0;
   km_status st = KM_OK;
   b.g = km__malloc(sizeof *b.g);

@@ -16,18 +16,33 @@
 
 typedef struct km__frame_plan km__frame_plan;
 
+/* Shares of the tolerance: the planned Hermite pieces (a bound for every
+ * t), and the merging of runs of them into single cubics in each frame (a
+ * bound per frame, against the pieces). With the quadrature's tenth and
+ * the merged input pieces' tenth a frame is within 0.9 of it of the exact
+ * frame (the general path's reconstruction takes 0.9 too), and frames 0
+ * and 1 within the tolerance of the inputs with their signatures' tenth. */
+#define KM__PLAN_PIECE_SHARE 0.2
+#define KM__PLAN_MERGE_SHARE (0.7 - KM__PLAN_PIECE_SHARE)
+/* Share of the pieces of frames that keep them unmerged (the contours of
+ * compound shapes): as before merging existed. */
+#define KM__PLAN_KEPT_SHARE 0.5
+
 /* Plans frames between two inputs given as theta pieces in their own arc
  * length (km__build_theta), with lengths and start angles. Every frame
  * built from the plan is within tol of the exact frame (tol: the frame
- * tolerance; a half goes to the Hermite pieces, a tenth to the quadrature
+ * tolerance; piece_share of it goes to the Hermite pieces
+ * (KM__PLAN_PIECE_SHARE for frames that merge them, KM__PLAN_KEPT_SHARE
+ * for frames that keep them), the rest of 0.7 to merging them, a tenth to the quadrature
  * and a tenth to merging the inputs' pieces). More than max_pieces pieces
  * a frame (0: no bound but memory) fails with KM_ELIMIT, early: the
  * uniform splits are refused past twice that before their bounds are
  * taken. Stops (KM_ECANCELLED) when poll says so (NULL: never). */
 km_status km__frame_plan_build(km__frame_plan **out, const km_pp theta[2],
                                const double length[2], const double angle[2],
-                               bool closed, double tol, size_t max_pieces,
-                               km__poll *poll, km_error *err);
+                               bool closed, double tol, double piece_share,
+                               size_t max_pieces, km__poll *poll,
+                               km_error *err);
 void km__frame_plan_free(km__frame_plan *p);
 size_t km__frame_plan_pieces(const km__frame_plan *p);
 size_t km__frame_plan_nodes(const km__frame_plan *p);

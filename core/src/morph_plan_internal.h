@@ -16,15 +16,6 @@
  * theirs (WARM_POINTS + 1 of them, zero at both ends) */
 #define WARM_POINTS 6
 
-/* Shares of the tolerance: the planned Hermite pieces (a bound for every
- * t), and the merging of runs of them into single cubics in each frame (a
- * bound per frame, against the pieces). With the quadrature's tenth and
- * the merged input pieces' tenth a frame is within 0.9 of it of the exact
- * frame (the general path's reconstruction takes 0.9 too), and frames 0
- * and 1 within the tolerance of the inputs with their signatures' tenth. */
-#define KM__PLAN_PIECE_SHARE 0.2
-#define KM__PLAN_MERGE_SHARE (0.7 - KM__PLAN_PIECE_SHARE)
-
 typedef struct gnode {
   double w;      /* weight in r */
   double ta, tb; /* Ta(r), Tb(r) at the node */

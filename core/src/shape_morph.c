@@ -180,7 +180,7 @@ static km_status morph_pair(km_shape_morph *m, size_t k, const km_shape *a,
   /* contours keep their frames' planned pieces: the placement, the
    * corrections and the checks between contours sample each contour
    * by its parameter, which merged runs no longer keep in arc length */
-  if (st == KM_OK) km__morph_keep_pieces(m->morphs[k]);
+  if (st == KM_OK) st = km__morph_keep_pieces(m->morphs[k], err);
   if (st != KM_OK && err && st != KM_ECANCELLED) err->index = (long)k;
   return st;
 }
