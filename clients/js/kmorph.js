@@ -504,8 +504,13 @@ export function curveToPath(curve, { pieces } = {}) {
  * last at its ends), by dense sampling and chord-length resampling. */
 export function samplePoints(curve, n = 200, { perSpan = 24 } = {}) {
   const dense = [], cum = [0];
-  for (const [k, a, b] of spans(curve))
-    for (let i = dense.length ? 1 : 0; i <= perSpan; i++) dense.push(evalCurve(curve, a + (b - a) * i / perSpan, k)[0]);
+  const all = [...spans(curve)];
+  /* at least eight dense points a sample: a frame of few long pieces (a
+   * circle in eight) sampled 24 to a piece cuts chords 1.3e-4 of its
+   * radius inside it */
+  const per = Math.max(perSpan, Math.ceil((8 * n) / Math.max(1, all.length)));
+  for (const [k, a, b] of all)
+    for (let i = dense.length ? 1 : 0; i <= per; i++) dense.push(evalCurve(curve, a + (b - a) * i / per, k)[0]);
   for (let i = 1; i < dense.length; i++)
     cum.push(cum[i - 1] + Math.hypot(dense[i][0] - dense[i - 1][0], dense[i][1] - dense[i - 1][1]));
   const total = cum[cum.length - 1], out = [];

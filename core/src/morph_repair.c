@@ -385,23 +385,51 @@ static km_status strand_sample(strand *s, const km_curve *f, double r0,
   return KM_OK;
 }
 
+/* The largest of three numbers (comparisons: no call). */
+static inline double fmax3(double a, double b, double c) {
+  double m = a > b ? a : b;
+  return m > c ? m : c;
+}
+
+/* Squared distance from p to segment k of y and its fraction *lam. */
+static inline double seg_dist2(const double (*y)[2], size_t k,
+                               const double p[2], double *lam) {
+  double ex = y[k + 1][0] - y[k][0], ey = y[k + 1][1] - y[k][1];
+  double ee = ex * ex + ey * ey;
+  double l =
+      ee > 0 ? ((p[0] - y[k][0]) * ex + (p[1] - y[k][1]) * ey) / ee : 0.0;
+  l = fmin(1.0, fmax(0.0, l));
+  double qx = y[k][0] + l * ex - p[0], qy = y[k][1] + l * ey - p[1];
+  *lam = l;
+  return qx * qx + qy * qy;
+}
+
 /* The nearest point to p on the polyline y[0..n): its segment k and
- * fraction lam; false when the nearest is an end of the polyline (the
- * other strand does not face p). */
+ * fraction lam (the first segment of the least distance); false when the
+ * nearest is an end of the polyline (the other strand does not face p).
+ * hint (or n for none) is a segment to try first: the previous sample's,
+ * so that the segments whose boxes lie farther than it are passed over
+ * without their division (the margin covers the rounding of the
+ * distances); the answer is the one of the plain scan. */
 static bool project(const double (*y)[2], size_t n, const double p[2],
-                    size_t *k_out, double *lam_out, double *dist2) {
+                    size_t hint, size_t *k_out, double *lam_out,
+                    double *dist2) {
   double best = INFINITY;
   size_t bk = 0;
   double bl = 0;
+  if (hint + 1 < n) {
+    best = seg_dist2(y, hint, p, &bl);
+    bk = hint;
+  }
   for (size_t k = 0; k + 1 < n; k++) {
-    double ex = y[k + 1][0] - y[k][0], ey = y[k + 1][1] - y[k][1];
-    double ee = ex * ex + ey * ey;
-    double lam =
-        ee > 0 ? ((p[0] - y[k][0]) * ex + (p[1] - y[k][1]) * ey) / ee : 0.0;
-    lam = fmin(1.0, fmax(0.0, lam));
-    double qx = y[k][0] + lam * ex - p[0], qy = y[k][1] + lam * ey - p[1];
-    double d2 = qx * qx + qy * qy;
-    if (d2 < best) {
+    double x0 = y[k][0], x1 = y[k + 1][0], y0 = y[k][1], y1 = y[k + 1][1];
+    double bx = x0 < x1 ? fmax3(x0 - p[0], p[0] - x1, 0.0)
+                        : fmax3(x1 - p[0], p[0] - x0, 0.0);
+    double by = y0 < y1 ? fmax3(y0 - p[1], p[1] - y1, 0.0)
+                        : fmax3(y1 - p[1], p[1] - y0, 0.0);
+    if (bx * bx + by * by > best * (1 + 1e-9)) continue;
+    double lam, d2 = seg_dist2(y, k, p, &lam);
+    if (d2 < best || (d2 == best && k < bk)) {
       best = d2;
       bk = k;
       bl = lam;
@@ -484,7 +512,7 @@ static void sides(const fit *ft, int sigma[2], double sep[2],
       size_t k;
       double lam, d2, n[2];
       bool faces =
-          project((const double(*)[2])b->x, b->n, a->x[i], &k, &lam, &d2);
+          project((const double(*)[2])b->x, b->n, a->x[i], b->n, &k, &lam, &d2);
       double d = side_of((const double(*)[2])b->x, k, lam, a->x[i], n);
       per[s][i] = faces && fabs(d) < 0.05 * ft->size ? (d > 0) - (d < 0) : 0;
       if (r < lo - wc || r > hi + wc) continue;
@@ -556,15 +584,17 @@ static km_status fit_solve(const fit *ft, double *c, km__poll *poll) {
     for (int s = 0; s < 2; s++) {
       const strand *a = &ft->s[s], *b = &ft->s[1 - s];
       int whole = s ? e->sigma_j : e->sigma_i;
+      size_t hint = b->n;
       for (size_t i = 0; i < a->n; i++) {
         /* the sample's own side, else its strand's */
         int sigma = e->side[s][i] ? e->side[s][i] : whole;
         if (sigma == 0) continue;
         size_t k;
         double lam, d2, n[2];
-        if (!project((const double(*)[2])y[1 - s], b->n, y[s][i], &k, &lam,
-                     &d2))
-          continue;
+        bool faces = project((const double(*)[2])y[1 - s], b->n, y[s][i], hint,
+                             &k, &lam, &d2);
+        hint = k; /* the next sample's nearest is near this one's */
+        if (!faces) continue;
         double d = side_of((const double(*)[2])y[1 - s], k, lam, y[s][i], n);
         double g = sigma * d - e->h;
         if (g >= 0 || fabs(d) > reach) continue;
@@ -1088,7 +1118,8 @@ static void kfit_residuals(const kfit *k, double (*y)[2], double *g,
       size_t q;
       double lam, d2, nrm[2];
       const double(*b)[2] = (const double(*)[2])(y + ooff);
-      if (!project(b, k->n[1 - s], y[off + i], &q, &lam, &d2)) continue;
+      if (!project(b, k->n[1 - s], y[off + i], k->n[1 - s], &q, &lam, &d2))
+        continue;
       double d = side_of(b, q, lam, y[off + i], nrm);
       if (fabs(d) > k->reach) continue;
       g[off + i] = sigma * d - e->h;
@@ -1505,6 +1536,14 @@ km_status km__repair_crossings(km_morph *m, km__repair_method how,
   km_status st = scan(m, poll, sev, &nsev, &frames);
   m->avoid.repair_scan_crossing = frames;
   if (st || nsev == 0) return st;
+  /* frames that cross over most of the morph are no pinch: a displacement
+   * of at most MAX_MOVE cannot hold them apart, and trying spends the
+   * whole budget of fits for nothing (a 3-frame request took 0.3 s). The
+   * pairs of repair.json cross on 9 of the 31 scan frames at most. */
+  if (2 * frames > SCAN - 1) {
+    m->avoid.repair_unrepaired = (long)nsev;
+    return KM_OK;
+  }
   km__repair *rp = km__calloc(1, sizeof *rp);
   if (!rp) return KM_ENOMEM;
   rp->degree = m->opt.degree;

@@ -542,9 +542,13 @@ def curve_to_path(curve: JSON, pieces: int = 8) -> str:
 def sample_points(curve: JSON, n: int = 200, per_span: int = 24) -> List[Point]:
     """n points at equal fractions of the curve's arc length."""
     dense = []
-    for k, a, b in _spans(curve):
-        for i in range(1 if dense else 0, per_span + 1):
-            dense.append(eval_curve(curve, a + (b - a) * i / per_span, k)[0])
+    spans = list(_spans(curve))
+    # at least eight dense points a sample: a frame of few long pieces (a
+    # circle in eight) sampled 24 to a piece cuts chords inside it
+    per = max(per_span, -(-8 * n // max(1, len(spans))))
+    for k, a, b in spans:
+        for i in range(1 if dense else 0, per + 1):
+            dense.append(eval_curve(curve, a + (b - a) * i / per, k)[0])
     cum = [0.0]
     for i in range(1, len(dense)):
         cum.append(cum[-1] + math.dist(dense[i], dense[i - 1]))
