@@ -606,8 +606,9 @@ static km_status placed_signature(const km_signature *sig, double rot,
  * the tolerance of it. Neither the exact frame's reconstruction nor a
  * second closure solve is needed: a frame with metrics costs the blend,
  * the closure's passes again and the crossing count beyond the planned
- * frame, and has the same curve as without. Frames closed by their
- * corners take the general path's closure. */
+ * frame, and has the same curve as without. A frame closed by turning
+ * its corners has the blend's smooth curvature and length: the blend is
+ * its signature for these metrics. */
 static km_status planned_frame_with_metrics(const km_morph *m, double t,
                                             km_closure how, km__poll *poll,
                                             km_curve *out,
@@ -618,14 +619,14 @@ static km_status planned_frame_with_metrics(const km_morph *m, double t,
   km_curve f;
   km_curve_init(&f);
   double gap = 0.0, c[KM__CLOSURE_INTERVALS - 3];
-  bool by_psi = false;
+  bool by_plan = false, by_corners = false;
   km_status st = KM_OK;
   if (m->closed && how == KM_CLOSURE_LSQ) {
     const km__input *a = &m->in[0], *b = &m->in[1];
     double phia = a->sig.angle,
            phib = phia + km__wrap_angle(b->sig.angle - phia);
     st = km__frame_plan_closure(m->plan, t, (1 - t) * phia + t * phib, c, &gap,
-                                &by_psi, poll);
+                                &by_plan, &by_corners, poll);
     if (st == KM_ECANCELLED)
       st = km__stopped(err);
     else if (st == KM_ENOMEM)
@@ -633,7 +634,10 @@ static km_status planned_frame_with_metrics(const km_morph *m, double t,
     else if (st) /* the general path's own closure then */
       st = KM_OK;
   }
-  if (!st && by_psi) {
+  if (!st && by_plan && by_corners) {
+    /* turning the corners leaves the smooth curvature and the length */
+    st = km__blend_signature(m, t, &sig, err);
+  } else if (!st && by_plan) {
     km_signature blended;
     km_signature_init(&blended);
     st = km__blend_signature(m, t, &blended, err);

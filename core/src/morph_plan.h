@@ -72,11 +72,14 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t, double theta0,
  * coefficients c of the lsq closure's basis (KM__CLOSURE_INTERVALS - 3 of
  * them) and the gap of the frame before closing (*gap0, in length). For
  * the frame's metrics, which describe the signature the frame is built
- * from. *by_psi false (c and gap0 untouched) when the morph is open or its
- * frames close by their corners: the general path has those. KM_ENOMEM,
- * KM_ECANCELLED when poll says stop, KM_ENOCONVERGE; no message. */
+ * from. *by_plan false (c and gap0 untouched) when the morph is open;
+ * *by_corners true when the frame closes by turning its corners: its
+ * smooth curvature is then the blend's (c zero), which is all length,
+ * curvature and energy depend on. KM_ENOMEM, KM_ECANCELLED when poll says
+ * stop, KM_ENOCONVERGE; no message. */
 km_status km__frame_plan_closure(const km__frame_plan *p, double t,
                                  double theta0, double *c, double *gap0,
-                                 bool *by_psi, km__poll *poll);
+                                 bool *by_plan, bool *by_corners,
+                                 km__poll *poll);
 
 #endif

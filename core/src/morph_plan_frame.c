@@ -341,7 +341,7 @@ static void warm_start(const km__frame_plan *p, double t, double *c) {
  * km__frame_plan_curve allocates it). */
 static km_status frame_closure(const km__frame_plan *p, double t, double theta0,
                                bool close_lsq, double *c, double *sum,
-                               double *dp, km__poll *poll) {
+                               double *dp, bool *corners, km__poll *poll) {
   size_t np = p->np, nc = p->ncorners;
   double *e = sum + 2 * np;
   double *tau = sum + km__plan_frame_scratch(p), *delta = tau + nc,
@@ -354,6 +354,7 @@ static km_status frame_closure(const km__frame_plan *p, double t, double theta0,
     if (!st)
       st = km__plan_corner_closure(p, t, sum, tau, delta, S, dp, &by_corners);
   }
+  if (corners) *corners = !st && by_corners;
   if (st || by_corners) return st;
   /* the smooth curvature takes the correction, by steps from the
    * cubic through the kept ones (warm_start): closed at those points
@@ -774,7 +775,7 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t, double theta0,
   const char *msg = "closing the frame did not converge";
   km_curve f;
   km_curve_init(&f);
-  km_status st = frame_closure(p, t, theta0, close_lsq, c, sum, dp, poll);
+  km_status st = frame_closure(p, t, theta0, close_lsq, c, sum, dp, NULL, poll);
   if (st == KM_ECANCELLED || (poll && poll->stopped)) {
     st = KM_ECANCELLED;
     goto done;
@@ -809,9 +810,10 @@ done:
 
 km_status km__frame_plan_closure(const km__frame_plan *p, double t,
                                  double theta0, double *c, double *gap0,
-                                 bool *by_psi, km__poll *poll) {
-  *by_psi = false;
-  if (!p->closed || p->by_corners) return KM_OK;
+                                 bool *by_plan, bool *by_corners,
+                                 km__poll *poll) {
+  *by_plan = *by_corners = false;
+  if (!p->closed) return KM_OK;
   size_t nc = p->ncorners, scratch = km__plan_frame_scratch(p) + 4 * nc + 2;
   double *sum = km__malloc((scratch + p->np) * sizeof(double));
   if (!sum) return KM_ENOMEM;
@@ -822,12 +824,16 @@ km_status km__frame_plan_closure(const km__frame_plan *p, double t,
   km_status st = KM_OK;
   if (poll && poll->stopped) st = KM_ECANCELLED;
   double cf[NF] = {0};
-  if (!st) st = frame_closure(p, t, theta0, true, cf, sum, sum + scratch, poll);
+  bool corners = false;
+  if (!st)
+    st = frame_closure(p, t, theta0, true, cf, sum, sum + scratch, &corners,
+                       poll);
   if (!st && poll && poll->stopped) st = KM_ECANCELLED;
   if (!st) {
     memcpy(c, cf, sizeof cf);
     *gap0 = Lt * hypot(G[0], G[1]);
-    *by_psi = true;
+    *by_plan = true;
+    *by_corners = corners;
   }
   km__free(sum);
   return st;
