@@ -23,6 +23,7 @@
 #include "km/reconstruct.h"
 #include "morph_blend.h"
 #include "morph_closure.h"
+#include "pp_internal.h"
 #include "morph_internal.h"
 #include "morph_linear.h"
 #include "morph_match.h"
@@ -436,10 +437,11 @@ void km_morph_inputs(const km_morph *m, double length[2], double turning[2]) {
   }
 }
 
-/* A frame from the plan: the curve only (metrics and signatures take the
- * general path, which yields them exactly). */
+/* A frame from the plan: the curve, and how it was closed into *closure
+ * (NULL: not wanted) for its metrics. */
 static km_status planned_frame(const km_morph *m, double t, km_closure how,
-                               km__poll *poll, km_curve *out, km_error *err) {
+                               km__poll *poll, km_curve *out,
+                               km__plan_closure *closure, km_error *err) {
   const km__input *a = &m->in[0], *b = &m->in[1];
   double phia = a->sig.angle, phib = phia + km__wrap_angle(b->sig.angle - phia);
   double rot, T[2];
@@ -453,9 +455,9 @@ static km_status planned_frame(const km_morph *m, double t, km_closure how,
    * repair's displacement lives in arc length, which merged runs leave
    * between their knots */
   bool merge = !m->keep_pieces && !km__repair_active(m->repair, t);
-  km_status st =
-      km__frame_plan_curve(m->plan, t, (1 - t) * phia + t * phib,
-                           how == KM_CLOSURE_LSQ, merge, &f, buf, poll, err);
+  km_status st = km__frame_plan_curve(m->plan, t, (1 - t) * phia + t * phib,
+                                      how == KM_CLOSURE_LSQ, merge, &f, buf,
+                                      closure, poll, err);
   if (st) goto done;
   if (m->closed && !f.closed && how != KM_CLOSURE_NONE)
     km__close_polygon(&f, how == KM_CLOSURE_LSQ ? KM_CLOSURE_C0 : how);
@@ -568,6 +570,20 @@ static km_status frame_signature(const km_morph *m, double t, const km_pp *dk,
   return st;
 }
 
+/* The metrics measured on the returned curve (its crossings) and the
+ * gap before closure. */
+static km_status curve_metrics(const km_morph *m, const km_curve *placed,
+                               double gap, km__poll *poll,
+                               km_frame_metrics *metrics, km_error *err) {
+  metrics->self_intersections = km__self_intersections(placed, m->tol, poll);
+  metrics->closure_gap = m->closed ? gap : 0.0;
+  if (poll && poll->stopped) return km__stopped(err);
+  /* -1 for a valid curve that was not stopped: no memory */
+  if (metrics->self_intersections < 0)
+    return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
+  return KM_OK;
+}
+
 /* Metrics of the exact frame sig, its placed curve and its gap. */
 static km_status exact_metrics(const km_morph *m, const km_signature *sig,
                                const km_curve *placed, double gap,
@@ -576,13 +592,7 @@ static km_status exact_metrics(const km_morph *m, const km_signature *sig,
   metrics->length = sig->length;
   metrics->max_abs_kappa = km_signature_max_abs_kappa(sig);
   metrics->bending_energy = km_signature_bending_energy(sig);
-  metrics->self_intersections = km__self_intersections(placed, m->tol, poll);
-  metrics->closure_gap = m->closed ? gap : 0.0;
-  if (poll && poll->stopped) return km__stopped(err);
-  /* -1 for a valid curve that was not stopped: no memory */
-  if (metrics->self_intersections < 0)
-    return km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
-  return KM_OK;
+  return curve_metrics(m, placed, gap, poll, metrics, err);
 }
 
 /* sig moved by the frame's placement (rotation rot about the origin, then
@@ -604,55 +614,57 @@ static km_status placed_signature(const km_signature *sig, double rot,
  * planned frame found) gives length, curvature, energy and gap exactly,
  * and the crossings are counted on the returned curve, which is within
  * the tolerance of it. Neither the exact frame's reconstruction nor a
- * second closure solve is needed: a frame with metrics costs the blend,
- * the closure's passes again and the crossing count beyond the planned
- * frame, and has the same curve as without. A frame closed by turning
- * its corners has the blend's smooth curvature and length: the blend is
- * its signature for these metrics. */
+ * second closure solve is needed: a frame with metrics costs the blended
+ * curvature (a piecewise polynomial, no signature), one pass for the gap
+ * and the crossing count beyond the planned frame, and has the same curve
+ * as without. A frame closed by turning its corners, and an open one,
+ * have the blend's smooth curvature and length. */
 static km_status planned_frame_with_metrics(const km_morph *m, double t,
                                             km_closure how, km__poll *poll,
                                             km_curve *out,
                                             km_frame_metrics *metrics,
                                             km_error *err) {
-  km_signature sig;
-  km_signature_init(&sig);
   km_curve f;
   km_curve_init(&f);
-  double gap = 0.0, c[KM__CLOSURE_INTERVALS - 3];
-  bool by_plan = false, by_corners = false;
   km_status st = KM_OK;
-  if (m->closed && how == KM_CLOSURE_LSQ) {
-    const km__input *a = &m->in[0], *b = &m->in[1];
-    double phia = a->sig.angle,
-           phib = phia + km__wrap_angle(b->sig.angle - phia);
-    st = km__frame_plan_closure(m->plan, t, (1 - t) * phia + t * phib, c, &gap,
-                                &by_plan, &by_corners, poll);
-    if (st == KM_ECANCELLED)
-      st = km__stopped(err);
-    else if (st == KM_ENOMEM)
+  bool lsq = m->closed && how == KM_CLOSURE_LSQ;
+  if (lsq || !m->closed) {
+    km__plan_closure cl;
+    st = planned_frame(m, t, how, poll, &f, lsq ? &cl : NULL, err);
+    /* the curvature the frame is built from, without the signature's
+     * tables: a piecewise polynomial is all its metrics need */
+    double Lt = (1 - t) * m->in[0].sig.length + t * m->in[1].sig.length;
+    km_pp kb, kt;
+    km__pp_init(&kb);
+    km__pp_init(&kt);
+    if (!st) st = km__blend_kappa(m, t, &kb, err);
+    /* turning the corners leaves the blend's smooth curvature */
+    bool psi = lsq && !cl.by_corners;
+    if (!st && psi && km__closure_kappa(&kb, Lt, cl.c, &kt))
       st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
-    else if (st) /* the general path's own closure then */
-      st = KM_OK;
-  }
-  if (!st && by_plan && by_corners) {
-    /* turning the corners leaves the smooth curvature and the length */
-    st = km__blend_signature(m, t, &sig, err);
-  } else if (!st && by_plan) {
-    km_signature blended;
-    km_signature_init(&blended);
-    st = km__blend_signature(m, t, &blended, err);
-    if (!st) st = km__closure_add(&blended, c, &sig, err);
-    km_signature_free(&blended);
-  } else if (!st) {
+    if (!st) {
+      const km_pp *k = psi ? &kt : &kb;
+      metrics->length = Lt;
+      metrics->max_abs_kappa = km__pp_max_abs(k);
+      metrics->bending_energy = km__pp_integral_sq(k);
+      st = curve_metrics(m, &f, lsq ? cl.gap0 : 0.0, poll, metrics, err);
+    }
+    km__pp_free(&kb);
+    km__pp_free(&kt);
+  } else {
+    /* the other closures: the general path's signature and gap */
+    km_signature sig;
+    km_signature_init(&sig);
+    double gap = 0.0;
     st = frame_signature(m, t, NULL, poll, &sig, &gap, err);
+    if (!st) st = planned_frame(m, t, how, poll, &f, NULL, err);
+    if (!st) st = exact_metrics(m, &sig, &f, gap, poll, metrics, err);
+    km_signature_free(&sig);
   }
-  if (!st) st = planned_frame(m, t, how, poll, &f, err);
-  if (!st) st = exact_metrics(m, &sig, &f, gap, poll, metrics, err);
   if (!st) {
     *out = f;
     km_curve_init(&f);
   }
-  km_signature_free(&sig);
   km_curve_free(&f);
   return st;
 }
@@ -673,7 +685,7 @@ static km_status frame_base(const km_morph *m, double t, const km_pp *dk,
   if (m->plan && !sig_out && !dk)
     return metrics
                ? planned_frame_with_metrics(m, t, how, poll, out, metrics, err)
-               : planned_frame(m, t, how, poll, out, err);
+               : planned_frame(m, t, how, poll, out, NULL, err);
   km_signature sig;
   km_signature_init(&sig);
   km_curve f, placed;
@@ -781,7 +793,7 @@ km_status km_morph_frame_points(const km_morph *m, double t,
         m->opt.closure == KM_CLOSURE_AUTO ? KM_CLOSURE_LSQ : m->opt.closure;
     km_curve f;
     km_curve_init(&f);
-    km_status st = planned_frame(m, t, how, &poll, &f, err);
+    km_status st = planned_frame(m, t, how, &poll, &f, NULL, err);
     if (!st) *points = f.n + extra;
     km_curve_free(&f);
     return st;

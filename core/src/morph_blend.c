@@ -560,29 +560,51 @@ static size_t merge_corners(corner_list *cl, double Lt) {
   return keep;
 }
 
-km_status km__blend_signature(const km_morph *m, double t, km_signature *out,
-                              km_error *err) {
+/* The blend's curvature into *whole and its corners into *cl (the
+ * caller frees both); statuses as km__blend_signature, no message. */
+static km_status blend_parts(const km_morph *m, double t, km_pp *whole,
+                             corner_list *cl) {
   const km__input *a = &m->in[0], *b = &m->in[1];
   double Lt = (1 - t) * a->sig.length + t * b->sig.length;
   km_pp *segs = km__calloc(m->nk - 1, sizeof *segs);
-  corner_list cl = {NULL, 0, 0};
-  km_pp whole;
-  km__pp_init(&whole);
-  km_fn kf;
-  km_fn_init(&kf);
   km_status st = segs ? KM_OK : KM_ENOMEM;
   bool smooth = false;
   if (!st && m->nk > 2 && t > 0 && t < 1) {
-    km_status ss = blend_smooth(m, t, &whole, &cl);
+    km_status ss = blend_smooth(m, t, whole, cl);
     if (ss == KM_OK)
       smooth = true;
     else if (ss != KM_EINVAL)
       st = ss;
   }
-  if (!st && !smooth) st = blend_linear(m, t, segs, &whole, &cl);
+  if (!st && !smooth) st = blend_linear(m, t, segs, whole, cl);
+  if (!st) drop_short_pieces(whole, SHORT_PIECE * Lt);
+  if (segs)
+    for (size_t k = 0; k + 1 < m->nk; k++) km__pp_free(&segs[k]);
+  km__free(segs);
+  return st;
+}
+
+km_status km__blend_kappa(const km_morph *m, double t, km_pp *out,
+                          km_error *err) {
+  corner_list cl = {NULL, 0, 0};
+  km_status st = blend_parts(m, t, out, &cl);
+  km__free(cl.c);
+  if (st == KM_ENOMEM) km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
+  return st;
+}
+
+km_status km__blend_signature(const km_morph *m, double t, km_signature *out,
+                              km_error *err) {
+  const km__input *a = &m->in[0], *b = &m->in[1];
+  double Lt = (1 - t) * a->sig.length + t * b->sig.length;
+  corner_list cl = {NULL, 0, 0};
+  km_pp whole;
+  km__pp_init(&whole);
+  km_fn kf;
+  km_fn_init(&kf);
+  km_status st = blend_parts(m, t, &whole, &cl);
   if (st) goto done;
   size_t keep = merge_corners(&cl, Lt);
-  drop_short_pieces(&whole, SHORT_PIECE * Lt);
   st = km__pp_to_fn(&kf, &whole);
   if (st) goto done;
   double phia = a->sig.angle, phib = b->sig.angle;
@@ -591,9 +613,6 @@ km_status km__blend_signature(const km_morph *m, double t, km_signature *out,
   st = km_signature_create(out, Lt, origin, (1 - t) * phia + t * phib, &kf,
                            cl.c, keep, m->closed, err);
 done:
-  if (segs)
-    for (size_t k = 0; k + 1 < m->nk; k++) km__pp_free(&segs[k]);
-  km__free(segs);
   km_fn_free(&kf);
   km__pp_free(&whole);
   km__free(cl.c);

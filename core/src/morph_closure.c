@@ -369,17 +369,13 @@ static km_status closure_coefficients(const qnode *q, size_t nq, double L,
 
 /* sig with kappa~ = kappa + psi' (psi' is quadratic on each basis
  * interval, so exact in Bernstein form from three values). */
-km_status km__closure_add(const km_signature *sig, const double *c,
-                          km_signature *out, km_error *err) {
-  double L = sig->length, h = L / NB;
-  km_pp dpsi, k0, kt;
+km_status km__closure_kappa(const km_pp *kappa, double L, const double *c,
+                            km_pp *out) {
+  double h = L / NB;
+  km_pp dpsi;
   km__pp_init(&dpsi);
-  km__pp_init(&k0);
-  km__pp_init(&kt);
-  km_fn kf;
-  km_fn_init(&kf);
   km_status st = km__pp_alloc(&dpsi, 2, NB);
-  if (st) goto done;
+  if (st) return st;
   for (int iv = 0; iv < NB; iv++) {
     double f[3];
     for (int k = 0; k < 3; k++) {
@@ -394,15 +390,25 @@ km_status km__closure_add(const km_signature *sig, const double *c,
     dpsi.x[iv] = iv * h;
   }
   dpsi.x[NB] = L;
-  st = km__pp_from_fn(&k0, &sig->kappa);
-  if (!st) st = km__pp_blend(&kt, &k0, 1.0, &dpsi, 1.0, 0.0, L);
+  st = km__pp_blend(out, kappa, 1.0, &dpsi, 1.0, 0.0, L);
+  km__pp_free(&dpsi);
+  return st;
+}
+
+km_status km__closure_add(const km_signature *sig, const double *c,
+                          km_signature *out, km_error *err) {
+  km_pp k0, kt;
+  km__pp_init(&k0);
+  km__pp_init(&kt);
+  km_fn kf;
+  km_fn_init(&kf);
+  km_status st = km__pp_from_fn(&k0, &sig->kappa);
+  if (!st) st = km__closure_kappa(&k0, sig->length, c, &kt);
   if (!st) st = km__pp_to_fn(&kf, &kt);
   if (!st)
-    st = km_signature_create(out, L, sig->start, sig->angle, &kf, sig->corners,
-                             sig->ncorners, sig->closed, err);
-done:
+    st = km_signature_create(out, sig->length, sig->start, sig->angle, &kf,
+                             sig->corners, sig->ncorners, sig->closed, err);
   km_fn_free(&kf);
-  km__pp_free(&dpsi);
   km__pp_free(&k0);
   km__pp_free(&kt);
   return st;

@@ -69,6 +69,11 @@ km_status km__close_lsq(const km_signature *sig, bool by_corners,
  * tangent angle) into *out, as km__close_lsq closes it. KM_ENOMEM. */
 km_status km__closure_add(const km_signature *sig, const double *c,
                           km_signature *out, km_error *err);
+/* Curvature kappa (over [0, L] in arc length) changed by the closure
+ * correction psi' of coefficients c into *out (the caller frees it), as
+ * km__closure_add changes a signature's. KM_ENOMEM. */
+km_status km__closure_kappa(const km_pp *kappa, double L, const double *c,
+                            km_pp *out);
 /* km__close_lsq of a blended frame of m (with m's closure by corners),
  * kept within the inputs' largest |kappa| where the least change would
  * cross it; statuses as km__close_lsq. */

@@ -55,6 +55,17 @@ const double *km__frame_plan_breaks(const km__frame_plan *p);
  * (decided once per morph, see morph_plan.c). */
 bool km__frame_plan_by_corners(const km__frame_plan *p);
 
+/* How a frame built from the plan was closed, for its metrics (which
+ * describe the signature the frame is built from): the coefficients c of
+ * the lsq closure's basis, the gap of the frame before closing (in
+ * length), and whether it closed by turning its corners (its smooth
+ * curvature then the blend's, c zero). */
+typedef struct km__plan_closure {
+  double c[KM__CLOSURE_INTERVALS - 3];
+  double gap0;
+  bool by_corners;
+} km__plan_closure;
+
 /* The frame at t as a cubic B-spline over its arc length (knots near arc
  * length; the parameter leaves it between them: runs of the plan's pieces
  * merged into single cubics), starting at the origin with tangent angle
@@ -62,24 +73,12 @@ bool km__frame_plan_by_corners(const km__frame_plan *p);
  * lsq correction of theta; merge: merges runs of the pieces (else each
  * piece is Hermite in arc length). The result is marked closed (end snapped to start) when
  * its gap is within the tolerance. ends (optional, 2 (pieces + 1) values)
- * receives the pieces' end points. Stops (KM_ECANCELLED) when poll says so
- * (NULL: never). */
+ * receives the pieces' end points; closure (optional) how the frame was
+ * closed (gap0 is measured only when it is asked for). Stops
+ * (KM_ECANCELLED) when poll says so (NULL: never). */
 km_status km__frame_plan_curve(const km__frame_plan *p, double t, double theta0,
                                bool close_lsq, bool merge, km_curve *out,
-                               double *ends, km__poll *poll, km_error *err);
-
-/* The closure of the frame at t as km__frame_plan_curve makes it: the
- * coefficients c of the lsq closure's basis (KM__CLOSURE_INTERVALS - 3 of
- * them) and the gap of the frame before closing (*gap0, in length). For
- * the frame's metrics, which describe the signature the frame is built
- * from. *by_plan false (c and gap0 untouched) when the morph is open;
- * *by_corners true when the frame closes by turning its corners: its
- * smooth curvature is then the blend's (c zero), which is all length,
- * curvature and energy depend on. KM_ENOMEM, KM_ECANCELLED when poll says
- * stop, KM_ENOCONVERGE; no message. */
-km_status km__frame_plan_closure(const km__frame_plan *p, double t,
-                                 double theta0, double *c, double *gap0,
-                                 bool *by_plan, bool *by_corners,
-                                 km__poll *poll);
+                               double *ends, km__plan_closure *closure,
+                               km__poll *poll, km_error *err);
 
 #endif

@@ -758,7 +758,8 @@ static km_status frame_points_of_runs(const km__frame_plan *p, const double *bz,
 
 km_status km__frame_plan_curve(const km__frame_plan *p, double t, double theta0,
                                bool close_lsq, bool merge, km_curve *out,
-                               double *ends, km__poll *poll, km_error *err) {
+                               double *ends, km__plan_closure *closure,
+                               km__poll *poll, km_error *err) {
   double c[NF] = {0};
   /* sums of the pieces, scratch of the nodes, and per corner its turn,
    * its change and the stretch sums; per piece the turn added before it,
@@ -775,13 +776,27 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t, double theta0,
   const char *msg = "closing the frame did not converge";
   km_curve f;
   km_curve_init(&f);
-  km_status st = frame_closure(p, t, theta0, close_lsq, c, sum, dp, NULL, poll);
+  km_status st = KM_OK;
+  if (closure) {
+    memset(closure, 0, sizeof *closure);
+    if (p->closed) {
+      /* theta_t alone: its gap, as the general path measures it */
+      double zero[NF + 6] = {0}, G[2];
+      frame_pass(p, t, theta0, zero, NULL, false, sum, sum + 2 * np, G, NULL,
+                 poll);
+      closure->gap0 = ((1 - t) * p->La + t * p->Lb) * hypot(G[0], G[1]);
+    }
+  }
+  if (!(poll && poll->stopped))
+    st = frame_closure(p, t, theta0, close_lsq, c, sum, dp,
+                       closure ? &closure->by_corners : NULL, poll);
   if (st == KM_ECANCELLED || (poll && poll->stopped)) {
     st = KM_ECANCELLED;
     goto done;
   }
   if (st) goto done;
   msg = NULL;
+  if (closure) memcpy(closure->c, c, sizeof closure->c);
   hermite_pieces(p, t, theta0, c, sum, dp, bz, X, ends);
   size_t nr = np;
   if (merge)
@@ -806,35 +821,4 @@ done:
   if (st == KM_ECANCELLED) return km__stopped(err);
   if (st) return km__fail(err, st, KM_FIELD_NONE, -1, NAN, msg);
   return KM_OK;
-}
-
-km_status km__frame_plan_closure(const km__frame_plan *p, double t,
-                                 double theta0, double *c, double *gap0,
-                                 bool *by_plan, bool *by_corners,
-                                 km__poll *poll) {
-  *by_plan = *by_corners = false;
-  if (!p->closed) return KM_OK;
-  size_t nc = p->ncorners, scratch = km__plan_frame_scratch(p) + 4 * nc + 2;
-  double *sum = km__malloc((scratch + p->np) * sizeof(double));
-  if (!sum) return KM_ENOMEM;
-  /* theta_t alone: its gap, as the general path measures it */
-  double zero[NF + 6] = {0}, G[2], Lt = (1 - t) * p->La + t * p->Lb;
-  frame_pass(p, t, theta0, zero, NULL, false, sum, sum + 2 * p->np, G, NULL,
-             poll);
-  km_status st = KM_OK;
-  if (poll && poll->stopped) st = KM_ECANCELLED;
-  double cf[NF] = {0};
-  bool corners = false;
-  if (!st)
-    st = frame_closure(p, t, theta0, true, cf, sum, sum + scratch, &corners,
-                       poll);
-  if (!st && poll && poll->stopped) st = KM_ECANCELLED;
-  if (!st) {
-    memcpy(c, cf, sizeof cf);
-    *gap0 = Lt * hypot(G[0], G[1]);
-    *by_plan = true;
-    *by_corners = corners;
-  }
-  km__free(sum);
-  return st;
 }
