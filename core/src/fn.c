@@ -296,11 +296,17 @@ double km_fn_integral_sq(const km_fn *f) {
 }
 
 /* Coefficients of the piece of p covering [r0, r1] (normalised r over p's
- * domain), elevated to degree e. */
-static void piece_on(const km_pp *p, double r0, double r1, int e, double *out) {
+ * domain), elevated to degree e. *at is the piece the last call found:
+ * the intervals come in increasing order, so the search walks on from
+ * there to the piece km__pp_find would give (the last whose start is at
+ * or below the middle). */
+static void piece_on(const km_pp *p, double r0, double r1, int e, size_t *at,
+                     double *out) {
   double a = p->x[0], b = p->x[p->m], L = b - a;
-  double x0 = a + r0 * L, x1 = a + r1 * L;
-  size_t i = km__pp_find(p, 0.5 * (x0 + x1));
+  double x0 = a + r0 * L, x1 = a + r1 * L, mid = 0.5 * (x0 + x1);
+  size_t i = *at;
+  while (i + 1 < p->m && p->x[i + 1] <= mid) i++;
+  *at = i;
   double pa = p->x[i], h = p->x[i + 1] - pa;
   double u0 = (x0 - pa) / h, u1 = (x1 - pa) / h;
   if (u0 < 0) u0 = 0;
@@ -346,9 +352,10 @@ km_status km__pp_blend(km_pp *out, const km_pp *a, double wa, const km_pp *b,
     return KM_ENOMEM;
   }
   double ca[FN_MAX_DEGREE + 2], cb[FN_MAX_DEGREE + 2];
+  size_t at_a = 0, at_b = 0;
   for (size_t i = 0; i + 1 < m; i++) {
-    piece_on(a, r[i], r[i + 1], e, ca);
-    piece_on(b, r[i], r[i + 1], e, cb);
+    piece_on(a, r[i], r[i + 1], e, &at_a, ca);
+    piece_on(b, r[i], r[i + 1], e, &at_b, cb);
     double *c = o.c + i * (size_t)(e + 1);
     for (int j = 0; j <= e; j++) c[j] = wa * ca[j] + wb * cb[j];
     o.x[i] = u0 + r[i] * (u1 - u0);

@@ -114,7 +114,8 @@ void km__bern_restrict(const double *c, int d, double u0, double u1,
                        double *out) {
   double tmp[KM_MAX_FN_DEGREE + 2];
   if (u0 <= 0.0 && u1 >= 1.0) {
-    memcpy(out, c, (size_t)(d + 1) * sizeof(double));
+    /* a few values: a loop, not a call to memcpy */
+    for (int i = 0; i <= d; i++) out[i] = c[i];
     return;
   }
   if (u1 >= 1.0) {
@@ -131,6 +132,10 @@ void km__bern_restrict(const double *c, int d, double u0, double u1,
 
 void km__bern_elevate(const double *c, int d, int e, double *out) {
   double a[KM_MAX_FN_DEGREE + 2], b[KM_MAX_FN_DEGREE + 2];
+  if (e <= d) {
+    for (int i = 0; i <= d; i++) out[i] = c[i];
+    return;
+  }
   memcpy(a, c, (size_t)(d + 1) * sizeof(double));
   for (int k = d; k < e; k++) {
     b[0] = a[0];
