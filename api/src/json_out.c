@@ -290,9 +290,13 @@ static bool json_points_grid(api_ctx *ctx, api_svg_buf *b, const double *v,
   return true;
 }
 
+double api__curve_length(const km_curve *c) {
+  return km_curve_length_within(c, LENGTH_REL_TOL);
+}
+
 bool api__json_curve(api_ctx *ctx, api_svg_buf *b, const km_curve *c,
                      bool svg_d, double tol, const api_grid *grid,
-                     double *moved) {
+                     double known_length, double *moved) {
   double length, largest = 0.0;
   km_curve printed = *c;
   double *rounded = NULL;
@@ -321,8 +325,11 @@ bool api__json_curve(api_ctx *ctx, api_svg_buf *b, const km_curve *c,
     API_JSON_LIT(b, ",\"closed\":true,\"length\":");
   else
     API_JSON_LIT(b, ",\"closed\":false,\"length\":");
-  /* the length of the curve as printed, which the contract promises */
-  length = km_curve_length_within(&printed, LENGTH_REL_TOL);
+  /* the length of the curve as printed, which the contract promises:
+   * the curve's own when printed exactly and already measured */
+  length = printed.cp == c->cp && !isnan(known_length)
+               ? known_length
+               : km_curve_length_within(&printed, LENGTH_REL_TOL);
   if (!api__json_num(ctx, b, length, "length")) goto done;
   if (svg_d) {
     /* Default tolerance as everywhere: 1e-5 of the curve's length. */

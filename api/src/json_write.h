@@ -44,13 +44,18 @@ api_grid api__tolerance_grid(double tol);
 /* A curve as the contract's Curve (output) object (degree, knots,
  * control_points, weights when rational, closed, length, svg_d when
  * asked), its control points on grid (NULL: exact) with the length of
- * the curve so printed. *moved (may be NULL) receives the largest distance a
+ * the curve so printed (known_length, api__curve_length's, when printed
+ * exactly and already measured; else NAN). *moved (may be NULL) receives the largest distance a
  * control point moved by printing (0 when exact). Knots, weights and
  * length are always exact: rounding a knot or a weight moves the curve
  * by more than its share. */
 bool api__json_curve(api_ctx *ctx, api_svg_buf *b, const km_curve *c,
                      bool svg_d, double tol, const api_grid *grid,
-                     double *moved);
+                     double known_length, double *moved);
+/* The length a curve's "length" member gives, to the contract's 1e-12
+ * relative (api__json_curve takes it as known_length when the curve is
+ * printed exactly; NAN there: measured while printing). */
+double api__curve_length(const km_curve *c);
 /* A cJSON tree (consumed) printed into the buffer, for the parts of an
  * answer still built as trees. NULL item: false (the builder has recorded
  * its error). */

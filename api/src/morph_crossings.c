@@ -24,13 +24,12 @@ static long frame_crossings(const api_morph_plan *pl, const api_frame_slot *f,
     return n;
   }
   if (pl->metrics) return f->metrics.self_intersections;
+  if (f->crossings >= 0) return f->crossings;
   long x = km_curve_self_intersections(&f->curve, tol);
   return x > 0 ? x : 0;
 }
 
-/* The tolerance crossings are counted at: the request's, else the core's
- * default (1e-5 of the longer input). */
-static double count_tolerance(const api_morph_plan *pl) {
+double api__crossing_tolerance(const api_morph_plan *pl) {
   if (pl->tol > 0) return pl->tol;
   if (pl->shapes || pl->morph == NULL) return 1e-3;
   double len[2], turn[2];
@@ -97,7 +96,7 @@ cJSON *api__intersections_json(api_ctx *ctx, const api_morph_plan *pl) {
   km_morph_avoidance a;
   memset(&a, 0, sizeof a);
   if (!pl->shapes && pl->morph) km_morph_avoided(pl->morph, &a);
-  double tol = count_tolerance(pl);
+  double tol = api__crossing_tolerance(pl);
   cJSON *o = cJSON_CreateObject(), *frames = cJSON_CreateArray();
   if (o == NULL || frames == NULL) {
     cJSON_Delete(o);

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "km/alloc.h"
+#include "json_write.h"
 #include "morph_plan.h"
 
 void api_morph_plan_free(api_morph_plan *plan) {
@@ -179,12 +180,27 @@ api_status api_morph_render_frame_until(api_morph_plan *plan, size_t i,
   km_curve_free(&f->curve);
   km_signature_free(&f->sig);
   memset(&f->err, 0, sizeof f->err);
+  f->length = NAN;
+  f->crossings = -1;
   f->st = km_morph_frame_until(plan->morph, f->t, stop != NULL ? &ks : NULL,
                                &f->curve, plan->metrics ? &f->metrics : NULL,
                                plan->want_sig ? &f->sig : NULL, &f->err);
   if (f->st != KM_OK) {
     f->state = API_FRAME_FAILED;
     return f->st == KM_ENOMEM || f->st == KM_ECANCELLED ? 503 : 422;
+  }
+  /* what the JSON answer measures of the frame; a count stopped or out
+   * of memory is left to the answer */
+  if (!plan->svg) {
+    if (plan->precision != API_PRECISION_TOLERANCE)
+      f->length = api__curve_length(&f->curve);
+    if (plan->opt.intersections == KM_INTERSECTIONS_AVOID && !plan->metrics) {
+      long n = -1;
+      if (km_curve_self_intersections_until(
+              &f->curve, api__crossing_tolerance(plan),
+              stop != NULL ? &ks : NULL, &n) == KM_OK)
+        f->crossings = n;
+    }
   }
   f->state = API_FRAME_DONE;
   return API_STEP_DONE;

@@ -38,6 +38,11 @@ typedef struct api_frame_slot {
   km_shape_frame shape; /* compound morphs: the frame, in place of curve */
   km_status st;
   km_error err;
+  /* measured while rendering, so that frames rendered on several threads
+   * leave the answer only its printing: the curve's length (NAN: not
+   * measured) and its crossings for "intersections" (-1: not counted) */
+  double length;
+  long crossings;
 } api_frame_slot;
 
 struct api_morph_plan {
@@ -95,6 +100,9 @@ bool api__json_metrics(api_ctx *ctx, api_svg_buf *b, const km_frame_metrics *m);
 /* The "intersections" object of an answer that asked to avoid crossings
  * (morph_crossings.c): frames rendered. NULL with the error in ctx. */
 cJSON *api__intersections_json(api_ctx *ctx, const api_morph_plan *pl);
+/* The tolerance a frame's crossings are counted at for "intersections":
+ * the request's, else the core's default (1e-5 of the longer input). */
+double api__crossing_tolerance(const api_morph_plan *pl);
 /* Cubic pieces of a path "M x y C ..." as api_svg_path_d writes it. */
 size_t api__count_pieces(const char *d);
 

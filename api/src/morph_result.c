@@ -81,7 +81,8 @@ static bool frame_write(api_ctx *ctx, api_svg_buf *b, const api_morph_plan *pl,
   API_JSON_LIT(b, "{\"t\":");
   if (!api__json_num(ctx, b, f->t, "t")) return false;
   API_JSON_LIT(b, ",\"curve\":");
-  if (!api__json_curve(ctx, b, &f->curve, pl->inc.svg_d, pl->tol, grid, NULL))
+  if (!api__json_curve(ctx, b, &f->curve, pl->inc.svg_d, pl->tol, grid,
+                       f->length, NULL))
     return false;
   if (pl->metrics) {
     API_JSON_LIT(b, ",\"metrics\":");

@@ -470,7 +470,7 @@ bool api__shape_frame_write(api_ctx *ctx, api_svg_buf *b,
     if (!sf->present[k])
       API_JSON_LIT(b, "null");
     else if (!api__json_curve(ctx, b, &sf->contours[k], false, pl->tol, NULL,
-                              NULL))
+                              NAN, NULL))
       return false;
   }
   API_JSON_LIT(b, "]");

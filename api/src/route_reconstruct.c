@@ -74,7 +74,7 @@ static bool answer_write(api_ctx *ctx, api_svg_buf *b, const options *o,
   api_grid grid = {false, 0};
   if (o->precision == API_PRECISION_TOLERANCE) grid = api__tolerance_grid(tol);
   API_JSON_LIT(b, "{\"curve\":");
-  if (!api__json_curve(ctx, b, curve, o->inc.svg_d, tol, &grid, &moved))
+  if (!api__json_curve(ctx, b, curve, o->inc.svg_d, tol, &grid, NAN, &moved))
     return false;
   API_JSON_LIT(b, ",\"error_bound\":");
   if (!api__json_num(ctx, b, bound + moved, "error_bound")) return false;
