@@ -157,7 +157,7 @@ $(LIBAPI): $(API_OBJ)
 
 $(CLI): cli/kmorph.c $(LIBAPI) $(LIBCORE) VERSION | check-deps
 	@mkdir -p $(@D)
-	$(CC) $(CFLAGS) $(SRV_INC) $(VERSION_DEF) $< -o $@ $(LIBAPI) $(LIBCORE) $(CJSON_LIBS) -lm $(LDFLAGS)
+	$(CC) $(CFLAGS) $(SRV_INC) $(VERSION_DEF) $< -o $@ $(LIBAPI) $(LIBCORE) $(CJSON_LIBS) -lm -lpthread $(LDFLAGS)
 
 $(BUILD)/server/src/config.o $(BUILD)/server/src/metrics.o: VERSION
 

@@ -6,7 +6,16 @@
  * stdout), 2 for a usage error (usage on stderr). The request goes through
  * api_handle exactly as the daemon's would, so the CLI is also a way to
  * reproduce any server answer without a network.
+ *
+ * A morph's frames are rendered on as many threads as the process may use
+ * CPUs (--threads N to choose): the plan allows distinct frames at once,
+ * and the answer, assembled by api_morph_result in frame order, is the
+ * same bytes whatever the count.
  */
+#define _GNU_SOURCE /* sched_getaffinity */
+#include <pthread.h>
+#include <sched.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,6 +37,8 @@ static void usage(FILE *to) {
         "\n"
         "  --pretty   indent JSON output\n"
         "  --svg      ask for SVG (as the header Accept: image/svg+xml)\n"
+        "  --threads N  render a morph's frames on N threads (default: the\n"
+        "             CPUs this process may run on; 1: one thread)\n"
         "  --help     this text\n"
         "  --version  the version, then exit\n"
         "\n"
@@ -119,12 +130,67 @@ static void print_pretty(FILE *out, const char *s, size_t n) {
   }
 }
 
+/* The CPUs this process may run on (its affinity mask), at least 1. */
+static int usable_cpus(void) {
+  cpu_set_t set;
+  if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0)
+    return CPU_COUNT(&set);
+  return 1;
+}
+
+/* Frames handed out one at a time to the rendering threads. */
+typedef struct frame_queue {
+  api_morph_plan *plan;
+  size_t count;
+  atomic_size_t next;
+  atomic_bool failed; /* a frame could not be built: the rest are left to
+                       * api_morph_result, which reports the first */
+} frame_queue;
+
+static void *render_frames(void *arg) {
+  frame_queue *q = arg;
+  while (!atomic_load(&q->failed)) {
+    size_t i = atomic_fetch_add(&q->next, 1);
+    if (i >= q->count) break;
+    if (api_morph_render_frame(q->plan, i) != API_STEP_DONE)
+      atomic_store(&q->failed, true);
+  }
+  return NULL;
+}
+
+/* POST /v1/morph as api_handle answers it, its frames rendered on up to
+ * threads threads first (fewer when there are fewer frames, or a thread
+ * cannot be started: the calling thread renders too). */
+static void handle_morph(const api_config *cfg, const api_request *req,
+                         int threads, api_response *out) {
+  api_morph_plan *plan = NULL;
+  if (api_morph_prepare(cfg, req, cfg->max_frames_sync, &plan, out) !=
+      API_STEP_DONE)
+    return;
+  frame_queue q = {plan, api_morph_frame_count(plan), 0, false};
+  if (threads > 1 && q.count > 1) {
+    size_t extra = (size_t)threads - 1;
+    if (extra > q.count - 1) extra = q.count - 1;
+    pthread_t *tid = calloc(extra, sizeof *tid);
+    size_t started = 0;
+    while (tid != NULL && started < extra &&
+           pthread_create(&tid[started], NULL, render_frames, &q) == 0)
+      started++;
+    render_frames(&q);
+    for (size_t k = 0; k < started; k++) pthread_join(tid[k], NULL);
+    free(tid);
+  }
+  api_morph_result(plan, out);
+  api_morph_plan_free(plan);
+}
+
 int main(int argc, char **argv) {
   api_config cfg;
   api_request req;
   api_response res;
   const char *cmd = NULL;
   bool pretty = false, svg = false, too_big = false;
+  int threads = 0;
   size_t len = 0;
   char *body;
   api_status status;
@@ -140,6 +206,14 @@ int main(int argc, char **argv) {
       pretty = true;
     } else if (strcmp(argv[i], "--svg") == 0) {
       svg = true;
+    } else if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc) {
+      char *end;
+      long n = strtol(argv[++i], &end, 10);
+      if (*end != '\0' || n < 1 || n > 1024) {
+        fprintf(stderr, "kmorph: --threads takes a count from 1 to 1024\n");
+        return 2;
+      }
+      threads = (int)n;
     } else if (argv[i][0] != '-' && cmd == NULL) {
       cmd = argv[i];
     } else {
@@ -180,7 +254,10 @@ int main(int argc, char **argv) {
     req.body = body;
     req.length = len;
     req.accept = svg ? "image/svg+xml" : "application/json";
-    api_handle(&cfg, &req, &res);
+    if (req.route == API_ROUTE_MORPH)
+      handle_morph(&cfg, &req, threads > 0 ? threads : usable_cpus(), &res);
+    else
+      api_handle(&cfg, &req, &res);
   }
   free(body);
   status = res.status;

@@ -137,11 +137,46 @@ static void cli_morph_validation_goes_through_the_api(void **state) {
   free(out);
 }
 
+/* Frames rendered on several threads give the answer of one thread, byte
+ * for byte, and the lengths measured while rendering are the curves'
+ * own: frame 0 is the circle of radius 2 (4 pi), the last the square of
+ * side 4 (16). */
+static void cli_morph_threads_give_the_same_answer(void **state) {
+  cli_env *env = *state;
+  at_buf b = {0};
+  char *one, *many;
+  at_printf(&b, "{\"from\":");
+  at_circle_json(&b, 0, 0, 2, 1);
+  at_printf(&b, ",\"to\":{\"type\":\"svg\",\"d\":\"M-2 -2 L2 -2 L2 2 L-2 "
+                "2 Z\"},\"frames\":41,\"metrics\":true}");
+  assert_int_equal(run(env, "morph --threads 1", b.s, &one), 0);
+  assert_int_equal(run(env, "morph --threads 4", b.s, &many), 0);
+  assert_string_equal(one, many);
+  cJSON *j = cJSON_Parse(many);
+  assert_non_null(j);
+  const cJSON *frames = cJSON_GetObjectItem(j, "frames");
+  assert_int_equal(cJSON_GetArraySize(frames), 41);
+  const cJSON *c0 = cJSON_GetObjectItem(cJSON_GetArrayItem(frames, 0), "curve");
+  const cJSON *c1 =
+      cJSON_GetObjectItem(cJSON_GetArrayItem(frames, 40), "curve");
+  assert_rel(cJSON_GetObjectItem(c0, "length")->valuedouble, 4 * M_PI, 1e-5);
+  assert_rel(cJSON_GetObjectItem(c1, "length")->valuedouble, 16.0, 1e-9);
+  cJSON_Delete(j);
+  free(one);
+  free(many);
+  assert_int_equal(run(env, "morph --threads 0", b.s, &one), 2);
+  free(one);
+  assert_int_equal(run(env, "morph --threads", b.s, &one), 2);
+  free(one);
+  free(b.s);
+}
+
 static const struct CMUnitTest tests[] = {
     cmocka_unit_test(cli_signature_of_a_circle_succeeds),
     cmocka_unit_test(cli_problem_exits_1_with_problem_json),
     cmocka_unit_test(cli_usage_errors_exit_2),
     cmocka_unit_test(cli_morph_validation_goes_through_the_api),
+    cmocka_unit_test(cli_morph_threads_give_the_same_answer),
 };
 
 TM_SUITE("api_cli", tests, setup, teardown);
