@@ -10,6 +10,8 @@
 #include <string.h>
 #include <sys/socket.h>
 
+#include "frame_share.h"
+#include "pool.h"
 #include "reply.h"
 #include "request.h"
 #include "util.h"
@@ -252,13 +254,24 @@ static void morph_sync(srv_req *r, api_request *req) {
     return;
   }
   size_t n = api_morph_frame_count(plan);
-  size_t done = 0;
-  /* A frame that fails for its own reason leaves its problem in the plan
-   * for api_morph_result; one that was stopped ends the work. */
-  while (done < n && !request_should_stop(r)) {
-    api_morph_render_frame_until(plan, done, request_should_stop, r);
-    if (r->stopped == STOP_NONE) done++;
+  /* Idle workers render frames beside this one (frame_share.h). A frame
+   * that fails for its own reason leaves its problem in the plan for
+   * api_morph_result; one that was stopped ends the work. */
+  srv_shared_frames sf;
+  srv_frame_share_open(&s->shares, &sf, plan, n, r->deadline,
+                       &s->abort_compute);
+  if (n > 1) srv_pool_kick(s->pool);
+  for (size_t i;
+       !request_should_stop(r) && (i = srv_frame_share_take(&sf)) < n;) {
+    api_morph_render_frame_until(plan, i, request_should_stop, r);
+    if (r->stopped == STOP_NONE) atomic_fetch_add(&sf.done, 1);
   }
+  if (r->stopped != STOP_NONE) atomic_store(&sf.halt, true);
+  srv_frame_share_close(&s->shares, &sf);
+  /* a helper's frame stopped by the time or the shutdown: this sees it */
+  if (r->stopped == STOP_NONE && atomic_load(&sf.done) < n)
+    request_should_stop(r);
+  size_t done = atomic_load(&sf.done);
   if (r->stopped != STOP_NONE) {
     char progress[80];
     snprintf(message, sizeof message,

@@ -111,6 +111,15 @@ static bool shared_jobs(srv_server *s) {
   return true;
 }
 
+/* What idle workers do (the pool's background source): help with the
+ * frames of a synchronous morph first, whose client is waiting, then the
+ * frames of asynchronous jobs. */
+static bool idle_work(void *ctx) {
+  srv_server *s = ctx;
+  if (srv_frame_share_help(&s->shares)) return true;
+  return s->rjobs != NULL ? srv_rjobs_work(s->rjobs) : srv_jobs_work(s->jobs);
+}
+
 srv_server *srv_server_create(const srv_config *cfg, srv_log *logger) {
   srv_server *s = calloc(1, sizeof *s);
   if (s == NULL) return NULL;
@@ -150,13 +159,9 @@ srv_server *srv_server_create(const srv_config *cfg, srv_log *logger) {
     srv_server_destroy(s);
     return NULL;
   }
-  if (s->rjobs != NULL)
-    s->pool =
-        srv_pool_create(cfg->workers, cfg->queue, srv_rjobs_work, s->rjobs);
-  else
-    s->pool = s->jobs ? srv_pool_create(cfg->workers, cfg->queue, srv_jobs_work,
-                                        s->jobs)
-                      : NULL;
+  s->shares_ready = srv_frame_share_init(&s->shares) == 0;
+  if (s->shares_ready && (s->rjobs != NULL || s->jobs != NULL))
+    s->pool = srv_pool_create(cfg->workers, cfg->queue, idle_work, s);
   /* Batches of shared jobs appear without a kick from this process. */
   if (s->pool != NULL && s->rjobs != NULL) {
     srv_pool_set_poll(s->pool, 0.02);
@@ -291,6 +296,7 @@ void srv_server_destroy(srv_server *s) {
   if (s->daemon != NULL) MHD_stop_daemon(s->daemon);
   srv_front_destroy(s->front); /* after: it flushes what the daemon wrote */
   srv_pool_destroy(s->pool);
+  if (s->shares_ready) srv_frame_share_destroy(&s->shares);
   if (s->rjobs != NULL) {
     size_t n = srv_rjobs_hand_back_all(s->rjobs);
     if (n > 0)

@@ -22,6 +22,7 @@
 #include <stdio.h>
 
 #include "config.h"
+#include "frame_share.h"
 #include "front.h"
 #include "http_guard.h"
 #include "jobs.h"
@@ -45,6 +46,9 @@ struct srv_server {
   srv_front *front;          /* accepts, frames and relays (front.h) */
   unsigned port;             /* the port bound (cfg.port may be 0) */
   srv_pool *pool;            /* compute workers and their bounded queue */
+  srv_frame_share shares;    /* synchronous morphs' frames, for idle workers
+                              * to help with (frame_share.h) */
+  bool shares_ready;         /* shares initialised (destroy once) */
   srv_jobstore *store;       /* jobs' states and results */
   srv_jobs *jobs;            /* admission and running of asynchronous jobs */
   srv_redis *redis;          /* --jobs: connections to Redis, else NULL */

@@ -233,6 +233,47 @@ class ConfiguredOrigins(ContractCase):
         self.assertIsNone(r.header("Access-Control-Allow-Origin"))
 
 
+class SharedFrames(unittest.TestCase):
+    """A synchronous morph's frames are rendered by its worker and by
+    workers with nothing else to do (frame_share.h): the answer is the
+    same bytes as one worker's, for single curves and compound shapes,
+    and a time limit still stops the work."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.one = Daemon("--threads", "1")
+        cls.many = Daemon("--threads", "3")
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.one.stop()
+        cls.many.stop()
+
+    def test_one_worker_and_three_give_the_same_bytes(self):
+        for body in (heavy_morph_body(120), ring_morph_body(6),
+                     dict(heavy_morph_body(50), intersections="avoid",
+                          metrics=False)):
+            a = self.one.request("POST", "/v1/morph", body=body)
+            b = self.many.request("POST", "/v1/morph", body=body)
+            self.assertEqual(a.status, 200, a.body[:300])
+            self.assertEqual(a.body, b.body)
+
+    def test_a_time_limit_stops_shared_frames(self):
+        d = Daemon("--threads", "3", "--morph-time", "0.3")
+        try:
+            t0 = time.monotonic()
+            r = d.request("POST", "/v1/morph", body=ring_morph_body(400))
+            took = time.monotonic() - t0
+            self.assertEqual(r.status, 422, r.body[:300])
+            self.assertIn("KMORPH_MORPH_TIME", r.json()["detail"])
+            self.assertLess(took, 5.0)
+            # the workers are free again: a small morph answers at once
+            r = d.request("POST", "/v1/morph", body=morph_body(3))
+            self.assertEqual(r.status, 200)
+        finally:
+            d.stop()
+
+
 class CommandLine(unittest.TestCase):
     def test_help_lists_every_setting_and_exits_0(self):
         out = subprocess.run([DAEMON, "--help"], capture_output=True,
