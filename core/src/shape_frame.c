@@ -154,20 +154,28 @@ bool km__follow_parent(const km_shape_morph *m, size_t k, long parent,
 }
 
 /* The flattenings of a frame's slots, and the band index of each (built
- * when a contour is first asked about, dropped when it moves). */
+ * when a contour is first asked about, dropped when it moves); whether
+ * each lies inside its parent (INSIDE_UNKNOWN until asked, again when it
+ * or its parent moves): placing a hole asks at most three times where
+ * nothing moved between, and each answer is a winding query per point. */
 typedef struct flats {
   double **pt;
   size_t *n;
   km__poly_index *ix;
   bool *indexed;
+  signed char *inside;
 } flats;
+
+enum { INSIDE_UNKNOWN = 0, INSIDE_YES = 1, INSIDE_NO = 2 };
 
 static km_status flats_alloc(flats *fs, size_t n) {
   fs->pt = km__calloc(n, sizeof *fs->pt);
   fs->n = km__calloc(n, sizeof *fs->n);
   fs->ix = km__calloc(n, sizeof *fs->ix);
   fs->indexed = km__calloc(n, sizeof *fs->indexed);
-  return fs->pt && fs->n && fs->ix && fs->indexed ? KM_OK : KM_ENOMEM;
+  fs->inside = km__calloc(n, sizeof *fs->inside);
+  return fs->pt && fs->n && fs->ix && fs->indexed && fs->inside ? KM_OK
+                                                                : KM_ENOMEM;
 }
 
 static void flats_free(flats *fs, size_t n) {
@@ -177,6 +185,7 @@ static void flats_free(flats *fs, size_t n) {
   km__free(fs->n);
   km__free(fs->ix);
   km__free(fs->indexed);
+  km__free(fs->inside);
 }
 
 /* Slot k's index, NULL when out of memory. */
@@ -199,6 +208,23 @@ static bool all_inside(const double *P, size_t np, const km__poly_index *Q,
   return true;
 }
 
+/* Slot k's points as they stand lie inside its parent's index Q. */
+static bool inside_parent(flats *fs, size_t k, const km__poly_index *Q) {
+  const double zero[2] = {0, 0};
+  if (fs->inside[k] == INSIDE_UNKNOWN)
+    fs->inside[k] =
+        all_inside(fs->pt[k], fs->n[k], Q, zero) ? INSIDE_YES : INSIDE_NO;
+  return fs->inside[k] == INSIDE_YES;
+}
+
+/* Slot k moved: its index and what was known of it and its children. */
+static void slot_moved(const km_shape_frame *f, flats *fs, size_t k) {
+  fs->indexed[k] = false;
+  fs->inside[k] = INSIDE_UNKNOWN;
+  for (size_t c = 0; c < f->ncontours; c++)
+    if (f->parent[c] == (long)k) fs->inside[c] = INSIDE_UNKNOWN;
+}
+
 static void centroid_of(const double *P, size_t np, double g[2]) {
   g[0] = g[1] = 0.0;
   for (size_t i = 0; i + 1 < np; i++) {
@@ -217,7 +243,7 @@ static void translate(km_shape_frame *f, size_t k, flats *fs,
     fs->pt[k][2 * i] += d[0];
     fs->pt[k][2 * i + 1] += d[1];
   }
-  fs->indexed[k] = false;
+  slot_moved(f, fs, k);
 }
 
 /* Translate slot k toward the point inside its parent nearest its
@@ -225,13 +251,12 @@ static void translate(km_shape_frame *f, size_t k, flats *fs,
  * inside the parent; *moved says whether it did. */
 static km_status adjust(km_shape_frame *f, size_t k, flats *fs, bool *moved) {
   size_t p = (size_t)f->parent[k];
-  const double zero[2] = {0, 0};
   const km__poly_index *Q = index_of(fs, p);
   *moved = false;
   if (!Q) return KM_ENOMEM;
   const double *P = fs->pt[k];
   size_t np = fs->n[k];
-  if (all_inside(P, np, Q, zero)) return KM_OK;
+  if (inside_parent(fs, k, Q)) return KM_OK;
   double gk[2], gp[2], d[2];
   centroid_of(P, np, gk);
   km__poly_interior_point(Q, gk, gp);
@@ -250,6 +275,8 @@ static km_status adjust(km_shape_frame *f, size_t k, flats *fs, bool *moved) {
   d[0] = hi * full[0];
   d[1] = hi * full[1];
   translate(f, k, fs, d);
+  /* the very sums all_inside tested at hi */
+  fs->inside[k] = INSIDE_YES;
   *moved = true;
   return KM_OK;
 }
@@ -296,7 +323,7 @@ static void scale_about(km_shape_frame *f, size_t k, flats *fs,
     P[2 * i] = g[0] + r * (P[2 * i] - g[0]);
     P[2 * i + 1] = g[1] + r * (P[2 * i + 1] - g[1]);
   }
-  fs->indexed[k] = false;
+  slot_moved(f, fs, k);
   km_frame_metrics *mt = &f->metrics[k];
   mt->length *= r;
   mt->closure_gap *= r;
@@ -324,7 +351,7 @@ static km_status shrink_to_fit(const km_shape_morph *m, double t,
   km__curve_area(&f->contours[k], &a, g);
   if (cap < 1.0) scale_about(f, k, fs, g, cap);
   *ratio = cap;
-  if (all_inside(fs->pt[k], fs->n[k], Q, zero)) return KM_OK;
+  if (inside_parent(fs, k, Q)) return KM_OK;
   if (km__poly_index_winding(Q, g) == 0) {
     /* its centre first to the nearest point well inside the parent */
     double q[2];
@@ -383,7 +410,6 @@ static km_status finish(const km_shape_morph *m, double t, km_shape_frame *f,
   int maxd = 0;
   for (size_t k = 0; k < f->ncontours; k++)
     if (frame_depth(f, k) > maxd) maxd = frame_depth(f, k);
-  const double zero[2] = {0, 0};
   for (int d = 0; d <= maxd; d++)
     for (size_t k = 0; k < f->ncontours; k++) {
       if (!f->present[k] || frame_depth(f, k) != d) continue;
@@ -410,7 +436,7 @@ static km_status finish(const km_shape_morph *m, double t, km_shape_frame *f,
     if (!f->present[k] || p < 0 || !f->present[p]) continue;
     const km__poly_index *Q = index_of(fs, (size_t)p);
     if (!Q) return KM_ENOMEM;
-    if (!all_inside(fs->pt[k], fs->n[k], Q, zero)) f->nesting_ok = false;
+    if (!inside_parent(fs, k, Q)) f->nesting_ok = false;
   }
   f->mutual_intersections = 0;
   for (size_t k = 0; k < f->ncontours; k++)

@@ -73,8 +73,7 @@ bool srv_frame_share_help(srv_frame_share *fs) {
   if (sf == NULL) return false;
   size_t i = srv_frame_share_take(sf);
   if (i < sf->count &&
-      api_morph_render_frame_until(sf->plan, i, helper_should_stop, sf) !=
-          503)
+      api_morph_render_frame_until(sf->plan, i, helper_should_stop, sf) != 503)
     atomic_fetch_add(&sf->done, 1);
   pthread_mutex_lock(&fs->mu);
   if (--sf->helpers == 0) pthread_cond_broadcast(&fs->left);

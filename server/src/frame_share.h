@@ -30,12 +30,12 @@
 typedef struct srv_shared_frames {
   api_morph_plan *plan;
   size_t count;
-  double deadline;             /* srv_now() past it: helpers stop */
-  const atomic_bool *abort;    /* the server's abort_compute */
-  atomic_size_t next;          /* the next frame to take */
-  atomic_size_t done;          /* frames rendered and not stopped */
-  atomic_bool halt;            /* the owner stopped: take no more */
-  size_t helpers;              /* rendering now (under the registry lock) */
+  double deadline;                /* srv_now() past it: helpers stop */
+  const atomic_bool *abort;       /* the server's abort_compute */
+  atomic_size_t next;             /* the next frame to take */
+  atomic_size_t done;             /* frames rendered and not stopped */
+  atomic_bool halt;               /* the owner stopped: take no more */
+  size_t helpers;                 /* rendering now (under the registry lock) */
   struct srv_shared_frames *link; /* open morphs (under the registry lock) */
 } srv_shared_frames;
 
