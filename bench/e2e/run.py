@@ -22,6 +22,7 @@ import argparse
 import http.client
 import json
 import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -47,17 +48,28 @@ def control_points(answer):
     return n
 
 
+def children_cpu():
+    u = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return u.ru_utime + u.ru_stime
+
+
 def time_cli(cli, req, runs):
-    best, out = None, b""
+    """Best elapsed time, the answer, and the CPU time (every thread's) of
+    the run with the best elapsed time: the CLI renders frames on every
+    CPU it may use, flubber on one."""
+    best, out, cpu = None, b"", None
     for _ in range(runs):
+        c0 = children_cpu()
         t0 = time.perf_counter()
         r = subprocess.run([cli, "morph"], input=req, capture_output=True)
         dt = time.perf_counter() - t0
+        c = children_cpu() - c0
         if r.returncode != 0:
             raise RuntimeError(r.stdout[:300])
-        best = dt if best is None or dt < best else best
+        if best is None or dt < best:
+            best, cpu = dt, c
         out = r.stdout
-    return best, out
+    return best, out, cpu
 
 
 def time_http(conn, req, runs):
@@ -73,11 +85,12 @@ def time_http(conn, req, runs):
             raise RuntimeError(data[:300])
         best = dt if best is None or dt < best else best
         out = data
-    return best, out
+    return best, out, None
 
 
 def measure(cli, daemon_exe, pairs, frames, runs, precision):
-    """{(pair, mode, via): (us per frame, bytes per frame, cps per frame)}"""
+    """{(pair, mode, via): (us per frame, bytes per frame, cps per frame,
+    CPU us per frame or None)}"""
     out = {}
     d = Daemon(exe=daemon_exe) if daemon_exe else None
     conn = http.client.HTTPConnection("127.0.0.1", d.port,
@@ -90,11 +103,12 @@ def measure(cli, daemon_exe, pairs, frames, runs, precision):
                 if conn:
                     vias.append(("http", lambda r: time_http(conn, r, runs)))
                 for via, fn in vias:
-                    dt, text = fn(req)
+                    dt, text, cpu = fn(req)
                     cps = None if svg else control_points(json.loads(text))
                     out[(name, mode, via)] = (
                         1e6 * dt / frames, len(text) / frames,
-                        None if cps is None else cps / frames)
+                        None if cps is None else cps / frames,
+                        None if cpu is None else 1e6 * cpu / frames)
     finally:
         if conn:
             conn.close()
@@ -162,14 +176,16 @@ def main():
     print(f"# {args.frames} frames a request, best of {args.runs}; "
           f"us, bytes and control points per frame"
           + (f"; precision {args.precision}" if args.precision else ""))
-    head = "| pair | kind | mode | CLI us | HTTP us | HTTP/CLI | bytes | cps |"
-    rule = "|---|---|---|---:|---:|---:|---:|---:|"
+    head = ("| pair | kind | mode | CLI us | CLI CPU us | HTTP us | HTTP/CLI |"
+            " bytes | cps |")
+    rule = "|---|---|---|---:|---:|---:|---:|---:|---:|"
     if before:
         head += " CLI after/before | HTTP after/before | bytes after/before |"
         rule += "---:|---:|---:|"
     if fl:
-        head += " CLI / flubber default | CLI / flubber equal |"
-        rule += "---:|---:|"
+        head += (" CLI / flubber default | CLI CPU / flubber default |"
+                 " CLI / flubber equal |")
+        rule += "---:|---:|---:|"
     print(head)
     print(rule)
     for name, kind, a, b in pairs:
@@ -177,7 +193,7 @@ def main():
             c = after[(name, mode, "cli")]
             h = after.get((name, mode, "http"))
             row = (f"| {name} | {kind} | {mode} | {fmt(c[0])} | "
-                   f"{fmt(h[0] if h else None)} | "
+                   f"{fmt(c[3])} | {fmt(h[0] if h else None)} | "
                    f"{fmt(h[0] / c[0] if h else None, 2)} | {fmt(c[1], 0)} | "
                    f"{fmt(c[2])} |")
             if before:
@@ -189,6 +205,7 @@ def main():
             if fl:
                 f = fl.get(name)
                 row += (f" {fmt(c[0] / f['default']['us'] if f else None, 2)}"
+                        f" | {fmt(c[3] / f['default']['us'] if f else None, 2)}"
                         f" | {fmt(c[0] / f['equal']['us'] if f else None, 3)}"
                         " |")
             print(row)
