@@ -68,11 +68,13 @@ typedef struct seg {
   double u0, u1;     /* local parameter range within the piece */
   double h[MAXC][3]; /* homogeneous Bezier points of the sub-curve */
   double xmin, xmax, ymin, ymax;
+  int way[2]; /* travel() of a kept sub-curve, for the sweep's pruning */
 } seg;
 
 typedef struct ctx {
   int p;
   const km__hcurve *bz; /* Bezier form, dim 3 */
+  size_t pieces;        /* Bezier pieces of bz */
   double t0, t1;        /* curve domain */
   double tol, flat, size, eps_t;
   double mono_eps; /* step back a monotone control polygon may take */
@@ -154,6 +156,15 @@ static bool monotone(const seg *s, int p, double eps) {
   return true;
 }
 
+/* Sign of a sub-curve's travel in x and in y (from its first control
+ * point to its last; 0 if none). */
+static void travel(const seg *s, int p, int sg[2]) {
+  double a[2], b[2];
+  cart(s->h[0], a);
+  cart(s->h[p], b);
+  for (int k = 0; k < 2; k++) sg[k] = (b[k] > a[k]) - (b[k] < a[k]);
+}
+
 static void push_seg(ctx *x, const seg *s) {
   if (x->nseg == x->capseg) {
     size_t cap = x->capseg ? 2 * x->capseg : 64;
@@ -165,7 +176,9 @@ static void push_seg(ctx *x, const seg *s) {
     x->segs = n;
     x->capseg = cap;
   }
-  x->segs[x->nseg++] = *s;
+  seg *kept = &x->segs[x->nseg++];
+  *kept = *s;
+  travel(kept, x->p, kept->way);
 }
 
 static void collect(ctx *x, const seg *s, int depth) {
@@ -492,15 +505,6 @@ static void pair(ctx *x, const seg *A, const seg *B, int depth) {
   }
 }
 
-/* Sign of a sub-curve's travel in x and in y (from its first control
- * point to its last; 0 if none). */
-static void travel(const seg *s, int p, int sg[2]) {
-  double a[2], b[2];
-  cart(s->h[0], a);
-  cart(s->h[p], b);
-  for (int k = 0; k < 2; k++) sg[k] = (b[k] > a[k]) - (b[k] < a[k]);
-}
-
 /* Two sub-curves that follow each other along the curve (A's end is B's
  * start) and travel the same way in x or in y cannot cross: say both go
  * up in y; A lies below the shared point's y and B above it, so they can
@@ -509,7 +513,7 @@ static void travel(const seg *s, int p, int sg[2]) {
  * travel opposite ways in x but the same way in y.) Subdividing toward the
  * shared end would otherwise cost some forty levels a pair. */
 static bool consecutive_same_way(const ctx *x, const seg *A, const seg *B) {
-  size_t last = (x->bz->n - 1) / (size_t)x->p - 1;
+  size_t last = x->pieces - 1;
   const seg *f = NULL, *g = NULL;
   for (int k = 0; k < 2 && !f; k++) {
     const seg *u = k ? B : A, *v = k ? A : B;
@@ -523,10 +527,8 @@ static bool consecutive_same_way(const ctx *x, const seg *A, const seg *B) {
     }
   }
   if (!f) return false;
-  int sf[2], sg[2];
-  travel(f, x->p, sf);
-  travel(g, x->p, sg);
-  return (sf[0] != 0 && sf[0] == sg[0]) || (sf[1] != 0 && sf[1] == sg[1]);
+  return (f->way[0] != 0 && f->way[0] == g->way[0]) ||
+         (f->way[1] != 0 && f->way[1] == g->way[1]);
 }
 
 /* Sort order[0 .. n) by xmin, stably (equal keys keep their order, as
@@ -593,11 +595,13 @@ km_status km_curve_self_intersections_until(const km_curve *c, double tol,
  * tolerance, flatness, margin, budgets. False for a curve of no size. */
 static bool set_scales(ctx *x, const km_curve *c, double tol) {
   double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
+  /* comparisons, not fmin and fmax: a curve's points are finite */
   for (size_t i = 0; i < c->n; i++) {
-    xmin = fmin(xmin, c->cp[2 * i]);
-    xmax = fmax(xmax, c->cp[2 * i]);
-    ymin = fmin(ymin, c->cp[2 * i + 1]);
-    ymax = fmax(ymax, c->cp[2 * i + 1]);
+    double px = c->cp[2 * i], py = c->cp[2 * i + 1];
+    if (px < xmin) xmin = px;
+    if (px > xmax) xmax = px;
+    if (py < ymin) ymin = py;
+    if (py > ymax) ymax = py;
   }
   x->size = hypot(xmax - xmin, ymax - ymin);
   x->mag = fmax(fmax(fabs(xmin), fabs(xmax)), fmax(fabs(ymin), fabs(ymax)));
@@ -672,8 +676,8 @@ long km__self_intersection_params(const km_curve *c, double tol, km__poll *poll,
     goto cleanup;
   }
   /* every Bezier piece split until flat */
-  size_t pieces = (bz.n - 1) / (size_t)p;
-  for (size_t k = 0; k < pieces && !x.oom; k++) {
+  x.pieces = (bz.n - 1) / (size_t)p;
+  for (size_t k = 0; k < x.pieces && !x.oom; k++) {
     seg s;
     s.piece = k;
     s.u0 = 0;
