@@ -165,20 +165,29 @@ static void travel(const seg *s, int p, int sg[2]) {
   for (int k = 0; k < 2; k++) sg[k] = (b[k] > a[k]) - (b[k] < a[k]);
 }
 
-static void push_seg(ctx *x, const seg *s) {
+/* The place of the next sub-curve kept, segs[nseg], or NULL when memory
+ * runs out. */
+static seg *next_seg(ctx *x) {
   if (x->nseg == x->capseg) {
     size_t cap = x->capseg ? 2 * x->capseg : 64;
     seg *n = km__realloc(x->segs, cap * sizeof *n);
     if (!n) {
       x->oom = true;
-      return;
+      return NULL;
     }
     x->segs = n;
     x->capseg = cap;
   }
-  seg *kept = &x->segs[x->nseg++];
-  *kept = *s;
+  return &x->segs[x->nseg];
+}
+
+/* Keeps s, which may already stand in next_seg()'s place. */
+static void push_seg(ctx *x, const seg *s) {
+  seg *kept = next_seg(x);
+  if (!kept) return;
+  if (kept != s) *kept = *s;
   travel(kept, x->p, kept->way);
+  x->nseg++;
 }
 
 static void collect(ctx *x, const seg *s, int depth) {
@@ -678,14 +687,17 @@ long km__self_intersection_params(const km_curve *c, double tol, km__poll *poll,
   /* every Bezier piece split until flat */
   x.pieces = (bz.n - 1) / (size_t)p;
   for (size_t k = 0; k < x.pieces && !x.oom; k++) {
-    seg s;
-    s.piece = k;
-    s.u0 = 0;
-    s.u1 = 1;
-    memcpy(s.h, bz.pw + k * (size_t)p * 3,
+    /* built where it is kept, so that a piece kept whole (most are) is
+     * not copied; split, it is read no more once its parts are kept */
+    seg *s = next_seg(&x);
+    if (!s) break;
+    s->piece = k;
+    s->u0 = 0;
+    s->u1 = 1;
+    memcpy(s->h, bz.pw + k * (size_t)p * 3,
            (size_t)(p + 1) * 3 * sizeof(double));
-    seg_bbox(&s, p);
-    collect_piece(&x, &s);
+    seg_bbox(s, p);
+    collect_piece(&x, s);
   }
   if (x.oom) goto cleanup;
   /* the sweep orders pointers: a sub-curve is hundreds of bytes */
