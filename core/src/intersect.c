@@ -684,7 +684,7 @@ long km__self_intersection_params(const km_curve *c, double tol, km__poll *poll,
     result = 0;
     goto cleanup;
   }
-  /* every Bezier piece split until flat */
+  /* every Bezier piece cut into monotone sub-curves */
   x.pieces = (bz.n - 1) / (size_t)p;
   for (size_t k = 0; k < x.pieces && !x.oom; k++) {
     /* built where it is kept, so that a piece kept whole (most are) is
