@@ -3,13 +3,16 @@
  *
  * DESIGN. The curve is cut into its Bezier pieces (homogeneous, so rational
  * curves are exact) and each piece into sub-curves whose control polygons
- * are monotone in x and in y. Such a sub-curve is itself monotone in both
- * coordinates (for positive weights the derivative of a rational Bezier
- * coordinate is a positive combination of control differences), so it
- * cannot cross itself: only pairs of sub-curves need testing. Pairs are
- * pruned by a sweep over their bounding boxes, then subdivided while their
- * boxes overlap until both are flat; the chords' intersection seeds Newton
- * on the exact pieces. A root counts when |C(s) - C(t)| <= tol, the two
+ * are monotone in x and in y: a polynomial piece of degree <= 3 is cut
+ * where x' or y' vanishes (roots of a quadratic), and whatever is still
+ * not monotone, with every rational or higher-degree piece, is halved
+ * until it is. Such a sub-curve is itself monotone in both coordinates
+ * (for positive weights the derivative of a rational Bezier coordinate is
+ * a positive combination of control differences), so it cannot cross
+ * itself: only pairs of sub-curves need testing. Pairs are pruned by a
+ * sweep over their bounding boxes, then subdivided while their boxes
+ * overlap until both are flat; the chords' intersection seeds Newton on
+ * the exact pieces. A root counts when |C(s) - C(t)| <= tol, the two
  * parameters are different points of the curve (not the shared end of
  * adjacent pieces, not the seam of a closed curve, not an end of an open
  * one), and the tangents are transversal. Roots found twice (a crossing on
@@ -65,17 +68,21 @@ typedef struct seg {
   double u0, u1;     /* local parameter range within the piece */
   double h[MAXC][3]; /* homogeneous Bezier points of the sub-curve */
   double xmin, xmax, ymin, ymax;
+  int way[2]; /* travel() of a kept sub-curve, for the sweep's pruning */
 } seg;
 
 typedef struct ctx {
   int p;
   const km__hcurve *bz; /* Bezier form, dim 3 */
+  size_t pieces;        /* Bezier pieces of bz */
   double t0, t1;        /* curve domain */
   double tol, flat, size, eps_t;
-  double mag;    /* largest |coordinate| of the control points */
-  double margin; /* rounding of the coordinates: the boxes' margin */
+  double mono_eps; /* step back a monotone control polygon may take */
+  double mag;      /* largest |coordinate| of the control points */
+  double margin;   /* rounding of the coordinates: the boxes' margin */
   long pairs_left, seeds_left, newton_left; /* work bounds (*_BUDGET) */
   bool closed;
+  bool polynomial; /* unit weights and degree <= 3: turns in closed form */
   seg *segs;
   size_t nseg, capseg;
   double *hits; /* (ta, tb) pairs, ta < tb */
@@ -149,29 +156,44 @@ static bool monotone(const seg *s, int p, double eps) {
   return true;
 }
 
-static void push_seg(ctx *x, const seg *s) {
+/* Sign of a sub-curve's travel in x and in y (from its first control
+ * point to its last; 0 if none). */
+static void travel(const seg *s, int p, int sg[2]) {
+  double a[2], b[2];
+  cart(s->h[0], a);
+  cart(s->h[p], b);
+  for (int k = 0; k < 2; k++) sg[k] = (b[k] > a[k]) - (b[k] < a[k]);
+}
+
+/* The place of the next sub-curve kept, segs[nseg], or NULL when memory
+ * runs out. */
+static seg *next_seg(ctx *x) {
   if (x->nseg == x->capseg) {
     size_t cap = x->capseg ? 2 * x->capseg : 64;
     seg *n = km__realloc(x->segs, cap * sizeof *n);
     if (!n) {
       x->oom = true;
-      return;
+      return NULL;
     }
     x->segs = n;
     x->capseg = cap;
   }
-  x->segs[x->nseg++] = *s;
+  return &x->segs[x->nseg];
+}
+
+/* Keeps s, which may already stand in next_seg()'s place. */
+static void push_seg(ctx *x, const seg *s) {
+  seg *kept = next_seg(x);
+  if (!kept) return;
+  if (kept != s) *kept = *s;
+  travel(kept, x->p, kept->way);
+  x->nseg++;
 }
 
 static void collect(ctx *x, const seg *s, int depth) {
   if (x->oom || (x->oom = km__poll_stop(x->poll, 4))) return;
-  /* monotone up to the rounding of the coordinates (far from the origin
-   * that rounding wiggles every control polygon, however small) and up to
-   * a tenth of the tolerance: a sub-curve monotone but for steps back of
-   * that size can only loop within it, below what the count resolves */
-  double eps =
-      fmax(fmax(1e-15 * x->size, 64 * DBL_EPSILON * x->mag), 0.1 * x->tol);
-  if (depth >= MONO_DEPTH || x->nseg >= MAX_SEGS || monotone(s, x->p, eps)) {
+  if (depth >= MONO_DEPTH || x->nseg >= MAX_SEGS ||
+      monotone(s, x->p, x->mono_eps)) {
     push_seg(x, s);
     return;
   }
@@ -179,6 +201,115 @@ static void collect(ctx *x, const seg *s, int depth) {
   split_half(s, x->p, &l, &r);
   collect(x, &l, depth + 1);
   collect(x, &r, depth + 1);
+}
+
+/* de Casteljau at t in (0, 1) of s, which is the piece's parameter u: the
+ * sub-curves before and after it. */
+static void split_at(const seg *s, int p, double t, double u, seg *l, seg *r) {
+  double tmp[MAXC][3];
+  memcpy(tmp, s->h, sizeof tmp);
+  l->piece = r->piece = s->piece;
+  l->u0 = s->u0;
+  l->u1 = u;
+  r->u0 = u;
+  r->u1 = s->u1;
+  for (int c = 0; c < 3; c++) {
+    l->h[0][c] = tmp[0][c];
+    r->h[p][c] = tmp[p][c];
+  }
+  for (int k = 1; k <= p; k++) {
+    for (int i = 0; i <= p - k; i++)
+      for (int c = 0; c < 3; c++)
+        tmp[i][c] = (1 - t) * tmp[i][c] + t * tmp[i + 1][c];
+    for (int c = 0; c < 3; c++) {
+      l->h[k][c] = tmp[0][c];
+      r->h[p - k][c] = tmp[p - k][c];
+    }
+  }
+  seg_bbox(l, p);
+  seg_bbox(r, p);
+}
+
+/* Roots closer than this to an end of the piece or to each other are not
+ * split at: the sliver between would turn back by some 1e-18 of the size. */
+#define ROOT_GAP 1e-9
+
+/* Appends to roots[n ..] the parameters in (ROOT_GAP, 1 - ROOT_GAP) where
+ * coordinate k of the polynomial Bezier piece s (degree <= 3, unit
+ * weights) has a zero derivative; returns the new count. The derivative's
+ * Bernstein coefficients are the control differences d: if they keep one
+ * sign there is no turn to find. */
+static int turning_params(const seg *s, int p, int k, double *roots, int n) {
+  double d[MAXC - 1];
+  for (int i = 0; i < p; i++) d[i] = s->h[i + 1][k] - s->h[i][k];
+  bool up = false, down = false;
+  for (int i = 0; i < p; i++) {
+    up |= d[i] > 0;
+    down |= d[i] < 0;
+  }
+  if (!(up && down)) return n;
+  double cand[2];
+  int nc = 0;
+  if (p == 2) {
+    cand[nc++] = d[0] / (d[0] - d[1]);
+  } else {
+    /* d0 (1-u)^2 + 2 d1 u (1-u) + d2 u^2 = a u^2 + b u + c; the roots in
+     * the form that does not cancel (Numerical Recipes 5.6) */
+    double a = d[0] - 2 * d[1] + d[2], b = 2 * (d[1] - d[0]), c = d[0];
+    double scale = fabs(d[0]) + fabs(d[1]) + fabs(d[2]);
+    if (fabs(a) <= 1e-12 * scale) {
+      if (b != 0) cand[nc++] = -c / b;
+    } else {
+      double disc = b * b - 4 * a * c;
+      if (disc >= 0) {
+        double q = -0.5 * (b + copysign(sqrt(disc), b));
+        cand[nc++] = q / a;
+        if (q != 0) cand[nc++] = c / q;
+      }
+    }
+  }
+  for (int i = 0; i < nc; i++)
+    if (cand[i] > ROOT_GAP && cand[i] < 1 - ROOT_GAP) roots[n++] = cand[i];
+  return n;
+}
+
+/* A whole Bezier piece into monotone sub-curves. A polynomial piece of
+ * degree <= 3 is cut where x' or y' vanishes: between those points the
+ * curve is monotone, and its control polygon almost always is too;
+ * collect() checks that and halves the rare one that is not, so every
+ * sub-curve kept still has a monotone control polygon. Halving alone
+ * never lands on a turn and closes in on it level by level. */
+static void collect_piece(ctx *x, const seg *s) {
+  int p = x->p;
+  if (!x->polynomial) {
+    collect(x, s, 0);
+    return;
+  }
+  /* most pieces are monotone already: kept as collect() would keep them */
+  if (x->oom || (x->oom = km__poll_stop(x->poll, 4))) return;
+  if (monotone(s, p, x->mono_eps)) {
+    push_seg(x, s);
+    return;
+  }
+  double roots[4];
+  int n = turning_params(s, p, 0, roots, 0);
+  n = turning_params(s, p, 1, roots, n);
+  for (int i = 1; i < n; i++)
+    for (int j = i; j > 0 && roots[j - 1] > roots[j]; j--) {
+      double t = roots[j];
+      roots[j] = roots[j - 1];
+      roots[j - 1] = t;
+    }
+  seg rest = *s, l, r;
+  double from = 0;
+  for (int i = 0; i < n && !x->oom; i++) {
+    if (roots[i] - from <= ROOT_GAP || 1 - roots[i] <= ROOT_GAP) continue;
+    split_at(&rest, p, (roots[i] - from) / (1 - from), roots[i], &l, &r);
+    collect(x, &l, 0);
+    rest = r;
+    from = roots[i];
+  }
+  collect(x, &rest, 0);
 }
 
 /* Largest distance of the control points from the chord. */
@@ -383,15 +514,6 @@ static void pair(ctx *x, const seg *A, const seg *B, int depth) {
   }
 }
 
-/* Sign of a sub-curve's travel in x and in y (from its first control
- * point to its last; 0 if none). */
-static void travel(const seg *s, int p, int sg[2]) {
-  double a[2], b[2];
-  cart(s->h[0], a);
-  cart(s->h[p], b);
-  for (int k = 0; k < 2; k++) sg[k] = (b[k] > a[k]) - (b[k] < a[k]);
-}
-
 /* Two sub-curves that follow each other along the curve (A's end is B's
  * start) and travel the same way in x or in y cannot cross: say both go
  * up in y; A lies below the shared point's y and B above it, so they can
@@ -400,7 +522,7 @@ static void travel(const seg *s, int p, int sg[2]) {
  * travel opposite ways in x but the same way in y.) Subdividing toward the
  * shared end would otherwise cost some forty levels a pair. */
 static bool consecutive_same_way(const ctx *x, const seg *A, const seg *B) {
-  size_t last = (x->bz->n - 1) / (size_t)x->p - 1;
+  size_t last = x->pieces - 1;
   const seg *f = NULL, *g = NULL;
   for (int k = 0; k < 2 && !f; k++) {
     const seg *u = k ? B : A, *v = k ? A : B;
@@ -414,10 +536,8 @@ static bool consecutive_same_way(const ctx *x, const seg *A, const seg *B) {
     }
   }
   if (!f) return false;
-  int sf[2], sg[2];
-  travel(f, x->p, sf);
-  travel(g, x->p, sg);
-  return (sf[0] != 0 && sf[0] == sg[0]) || (sf[1] != 0 && sf[1] == sg[1]);
+  return (f->way[0] != 0 && f->way[0] == g->way[0]) ||
+         (f->way[1] != 0 && f->way[1] == g->way[1]);
 }
 
 /* Sort order[0 .. n) by xmin, stably (equal keys keep their order, as
@@ -484,11 +604,13 @@ km_status km_curve_self_intersections_until(const km_curve *c, double tol,
  * tolerance, flatness, margin, budgets. False for a curve of no size. */
 static bool set_scales(ctx *x, const km_curve *c, double tol) {
   double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
+  /* comparisons, not fmin and fmax: a curve's points are finite */
   for (size_t i = 0; i < c->n; i++) {
-    xmin = fmin(xmin, c->cp[2 * i]);
-    xmax = fmax(xmax, c->cp[2 * i]);
-    ymin = fmin(ymin, c->cp[2 * i + 1]);
-    ymax = fmax(ymax, c->cp[2 * i + 1]);
+    double px = c->cp[2 * i], py = c->cp[2 * i + 1];
+    if (px < xmin) xmin = px;
+    if (px > xmax) xmax = px;
+    if (py < ymin) ymin = py;
+    if (py > ymax) ymax = py;
   }
   x->size = hypot(xmax - xmin, ymax - ymin);
   x->mag = fmax(fmax(fabs(xmin), fabs(xmax)), fmax(fabs(ymin), fabs(ymax)));
@@ -502,6 +624,12 @@ static bool set_scales(ctx *x, const km_curve *c, double tol) {
    * tolerance must not make every pair of a small curve overlap. */
   x->flat = fmax(fmin(x->tol, 1e-4 * x->size), 1e-7 * x->size);
   x->margin = 256 * DBL_EPSILON * fmax(x->mag, x->size);
+  /* monotone up to the rounding of the coordinates (far from the origin
+   * that rounding wiggles every control polygon, however small) and up to
+   * a tenth of the tolerance: a sub-curve monotone but for steps back of
+   * that size can only loop within it, below what the count resolves */
+  x->mono_eps =
+      fmax(fmax(1e-15 * x->size, 64 * DBL_EPSILON * x->mag), 0.1 * x->tol);
   x->eps_t = 1e-8 * (x->t1 - x->t0);
   x->pairs_left = PAIR_BUDGET;
   x->seeds_left = SEED_BUDGET;
@@ -550,22 +678,26 @@ long km__self_intersection_params(const km_curve *c, double tol, km__poll *poll,
   x.p = p;
   x.bz = &bz;
   x.closed = c->closed;
+  x.polynomial = !c->w && p <= 3;
   km_curve_domain(c, &x.t0, &x.t1);
   if (!set_scales(&x, c, tol)) {
     result = 0;
     goto cleanup;
   }
-  /* every Bezier piece split until flat */
-  size_t pieces = (bz.n - 1) / (size_t)p;
-  for (size_t k = 0; k < pieces && !x.oom; k++) {
-    seg s;
-    s.piece = k;
-    s.u0 = 0;
-    s.u1 = 1;
-    memcpy(s.h, bz.pw + k * (size_t)p * 3,
+  /* every Bezier piece cut into monotone sub-curves */
+  x.pieces = (bz.n - 1) / (size_t)p;
+  for (size_t k = 0; k < x.pieces && !x.oom; k++) {
+    /* built where it is kept, so that a piece kept whole (most are) is
+     * not copied; split, it is read no more once its parts are kept */
+    seg *s = next_seg(&x);
+    if (!s) break;
+    s->piece = k;
+    s->u0 = 0;
+    s->u1 = 1;
+    memcpy(s->h, bz.pw + k * (size_t)p * 3,
            (size_t)(p + 1) * 3 * sizeof(double));
-    seg_bbox(&s, p);
-    collect(&x, &s, 0);
+    seg_bbox(s, p);
+    collect_piece(&x, s);
   }
   if (x.oom) goto cleanup;
   /* the sweep orders pointers: a sub-curve is hundreds of bytes */

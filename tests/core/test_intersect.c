@@ -245,6 +245,113 @@ static void count_is_invariant_under_rigid_motion(void **state) {
   km_curve_free(&c);
 }
 
+/* The cubic Bezier with x controls (0, 3, 1 - e, 2) and y controls
+ * (0, 3, 3, 0): y(t) = 9 t (1 - t) takes each value at t and 1 - t only,
+ * so a crossing is a pair t = 1/2 +- a with x(1/2 + a) = x(1/2 - a). In
+ * powers of a, x = c0 + c1 a + c2 a^2 + c3 a^3 with c1 = -3 e / 4 and
+ * c3 = 8 + 3 e; its odd part vanishes at a^2 = -c1 / c3: one loop for
+ * every e > 0 (the smaller e, the smaller the loop), none for
+ * -8/3 < e < 0. Turned through a full circle, the curve's turns in x and
+ * in y fall anywhere along the piece, inside the loop or beside it. */
+static void cubic_loops_cross_once_however_small_or_turned(void **state) {
+  (void)state;
+  const double knots[] = {0, 0, 0, 0, 1, 1, 1, 1};
+  const double loops[] = {4, 1, 0.1, 1e-2, 1e-3}, open[] = {-1e-2, -1, -2};
+  for (int k = 0; k < 8; k++) {
+    double e = k < 5 ? loops[k] : open[k - 5];
+    long expected = k < 5 ? 1 : 0;
+    double cp[] = {0, 0, 3, 3, 1 - e, 3, 2, 0};
+    km_curve c = make(3, 4, knots, cp, NULL, false), t;
+    for (int r = 0; r < 24; r++) {
+      assert_status(
+          km_curve_transform(&t, &c, 0.1 + 2 * M_PI * r / 24, 0.5, -2, NULL),
+          KM_OK);
+      long n = km_curve_self_intersections(&t, 1e-10);
+      if (n != expected)
+        print_error("e = %g turned %d/24: %ld crossings\n", e, r, n);
+      assert_int_equal(n, expected);
+      km_curve_free(&t);
+    }
+    km_curve_free(&c);
+  }
+}
+
+/* S-curves: x controls (0, 1, 2, 3) make x(t) = 3 t, so each curve is the
+ * graph of a function and cannot meet itself; turned, its two turns in y
+ * become turns in x and in y anywhere along it. */
+static void graphs_turned_any_way_do_not_cross(void **state) {
+  (void)state;
+  const double knots[] = {0, 0, 0, 0, 1, 1, 1, 1};
+  const double heights[] = {0.5, 3, 30};
+  for (int k = 0; k < 3; k++) {
+    double h = heights[k];
+    double cp[] = {0, 0, 1, h, 2, -h, 3, 0};
+    km_curve c = make(3, 4, knots, cp, NULL, false), t;
+    for (int r = 0; r < 24; r++) {
+      assert_status(km_curve_transform(&t, &c, 2 * M_PI * r / 24, 0, 0, NULL),
+                    KM_OK);
+      assert_int_equal(km_curve_self_intersections(&t, 1e-10), 0);
+      km_curve_free(&t);
+    }
+    km_curve_free(&c);
+  }
+}
+
+/* Closed curves through samples that start on a turn, so the seam is an
+ * extremum in x: the lemniscate of Gerono x = 2 cos t, y = sin t cos t
+ * (one double point, the origin, where the branches cross at slopes
+ * +-1/2) and the limacon r = 1/2 + cos(theta) (its inner loop closes at
+ * the origin, the branches at 120 degrees). The samples are symmetric
+ * about the x axis, and so is the interpolant: its double point stays on
+ * the axis. */
+static void closed_curves_starting_on_a_turn(void **state) {
+  (void)state;
+  double pts[2 * 48];
+  for (int i = 0; i < 24; i++) {
+    double t = 2 * M_PI * i / 24;
+    pts[2 * i] = 2 * cos(t);
+    pts[2 * i + 1] = sin(t) * cos(t);
+  }
+  km_curve c;
+  assert_status(km_curve_interpolate(&c, pts, 24, true, NULL), KM_OK);
+  assert_int_equal(km_curve_self_intersections(&c, 1e-10), 1);
+  km_curve_free(&c);
+  for (int i = 0; i < 48; i++) {
+    double t = 2 * M_PI * i / 48, r = 0.5 + cos(t);
+    pts[2 * i] = r * cos(t);
+    pts[2 * i + 1] = r * sin(t);
+  }
+  assert_status(km_curve_interpolate(&c, pts, 48, true, NULL), KM_OK);
+  assert_int_equal(km_curve_self_intersections(&c, 1e-10), 1);
+  km_curve_free(&c);
+}
+
+/* The Lissajous figure x = sin(a t + phi), y = sin(b t) (a, b coprime,
+ * phi generic) has 2 a b - a - b double points, all transversal; its
+ * interpolant through dense samples keeps them. Its turns in x and in y
+ * are many and close to the crossings, where a split in the wrong place
+ * would show. */
+static void lissajous_figures_cross_2ab_minus_a_minus_b_times(void **state) {
+  (void)state;
+  const int figures[][2] = {{1, 2}, {1, 3}, {3, 2}, {3, 4}, {2, 5}};
+  enum { SAMPLES = 240 };
+  static double pts[2 * SAMPLES];
+  for (size_t k = 0; k < sizeof figures / sizeof *figures; k++) {
+    int a = figures[k][0], b = figures[k][1];
+    for (int i = 0; i < SAMPLES; i++) {
+      double t = 2 * M_PI * i / SAMPLES;
+      pts[2 * i] = sin(a * t + 0.3);
+      pts[2 * i + 1] = sin(b * t);
+    }
+    km_curve c;
+    assert_status(km_curve_interpolate(&c, pts, SAMPLES, true, NULL), KM_OK);
+    long n = km_curve_self_intersections(&c, 1e-10);
+    if (n != 2L * a * b - a - b) print_error("%d:%d: %ld crossings\n", a, b, n);
+    assert_int_equal(n, 2L * a * b - a - b);
+    km_curve_free(&c);
+  }
+}
+
 static void invalid_curve_gives_minus_one(void **state) {
   (void)state;
   assert_int_equal(km_curve_self_intersections(NULL, 1e-9), -1);
@@ -265,6 +372,10 @@ static const struct CMUnitTest tests[] = {
     cmocka_unit_test(crossing_at_a_piece_boundary_counts_once),
     cmocka_unit_test(crossing_at_the_seam_counts_once),
     cmocka_unit_test(count_is_invariant_under_rigid_motion),
+    cmocka_unit_test(cubic_loops_cross_once_however_small_or_turned),
+    cmocka_unit_test(graphs_turned_any_way_do_not_cross),
+    cmocka_unit_test(closed_curves_starting_on_a_turn),
+    cmocka_unit_test(lissajous_figures_cross_2ab_minus_a_minus_b_times),
     cmocka_unit_test(invalid_curve_gives_minus_one),
 };
 
