@@ -34,6 +34,14 @@
 #include "num_pow10.h"
 #include "num_print.h"
 
+/* The printer of JSON numbers is one function, the shortest decimal and
+ * its layout within: a call to each costs more than its arguments. */
+#if defined(__GNUC__)
+#define ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define ALWAYS_INLINE inline
+#endif
+
 /* ---- 64 x 64 -> 128 bit products -------------------------------------- */
 
 typedef struct u128 {
@@ -63,10 +71,11 @@ static inline uint64_t round_to_odd(const uint64_t g[2], uint64_t cp) {
   return top | (mid > 1);
 }
 
-/* floor(x / 2^s) for negative x too, without relying on how >> treats
- * negative numbers. */
+/* floor(x / 2^s) for negative x too (x > -2^40, s <= 40), without
+ * relying on how >> treats negative numbers and without a branch: x is
+ * shifted up to a non-negative number by a multiple of 2^s first. */
 static inline int floor_shift(int64_t x, int s) {
-  return (int)(x >= 0 ? x >> s : -((-x + ((int64_t)1 << s) - 1) >> s));
+  return (int)(((x + ((int64_t)1 << 40)) >> s) - ((int64_t)1 << (40 - s)));
 }
 
 /* floor(log10(2^q)), floor(log10(3/4 2^q)) and floor(log2(10^k)) for the
@@ -128,9 +137,9 @@ static api_decimal normalised(uint64_t digits, int exp10) {
 
 /* ---- the shortest decimal ---------------------------------------------- */
 
-api_decimal api__shortest_decimal(double v) {
-  uint64_t bits;
-  memcpy(&bits, &v, sizeof bits);
+/* api__shortest_decimal of the double with these bits (sign clear),
+ * inlined into the printers. */
+static ALWAYS_INLINE api_decimal shortest(uint64_t bits) {
   uint64_t fraction = bits & (((uint64_t)1 << 52) - 1);
   int biased = (int)((bits >> 52) & 0x7ff);
   uint64_t c;
@@ -173,6 +182,12 @@ api_decimal api__shortest_decimal(double v) {
   uint64_t mid = 4 * s + 2;
   bool up = vb > mid || (vb == mid && (s & 1) != 0);
   return normalised(s + (up ? 1 : 0), k);
+}
+
+api_decimal api__shortest_decimal(double v) {
+  uint64_t bits;
+  memcpy(&bits, &v, sizeof bits);
+  return shortest(bits);
 }
 
 /* ---- layout --------------------------------------------------------- */
@@ -349,8 +364,9 @@ static inline size_t put_scientific(char *out, const char *text, int n,
  * characters longer than the scientific form. The first test is the
  * common case (a point among the digits, where the fixed form is the
  * shorter by at least two characters) decided early. */
-static inline size_t layout(char *out, bool negative, api_decimal d, int slack,
-                            int integers_below, int fixed_below) {
+static ALWAYS_INLINE size_t layout(char *out, bool negative, api_decimal d,
+                                   int slack, int integers_below,
+                                   int fixed_below) {
   char text[DIGITS_ROOM];
   const char *digits = put_digits(text, d.digits, d.ndigits);
   int lead = d.exp10 + d.ndigits - 1;
@@ -375,19 +391,22 @@ size_t api__decimal_print(char *out, bool negative, api_decimal d) {
 }
 
 size_t api__num_print(char *out, double v) {
-  if (!isfinite(v)) {
+  uint64_t bits;
+  memcpy(&bits, &v, sizeof bits);
+  bool negative = bits >> 63 != 0;
+  bits &= ~((uint64_t)1 << 63);
+  if (bits >= (uint64_t)0x7ff << 52) {
     memcpy(out, "null", 5);
     return 4;
   }
-  bool negative = signbit(v) != 0;
-  if (v == 0) {
+  if (bits == 0) {
     size_t n = 0;
     if (negative) out[n++] = '-';
     out[n++] = '0';
     out[n] = '\0';
     return n;
   }
-  return api__decimal_print(out, negative, api__shortest_decimal(fabs(v)));
+  return layout(out, negative, shortest(bits), 0, 15, 21);
 }
 
 /* ---- within a budget ------------------------------------------------ */
@@ -490,7 +509,9 @@ size_t api__num_print_within(char *out, double x, double budget, double *got) {
     *got = 0.0;
     return 1;
   }
-  api_decimal d = api__shortest_decimal(a);
+  uint64_t bits;
+  memcpy(&bits, &a, sizeof bits);
+  api_decimal d = shortest(bits);
   int lead = d.exp10 + d.ndigits - 1;
   int start = d.ndigits;
   if (budget > 0) {
