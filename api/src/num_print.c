@@ -131,6 +131,20 @@ static int count_digits(uint64_t d) {
 #endif
 }
 
+/* The number of zero bits below the lowest one bit of c (c > 0). */
+static inline int trailing_zeros(uint64_t c) {
+#if defined(__GNUC__)
+  return __builtin_ctzll(c);
+#else
+  int n = 0;
+  while ((c & 1) == 0) {
+    c >>= 1;
+    n++;
+  }
+  return n;
+#endif
+}
+
 static api_decimal normalised(uint64_t digits, int exp10) {
   while (digits % 10 == 0) {
     digits /= 10;
@@ -152,7 +166,7 @@ static ALWAYS_INLINE api_decimal shortest(uint64_t bits) {
     c = fraction | ((uint64_t)1 << 52);
     q = biased - 1075;
     /* an integer below 2^53 is its own shortest decimal */
-    if (q <= 0 && q >= -52 && (c & (((uint64_t)1 << -q) - 1)) == 0)
+    if ((unsigned)-q <= 52 && trailing_zeros(c) >= -q)
       return normalised(c >> -q, 0);
   } else {
     c = fraction;
