@@ -348,8 +348,8 @@ static int scientific_length(api_decimal d) {
 
 /* d with its point inside the digits (exp10 < 0 <= lead): "123.456". */
 static inline size_t put_point(char *out, const char *text, int n, int lead) {
-  /* at most 16 digits before the point, at most 16 after it, and at
-   * most 8 after it when 8 or more come before */
+  /* at most 16 digits before the point and at most 16 after it; more
+   * than 8 after it only when at most 8 come before */
   memcpy(out, text, 16);
   out[lead + 1] = '.';
   if (n - lead - 1 <= 8)
