@@ -207,41 +207,68 @@ void api__json_string(api_svg_buf *b, const char *s) {
   API_JSON_LIT(b, "\"");
 }
 
+/* v[0 .. count) as [a,b,...] at p; a number with the same bits as the
+ * one before it (every knot of a Hermite frame is double, the ends'
+ * fourfold) is copied, not printed again. Returns the end, or NULL at
+ * the first non-finite number. */
+static char *put_values(char *p, const double *v, size_t count) {
+  const char *last = NULL;
+  size_t last_len = 0;
+  *p++ = '[';
+  for (size_t i = 0; i < count; i++) {
+    if (!isfinite(v[i])) return NULL;
+    *p = ',';
+    p += i > 0 ? 1 : 0;
+    if (i > 0 && memcmp(&v[i], &v[i - 1], sizeof *v) == 0) {
+      /* by way of a buffer: the number before is the last thing
+       * written, so the two places overlap; a fixed-size copy costs
+       * less than an exact one and a number has at most 24 bytes */
+      char copy[API_NUM_PRINT_MAX];
+      memcpy(copy, last, 24);
+      memcpy(p, copy, 24);
+    } else {
+      last_len = api__num_print(p, v[i]);
+    }
+    last = p;
+    p += last_len;
+  }
+  *p++ = ']';
+  return p;
+}
+
+/* n points (x, y) at v as [[x,y],...] at p. Returns the end, or NULL at
+ * the first non-finite coordinate. */
+static char *put_points(char *p, const double *v, size_t n) {
+  *p++ = '[';
+  for (size_t i = 0; i < n; i++) {
+    if (!isfinite(v[2 * i]) || !isfinite(v[2 * i + 1])) return NULL;
+    *p = ',';
+    p += i > 0 ? 1 : 0;
+    *p++ = '[';
+    p += api__num_print(p, v[2 * i]);
+    *p++ = ',';
+    p += api__num_print(p, v[2 * i + 1]);
+    *p++ = ']';
+  }
+  *p++ = ']';
+  return p;
+}
+
 bool api__json_nums(api_ctx *ctx, api_svg_buf *b, const double *v, size_t n,
                     size_t stride) {
   size_t count = n * stride;
   if (count > SIZE_MAX / (2 * API_NUM_PRINT_MAX)) return api__oom(ctx);
-  /* the whole array's room at once: a number, its comma or bracket */
+  /* the whole array's room at once: a number (printed into room for
+   * API_NUM_PRINT_MAX bytes), its comma and brackets */
   char *at = api__svg_buf_room(b, 2 + count * (API_NUM_PRINT_MAX + 2));
   if (at == NULL) return true;
-  char *p = at, *last = NULL;
-  size_t last_len = 0;
-  *p++ = '[';
-  for (size_t i = 0; i < count; i++) {
-    if (!isfinite(v[i])) {
-      *at = '\0';
-      return nonfinite(ctx, "coordinate");
-    }
-    if (stride == 2 && i % 2 == 0) {
-      if (i > 0) *p++ = ',';
-      *p++ = '[';
-    } else if (i > 0) {
-      *p++ = ',';
-    }
-    /* a number the same as the one before (every knot of a Hermite
-     * frame is double, the ends' are fourfold) is copied, not printed
-     * again: the same bits, the same digits */
-    if (stride == 1 && i > 0 && memcmp(&v[i], &v[i - 1], sizeof *v) == 0)
-      memcpy(p, last, last_len);
-    else
-      last_len = api__num_print(p, v[i]);
-    last = p;
-    p += last_len;
-    if (stride == 2 && i % 2 == 1) *p++ = ']';
+  char *end = stride == 2 ? put_points(at, v, n) : put_values(at, v, count);
+  if (end == NULL) {
+    *at = '\0';
+    return nonfinite(ctx, "coordinate");
   }
-  *p++ = ']';
-  *p = '\0';
-  b->len += (size_t)(p - at);
+  *end = '\0';
+  b->len += (size_t)(end - at);
   return true;
 }
 

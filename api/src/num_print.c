@@ -15,6 +15,13 @@
  * comparisons need. The product uses unsigned __int128 where the
  * compiler has it (gcc, clang) and four 32-bit products elsewhere.
  *
+ * Layout is most of the rest of the cost, so the digits are made
+ * sixteen at a time in one SSE2 register, or eight at a time in one
+ * 64-bit word (no table, no loop), and moved to their final places with
+ * fixed-size copies, the point or the leading zeros written around
+ * them; the fixed/scientific choice is decided early for the common
+ * "123.456" and computed from lengths only elsewhere.
+ *
  * The SVG printer rounds the shortest digits to fewer significant
  * digits until the result lies within the budget, reading each
  * candidate back by one correctly rounded multiplication or division
@@ -24,9 +31,20 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "num_pow10.h"
 #include "num_print.h"
+
+/* The printer of JSON numbers is one function, the shortest decimal and
+ * its layout within: a call to each costs more than its arguments. */
+#if defined(__GNUC__)
+#define ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define ALWAYS_INLINE inline
+#endif
 
 /* ---- 64 x 64 -> 128 bit products -------------------------------------- */
 
@@ -57,10 +75,11 @@ static inline uint64_t round_to_odd(const uint64_t g[2], uint64_t cp) {
   return top | (mid > 1);
 }
 
-/* floor(x / 2^s) for negative x too, without relying on how >> treats
- * negative numbers. */
+/* floor(x / 2^s) for negative x too (x > -2^40, s <= 40), without
+ * relying on how >> treats negative numbers and without a branch: x is
+ * shifted up to a non-negative number by a multiple of 2^s first. */
 static inline int floor_shift(int64_t x, int s) {
-  return (int)(x >= 0 ? x >> s : -((-x + ((int64_t)1 << s) - 1) >> s));
+  return (int)(((x + ((int64_t)1 << 40)) >> s) - ((int64_t)1 << (40 - s)));
 }
 
 /* floor(log10(2^q)), floor(log10(3/4 2^q)) and floor(log2(10^k)) for the
@@ -112,6 +131,20 @@ static int count_digits(uint64_t d) {
 #endif
 }
 
+/* The number of zero bits below the lowest one bit of c (c > 0). */
+static inline int trailing_zeros(uint64_t c) {
+#if defined(__GNUC__)
+  return __builtin_ctzll(c);
+#else
+  int n = 0;
+  while ((c & 1) == 0) {
+    c >>= 1;
+    n++;
+  }
+  return n;
+#endif
+}
+
 static api_decimal normalised(uint64_t digits, int exp10) {
   while (digits % 10 == 0) {
     digits /= 10;
@@ -122,9 +155,9 @@ static api_decimal normalised(uint64_t digits, int exp10) {
 
 /* ---- the shortest decimal ---------------------------------------------- */
 
-api_decimal api__shortest_decimal(double v) {
-  uint64_t bits;
-  memcpy(&bits, &v, sizeof bits);
+/* api__shortest_decimal of the double with these bits (sign clear),
+ * inlined into the printers. */
+static ALWAYS_INLINE api_decimal shortest(uint64_t bits) {
   uint64_t fraction = bits & (((uint64_t)1 << 52) - 1);
   int biased = (int)((bits >> 52) & 0x7ff);
   uint64_t c;
@@ -133,7 +166,7 @@ api_decimal api__shortest_decimal(double v) {
     c = fraction | ((uint64_t)1 << 52);
     q = biased - 1075;
     /* an integer below 2^53 is its own shortest decimal */
-    if (q <= 0 && q >= -52 && (c & (((uint64_t)1 << -q) - 1)) == 0)
+    if ((unsigned)-q <= 52 && trailing_zeros(c) >= -q)
       return normalised(c >> -q, 0);
   } else {
     c = fraction;
@@ -169,6 +202,12 @@ api_decimal api__shortest_decimal(double v) {
   return normalised(s + (up ? 1 : 0), k);
 }
 
+api_decimal api__shortest_decimal(double v) {
+  uint64_t bits;
+  memcpy(&bits, &v, sizeof bits);
+  return shortest(bits);
+}
+
 /* ---- layout --------------------------------------------------------- */
 
 static const char two_digits[201] = "00010203040506070809"
@@ -182,43 +221,104 @@ static const char two_digits[201] = "00010203040506070809"
                                     "80818283848586878889"
                                     "90919293949596979899";
 
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+/* The 8 digits of d < 10^8, leading zeros included, into out[0 .. 8),
+ * all in one 64-bit word: d splits into two 4-digit halves in 32-bit
+ * lanes, each half into two 2-digit quarters in 16-bit lanes, each
+ * quarter into two digits in bytes. A quotient by 100 (by 10) is a
+ * product by 10486 / 2^20 (103 / 2^10), exact below 10^4 (below 100),
+ * and no lane's product reaches the next lane; the remainder joins its
+ * quotient in the lane above by one product with -(100 * 2^16 - 1)
+ * (-(10 * 2^8 - 1)). Little-endian: the lowest lane is the first
+ * character. */
+static inline void put_8_digits(char *out, uint32_t d) {
+  uint64_t halves = (d / 10000) | ((uint64_t)(d % 10000) << 32);
+  uint64_t hundreds = ((halves * 10486) >> 20) & 0x0000007F0000007Full;
+  uint64_t quarters = (halves << 16) - hundreds * 6553599;
+  uint64_t tens = ((quarters * 103) >> 10) & 0x000F000F000F000Full;
+  uint64_t digits = (quarters << 8) - tens * 2559;
+  digits += 0x3030303030303030ull;
+  memcpy(out, &digits, 8);
+}
+#else
 /* The 8 digits of d < 10^8, leading zeros included, into out[0 .. 8):
  * two at a time, in 32-bit arithmetic */
-static void put_8_digits(char *out, uint32_t d) {
+static inline void put_8_digits(char *out, uint32_t d) {
   uint32_t hi = d / 10000, lo = d % 10000;
   memcpy(out, &two_digits[2 * (hi / 100)], 2);
   memcpy(out + 2, &two_digits[2 * (hi % 100)], 2);
   memcpy(out + 4, &two_digits[2 * (lo / 100)], 2);
   memcpy(out + 6, &two_digits[2 * (lo % 100)], 2);
 }
+#endif
 
-/* The n decimal digits of d into out[0 .. n): eight at a time from the
- * end while more than eight are left (a 64-bit division each), the rest
- * two at a time in 32 bits. */
-static void put_digits(char *out, uint64_t d, int n) {
-  char *p = out + n;
-  while (d >= 100000000u) {
-    p -= 8;
-    put_8_digits(p, (uint32_t)(d % 100000000u));
-    d /= 100000000u;
-  }
-  uint32_t r = (uint32_t)d;
-  while (r >= 100) {
-    p -= 2;
-    memcpy(p, &two_digits[2 * (r % 100)], 2);
-    r /= 100;
-  }
-  if (r >= 10) {
-    p -= 2;
-    memcpy(p, &two_digits[2 * r], 2);
+#if defined(__SSE2__)
+/* The 16 digits of high * 10^8 + low (both below 10^8), leading zeros
+ * included, into out[0 .. 16): as put_8_digits does in a 64-bit word,
+ * but for both halves at once in one 128-bit register, and with the
+ * products' high parts as the quotients: by 10^4 a product by
+ * 109951163 / 2^40 (exact below 10^8), by 100 one by 5243 / 2^19 (exact
+ * below 10^4), by 10 one by 6554 / 2^16 (exact below 100). */
+static inline void put_16_digits(char *out, uint32_t high, uint32_t low) {
+  __m128i halves = _mm_set_epi64x((long long)low, (long long)high);
+  __m128i first_four =
+      _mm_srli_epi64(_mm_mul_epu32(halves, _mm_set1_epi32(109951163)), 40);
+  __m128i last_four =
+      _mm_sub_epi64(halves, _mm_mul_epu32(first_four, _mm_set1_epi32(10000)));
+  __m128i groups = _mm_or_si128(first_four, _mm_slli_epi64(last_four, 32));
+  __m128i hundreds =
+      _mm_srli_epi16(_mm_mulhi_epu16(groups, _mm_set1_epi16(5243)), 3);
+  __m128i rest =
+      _mm_sub_epi16(groups, _mm_mullo_epi16(hundreds, _mm_set1_epi16(100)));
+  __m128i pairs = _mm_or_si128(hundreds, _mm_slli_epi32(rest, 16));
+  __m128i tens = _mm_mulhi_epu16(pairs, _mm_set1_epi16(6554));
+  __m128i ones =
+      _mm_sub_epi16(pairs, _mm_mullo_epi16(tens, _mm_set1_epi16(10)));
+  __m128i digits = _mm_or_si128(tens, _mm_slli_epi16(ones, 8));
+  digits = _mm_add_epi8(digits, _mm_set1_epi8('0'));
+  _mm_storeu_si128((__m128i *)(void *)out, digits);
+}
+#else
+static inline void put_16_digits(char *out, uint32_t high, uint32_t low) {
+  put_8_digits(out, high);
+  put_8_digits(out + 8, low);
+}
+#endif
+
+/* Room for the digits of a decimal: they end at DIGITS_END, and every
+ * writer below copies 16 or 24 bytes from anywhere among them in fixed
+ * sizes (a few moves, no call) rather than exactly as many as there
+ * are; the bytes after them are defined so that such a copy never
+ * reads an indeterminate byte. */
+#define DIGITS_END 24
+#define DIGITS_ROOM 48
+
+/* The n <= 20 decimal digits of d, in text ending at DIGITS_END, eight
+ * or sixteen at a time; where they start. */
+static inline const char *put_digits(char text[DIGITS_ROOM], uint64_t d,
+                                     int n) {
+  memset(text + DIGITS_END, '0', DIGITS_ROOM - DIGITS_END);
+  if (d < 100000000u) {
+    put_8_digits(text + DIGITS_END - 8, (uint32_t)d);
+  } else if (d < 10000000000000000u) {
+    put_16_digits(text + DIGITS_END - 16, (uint32_t)(d / 100000000u),
+                  (uint32_t)(d % 100000000u));
   } else {
-    *--p = (char)('0' + r);
+    /* at most 4 digits before the last 16 (d < 2^64) */
+    uint32_t top = (uint32_t)(d / 10000000000000000u);
+    uint64_t r = d % 10000000000000000u;
+    put_16_digits(text + DIGITS_END - 16, (uint32_t)(r / 100000000u),
+                  (uint32_t)(r % 100000000u));
+    memcpy(text + DIGITS_END - 20, &two_digits[2 * (top / 100)], 2);
+    memcpy(text + DIGITS_END - 18, &two_digits[2 * (top % 100)], 2);
   }
+  return text + DIGITS_END - n;
 }
 
-static int exponent_length(int e) {
-  int a = e < 0 ? -e : e;
-  return (e < 0 ? 1 : 0) + (a >= 100 ? 3 : a >= 10 ? 2 : 1);
+/* The n <= 17 digits at from into to: one fixed-size move and a byte. */
+static inline void copy_digits(char *to, const char *from, int n) {
+  memcpy(to, from, 16);
+  if (n > 16) to[16] = from[16];
 }
 
 /* Characters of the fixed form of d (sign excluded). */
@@ -229,73 +329,114 @@ static int fixed_length(api_decimal d) {
   return 1 - lead + d.ndigits;
 }
 
+static int exponent_length(int e) {
+  int a = e < 0 ? -e : e;
+  return (e < 0 ? 1 : 0) + (a >= 100 ? 3 : a >= 10 ? 2 : 1);
+}
+
 static int scientific_length(api_decimal d) {
   int lead = d.exp10 + d.ndigits - 1;
   return d.ndigits + (d.ndigits > 1 ? 1 : 0) + 1 + exponent_length(lead);
 }
 
-static size_t put_fixed(char *out, api_decimal d) {
-  int lead = d.exp10 + d.ndigits - 1;
-  if (d.exp10 >= 0) {
-    put_digits(out, d.digits, d.ndigits);
-    memset(out + d.ndigits, '0', (size_t)d.exp10);
-    return (size_t)(d.ndigits + d.exp10);
-  }
-  if (lead >= 0) {
-    /* digits, then the point moved into place */
-    put_digits(out + 1, d.digits, d.ndigits);
-    /* a few bytes: a call to memmove costs more */
-    for (int i = 0; i <= lead; i++) out[i] = out[i + 1];
-    out[lead + 1] = '.';
-    return (size_t)d.ndigits + 1;
-  }
-  int zeros = -lead - 1;
-  out[0] = '0';
-  out[1] = '.';
-  memset(out + 2, '0', (size_t)zeros);
-  put_digits(out + 2 + zeros, d.digits, d.ndigits);
-  return (size_t)(2 + zeros + d.ndigits);
+/* The writers below put the n <= 17 digits at text (put_digits) at
+ * their final places and return the length written. Fixed-size moves
+ * cost less than exact ones, so they also write bytes past the end of
+ * the number: up to 25 bytes past out for the layouts of this file
+ * (the fixed form below one with at most 4 zeros after the point),
+ * fewer than API_NUM_PRINT_MAX with a sign. */
+
+/* d with its point inside the digits (exp10 < 0 <= lead): "123.456". */
+static inline size_t put_point(char *out, const char *text, int n, int lead) {
+  /* at most 16 digits before the point and at most 16 after it; more
+   * than 8 after it only when at most 8 come before */
+  memcpy(out, text, 16);
+  out[lead + 1] = '.';
+  if (n - lead - 1 <= 8)
+    memcpy(out + lead + 2, text + lead + 1, 8);
+  else
+    memcpy(out + lead + 2, text + lead + 1, 16);
+  return (size_t)n + 1;
 }
 
-static size_t put_scientific(char *out, api_decimal d) {
-  int lead = d.exp10 + d.ndigits - 1;
-  size_t n;
-  put_digits(out + 1, d.digits, d.ndigits);
-  out[0] = out[1];
-  if (d.ndigits > 1) {
-    out[1] = '.';
-    n = (size_t)d.ndigits + 1;
-  } else {
-    n = 1;
+/* d below 1 (lead < 0): "0.00123". */
+static inline size_t put_below_one(char *out, const char *text, int n,
+                                   int lead) {
+  int zeros = -lead - 1;
+  if (zeros <= 6)
+    memcpy(out, "0.000000", 8);
+  else {
+    memcpy(out, "0.", 2);
+    memset(out + 2, '0', (size_t)zeros);
   }
-  out[n++] = 'e';
+  copy_digits(out + 2 + zeros, text, n);
+  return (size_t)(2 + zeros + n);
+}
+
+/* d an integer (exp10 >= 0): "1200". */
+static inline size_t put_integer(char *out, const char *text, int n,
+                                 int exp10) {
+  copy_digits(out, text, n);
+  if (exp10 <= 8)
+    memcpy(out + n, "00000000", 8);
+  else
+    memset(out + n, '0', (size_t)exp10);
+  return (size_t)(n + exp10);
+}
+
+/* d as "1.25e-7": no '+' and no leading zeros in the exponent. */
+static inline size_t put_scientific(char *out, const char *text, int n,
+                                    int lead) {
+  size_t len = 1;
+  out[0] = text[0];
+  if (n > 1) {
+    out[1] = '.';
+    memcpy(out + 2, text + 1, 16);
+    len = (size_t)n + 1;
+  }
+  out[len++] = 'e';
   if (lead < 0) {
-    out[n++] = '-';
+    out[len++] = '-';
     lead = -lead;
   }
-  int len = lead >= 100 ? 3 : lead >= 10 ? 2 : 1;
-  put_digits(out + n, (uint64_t)lead, len);
-  return n + (size_t)len;
+  if (lead < 10) {
+    out[len++] = (char)('0' + lead);
+  } else if (lead < 100) {
+    memcpy(out + len, &two_digits[2 * lead], 2);
+    len += 2;
+  } else {
+    out[len] = (char)('0' + lead / 100);
+    memcpy(out + len + 1, &two_digits[2 * (lead % 100)], 2);
+    len += 3;
+  }
+  return len;
 }
 
 /* sign and d: fixed when its leading digit is below 10^fixed_below and
- * it is an integer below 10^integers_below or at most slack characters
- * longer than the scientific form. */
-static size_t layout(char *out, bool negative, api_decimal d, int slack,
-                     int integers_below, int fixed_below) {
-  size_t n = 0;
-  if (negative) out[n++] = '-';
+ * it is an integer below 10^integers_below or at most slack (>= 0)
+ * characters longer than the scientific form. The first test is the
+ * common case (a point among the digits, where the fixed form is the
+ * shorter by at least two characters) decided early. */
+static ALWAYS_INLINE size_t layout(char *out, bool negative, api_decimal d,
+                                   int slack, int integers_below,
+                                   int fixed_below) {
+  char text[DIGITS_ROOM];
+  const char *digits = put_digits(text, d.digits, d.ndigits);
   int lead = d.exp10 + d.ndigits - 1;
-  bool fixed;
-  if (lead >= fixed_below)
-    fixed = false;
-  else if (d.exp10 >= 0 && lead < integers_below)
-    fixed = true;
+  out[0] = '-';
+  char *at = out + (negative ? 1 : 0);
+  size_t n;
+  if (d.exp10 < 0 && lead >= 0 && lead < fixed_below)
+    n = put_point(at, digits, d.ndigits, lead);
+  else if (lead < fixed_below &&
+           ((d.exp10 >= 0 && lead < integers_below) ||
+            fixed_length(d) <= scientific_length(d) + slack))
+    n = d.exp10 >= 0 ? put_integer(at, digits, d.ndigits, d.exp10)
+                     : put_below_one(at, digits, d.ndigits, lead);
   else
-    fixed = fixed_length(d) <= scientific_length(d) + slack;
-  n += fixed ? put_fixed(out + n, d) : put_scientific(out + n, d);
-  out[n] = '\0';
-  return n;
+    n = put_scientific(at, digits, d.ndigits, lead);
+  at[n] = '\0';
+  return (size_t)(at - out) + n;
 }
 
 size_t api__decimal_print(char *out, bool negative, api_decimal d) {
@@ -303,19 +444,22 @@ size_t api__decimal_print(char *out, bool negative, api_decimal d) {
 }
 
 size_t api__num_print(char *out, double v) {
-  if (!isfinite(v)) {
+  uint64_t bits;
+  memcpy(&bits, &v, sizeof bits);
+  bool negative = bits >> 63 != 0;
+  bits &= ~((uint64_t)1 << 63);
+  if (bits >= (uint64_t)0x7ff << 52) {
     memcpy(out, "null", 5);
     return 4;
   }
-  bool negative = signbit(v) != 0;
-  if (v == 0) {
+  if (bits == 0) {
     size_t n = 0;
     if (negative) out[n++] = '-';
     out[n++] = '0';
     out[n] = '\0';
     return n;
   }
-  return api__decimal_print(out, negative, api__shortest_decimal(fabs(v)));
+  return layout(out, negative, shortest(bits), 0, 15, 21);
 }
 
 /* ---- within a budget ------------------------------------------------ */
@@ -418,7 +562,9 @@ size_t api__num_print_within(char *out, double x, double budget, double *got) {
     *got = 0.0;
     return 1;
   }
-  api_decimal d = api__shortest_decimal(a);
+  uint64_t bits;
+  memcpy(&bits, &a, sizeof bits);
+  api_decimal d = shortest(bits);
   int lead = d.exp10 + d.ndigits - 1;
   int start = d.ndigits;
   if (budget > 0) {

@@ -13,9 +13,10 @@
 #include <stdint.h>
 
 /* Bytes of the buffers the printers below write into, the terminating
- * NUL included. A JSON number is at most 24 characters (sign, 17 digits,
- * point, "e-308"); an SVG number, which prefers the fixed form by up to
- * two characters, at most 26. */
+ * NUL included; they may write past the NUL within them. A JSON number
+ * is at most 24 characters (sign, 17 digits, point, "e-308"); an SVG
+ * number, which prefers the fixed form by up to two characters, at most
+ * 26. */
 #define API_NUM_PRINT_MAX 32
 
 /* A positive decimal digits * 10^exp10 with ndigits digits, the last one
@@ -32,7 +33,8 @@ typedef struct api_decimal {
 api_decimal api__shortest_decimal(double v);
 
 /* v as a JSON number in its shortest round-trip form, NUL-terminated, in
- * out[0 .. API_NUM_PRINT_MAX), at most 24 characters. Integers below 1e15
+ * out[0 .. API_NUM_PRINT_MAX), at most 24 characters; bytes after the
+ * NUL within that room may be overwritten too. Integers below 1e15
  * are printed as integers (as %.15g would); others in the shorter of the
  * fixed and the scientific form ("0.25", "1.5e-7", "2e300"), fixed on a
  * tie. Negative zero is "-0".
@@ -40,9 +42,9 @@ api_decimal api__shortest_decimal(double v);
  * first, and a non-finite v prints as "null" rather than as garbage. */
 size_t api__num_print(char *out, double v);
 
-/* Write sign, digits * 10^exp10 into out as api__num_print lays it out;
- * returns the length (at most 24 for ndigits <= 17 and exponents of
- * doubles). */
+/* Write sign, digits * 10^exp10 (ndigits <= 17) into out[0 ..
+ * API_NUM_PRINT_MAX) as api__num_print lays it out; returns the length
+ * (at most 24 for exponents of doubles). */
 size_t api__decimal_print(char *out, bool negative, api_decimal d);
 
 /* The shortest decimal (fewest significant digits) within budget of x

@@ -267,6 +267,138 @@ static void layout_is_fixed_for_integers_and_else_the_shorter(void **state) {
   }
 }
 
+/* The layout the header promises, built from significant digits and
+ * the power of ten of the first one by plain string operations: fixed
+ * when the leading digit is below 10^fixed_below and the number is an
+ * integer below 10^integers_below or its fixed form is at most slack
+ * characters longer than "d.ddde-x"; else that scientific form. */
+static void expected_layout(char *out, bool negative, const char *digits,
+                            int lead, int slack, int integers_below,
+                            int fixed_below) {
+  int nd = (int)strlen(digits), exp10 = lead - nd + 1;
+  char fixed[400], sci[64];
+  size_t f = 0;
+  if (exp10 >= 0) {
+    f += (size_t)sprintf(fixed, "%s", digits);
+    for (int i = 0; i < exp10; i++) fixed[f++] = '0';
+  } else if (lead >= 0) {
+    memcpy(fixed, digits, (size_t)lead + 1);
+    f = (size_t)lead + 1;
+    fixed[f++] = '.';
+    f += (size_t)sprintf(fixed + f, "%s", digits + lead + 1);
+  } else {
+    f += (size_t)sprintf(fixed, "0.");
+    for (int i = 0; i < -lead - 1; i++) fixed[f++] = '0';
+    f += (size_t)sprintf(fixed + f, "%s", digits);
+  }
+  fixed[f] = '\0';
+  if (nd > 1)
+    snprintf(sci, sizeof sci, "%c.%se%d", digits[0], digits + 1, lead);
+  else
+    snprintf(sci, sizeof sci, "%ce%d", digits[0], lead);
+  bool use_fixed =
+      lead < fixed_below && ((exp10 >= 0 && lead < integers_below) ||
+                             (int)strlen(fixed) <= (int)strlen(sci) + slack);
+  sprintf(out, "%s%s", negative ? "-" : "", use_fixed ? fixed : sci);
+}
+
+/* The shortest digits of v by the C library: the fewest significant
+ * digits of %.*e that read back (nearest of their length, correctly
+ * rounded), trailing zeros dropped. */
+static int library_shortest(double v, char *digits, int *lead) {
+  char ref[64];
+  for (int p = 1; p <= 17; p++) {
+    snprintf(ref, sizeof ref, "%.*e", p - 1, v);
+    if (strtod(ref, NULL) == v) break;
+  }
+  significand(ref, digits, 32, lead);
+  return (int)strlen(digits);
+}
+
+/* Every decimal exponent of doubles with every digit count 1 .. 17, and
+ * the neighbours of each, against the layout built from the library's
+ * digits; the printer writes nothing past API_NUM_PRINT_MAX. */
+static void
+every_exponent_and_digit_count_is_laid_out_as_promised(void **state) {
+  (void)state;
+  uint64_t s = 2024;
+  char text[64], digits[32], want[400], out[API_NUM_PRINT_MAX + 16];
+  for (int e = -324; e <= 308; e++) {
+    for (int nd = 1; nd <= 17; nd++) {
+      for (int k = 0; k < 6; k++) {
+        double m = 1.0 + 8.999 * (double)(next_bits(&s) >> 11) * 0x1p-53;
+        snprintf(text, sizeof text, "%.*fe%d", nd - 1, m, e);
+        double v = strtod(text, NULL);
+        double cases[] = {v, nextafter(v, 0), nextafter(v, INFINITY), -v};
+        for (size_t c = 0; c < 4; c++) {
+          double x = cases[c];
+          if (!isfinite(x) || x == 0) continue;
+          int lead;
+          library_shortest(fabs(x), digits, &lead);
+          expected_layout(want, x < 0, digits, lead, 0, 15, 21);
+          memset(out, '#', sizeof out);
+          size_t len = api__num_print(out, x);
+          if (strcmp(out, want) != 0)
+            fail_msg("%.17g printed as %s, not %s", x, out, want);
+          assert_int_equal(len, strlen(want));
+          for (size_t i = API_NUM_PRINT_MAX; i < sizeof out; i++)
+            assert_int_equal(out[i], '#');
+        }
+      }
+    }
+  }
+}
+
+/* Round numbers near the fixed/scientific boundaries: integers with
+ * trailing zeros up to and past 10^15 and 10^21, and small numbers
+ * with up to four zeros after the point. */
+static void integers_and_small_numbers_at_the_form_boundaries(void **state) {
+  (void)state;
+  char digits[32], want[400], out[API_NUM_PRINT_MAX];
+  for (int lead = -8; lead <= 23; lead++) {
+    for (int nd = 1; nd <= 17; nd++) {
+      for (int first = 1; first <= 9; first += 4) {
+        char text[64];
+        /* first, then nd - 2 nines, then a 3: no trailing zero */
+        int n = 0;
+        text[n++] = (char)('0' + first);
+        for (int i = 1; i < nd - 1; i++) text[n++] = '9';
+        if (nd > 1) text[n++] = '3';
+        snprintf(text + n, sizeof text - (size_t)n, "e%d", lead - nd + 1);
+        double v = strtod(text, NULL);
+        int l;
+        library_shortest(v, digits, &l);
+        expected_layout(want, false, digits, l, 0, 15, 21);
+        api__num_print(out, v);
+        if (strcmp(out, want) != 0)
+          fail_msg("%s printed as %s, not %s", text, out, want);
+      }
+    }
+  }
+}
+
+/* The SVG form lays its digits out by its own rule: fixed below 1e16
+ * unless more than two characters longer than the scientific form. */
+static void within_budget_layout_prefers_fixed_by_two_characters(void **state) {
+  (void)state;
+  uint64_t s = 5;
+  char out[API_NUM_PRINT_MAX], digits[32], want[400];
+  for (int e = -30; e <= 30; e++) {
+    for (int i = 0; i < 300; i++) {
+      double x = ((double)(next_bits(&s) >> 11) * 0x1p-53 + 0.05) *
+                 pow(10.0, e) * (i % 2 ? -1 : 1);
+      double budget = fabs(x) * pow(10.0, -(double)(i % 18)), got;
+      api__num_print_within(out, x, budget, &got);
+      if (got == 0) continue;
+      int lead;
+      significand(out, digits, sizeof digits, &lead);
+      expected_layout(want, got < 0, digits, lead, 2, 0, 16);
+      if (strcmp(out, want) != 0)
+        fail_msg("%.17g within %g printed as %s, not %s", x, budget, out, want);
+    }
+  }
+}
+
 /* The SVG form: within budget, read back as *got, and no candidate one
  * significant digit shorter (x rounded to nearest by snprintf) within
  * budget. */
@@ -311,6 +443,9 @@ static const struct CMUnitTest tests[] = {
     cmocka_unit_test(halfway_cases_round_to_the_nearest_and_read_back),
     cmocka_unit_test(layout_is_fixed_for_integers_and_else_the_shorter),
     cmocka_unit_test(within_budget_prints_few_digits_within_the_budget),
+    cmocka_unit_test(every_exponent_and_digit_count_is_laid_out_as_promised),
+    cmocka_unit_test(integers_and_small_numbers_at_the_form_boundaries),
+    cmocka_unit_test(within_budget_layout_prefers_fixed_by_two_characters),
 };
 
 TM_SUITE("num_print", tests, NULL, NULL);
