@@ -111,15 +111,15 @@ static void seg_bbox(seg *s, int p) {
   }
 }
 
-/* de Casteljau at 1/2: both halves. */
-static void split_half(const seg *s, int p, seg *l, seg *r) {
+/* de Casteljau at t in (0, 1) of s, which is the piece's parameter u: the
+ * sub-curves before and after it. */
+static void split_at(const seg *s, int p, double t, double u, seg *l, seg *r) {
   double tmp[MAXC][3];
   memcpy(tmp, s->h, sizeof tmp);
   l->piece = r->piece = s->piece;
-  double um = 0.5 * (s->u0 + s->u1);
   l->u0 = s->u0;
-  l->u1 = um;
-  r->u0 = um;
+  l->u1 = u;
+  r->u0 = u;
   r->u1 = s->u1;
   for (int c = 0; c < 3; c++) {
     l->h[0][c] = tmp[0][c];
@@ -127,7 +127,8 @@ static void split_half(const seg *s, int p, seg *l, seg *r) {
   }
   for (int k = 1; k <= p; k++) {
     for (int i = 0; i <= p - k; i++)
-      for (int c = 0; c < 3; c++) tmp[i][c] = 0.5 * (tmp[i][c] + tmp[i + 1][c]);
+      for (int c = 0; c < 3; c++)
+        tmp[i][c] = (1 - t) * tmp[i][c] + t * tmp[i + 1][c];
     for (int c = 0; c < 3; c++) {
       l->h[k][c] = tmp[0][c];
       r->h[p - k][c] = tmp[p - k][c];
@@ -135,6 +136,12 @@ static void split_half(const seg *s, int p, seg *l, seg *r) {
   }
   seg_bbox(l, p);
   seg_bbox(r, p);
+}
+
+/* de Casteljau at 1/2: both halves (split_at at one half: (a + b) / 2
+ * and a / 2 + b / 2 round alike, halving being exact). */
+static void split_half(const seg *s, int p, seg *l, seg *r) {
+  split_at(s, p, 0.5, 0.5 * (s->u0 + s->u1), l, r);
 }
 
 static bool monotone(const seg *s, int p, double eps) {
@@ -201,33 +208,6 @@ static void collect(ctx *x, const seg *s, int depth) {
   split_half(s, x->p, &l, &r);
   collect(x, &l, depth + 1);
   collect(x, &r, depth + 1);
-}
-
-/* de Casteljau at t in (0, 1) of s, which is the piece's parameter u: the
- * sub-curves before and after it. */
-static void split_at(const seg *s, int p, double t, double u, seg *l, seg *r) {
-  double tmp[MAXC][3];
-  memcpy(tmp, s->h, sizeof tmp);
-  l->piece = r->piece = s->piece;
-  l->u0 = s->u0;
-  l->u1 = u;
-  r->u0 = u;
-  r->u1 = s->u1;
-  for (int c = 0; c < 3; c++) {
-    l->h[0][c] = tmp[0][c];
-    r->h[p][c] = tmp[p][c];
-  }
-  for (int k = 1; k <= p; k++) {
-    for (int i = 0; i <= p - k; i++)
-      for (int c = 0; c < 3; c++)
-        tmp[i][c] = (1 - t) * tmp[i][c] + t * tmp[i + 1][c];
-    for (int c = 0; c < 3; c++) {
-      l->h[k][c] = tmp[0][c];
-      r->h[p - k][c] = tmp[p - k][c];
-    }
-  }
-  seg_bbox(l, p);
-  seg_bbox(r, p);
 }
 
 /* Roots closer than this to an end of the piece or to each other are not

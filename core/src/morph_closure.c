@@ -395,20 +395,27 @@ km_status km__closure_kappa(const km_pp *kappa, double L, const double *c,
   return st;
 }
 
+km_status km__signature_with_kappa(const km_signature *sig, const km_pp *kt,
+                                   km_signature *out, km_error *err) {
+  km_fn kf;
+  km_fn_init(&kf);
+  km_status st = km__pp_to_fn(&kf, kt);
+  if (st) st = km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
+  if (!st)
+    st = km_signature_create(out, sig->length, sig->start, sig->angle, &kf,
+                             sig->corners, sig->ncorners, sig->closed, err);
+  km_fn_free(&kf);
+  return st;
+}
+
 km_status km__closure_add(const km_signature *sig, const double *c,
                           km_signature *out, km_error *err) {
   km_pp k0, kt;
   km__pp_init(&k0);
   km__pp_init(&kt);
-  km_fn kf;
-  km_fn_init(&kf);
   km_status st = km__pp_from_fn(&k0, &sig->kappa);
   if (!st) st = km__closure_kappa(&k0, sig->length, c, &kt);
-  if (!st) st = km__pp_to_fn(&kf, &kt);
-  if (!st)
-    st = km_signature_create(out, sig->length, sig->start, sig->angle, &kf,
-                             sig->corners, sig->ncorners, sig->closed, err);
-  km_fn_free(&kf);
+  if (!st) st = km__signature_with_kappa(sig, &kt, out, err);
   km__pp_free(&k0);
   km__pp_free(&kt);
   return st;

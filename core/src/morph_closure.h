@@ -69,6 +69,11 @@ km_status km__close_lsq(const km_signature *sig, bool by_corners,
  * tangent angle) into *out, as km__close_lsq closes it. KM_ENOMEM. */
 km_status km__closure_add(const km_signature *sig, const double *c,
                           km_signature *out, km_error *err);
+/* sig with its smooth curvature replaced by kt (over [0, sig's length])
+ * into *out: the same length, start, angle and corners. KM_ENOMEM (err)
+ * and the statuses of km_signature_create. */
+km_status km__signature_with_kappa(const km_signature *sig, const km_pp *kt,
+                                   km_signature *out, km_error *err);
 /* Curvature kappa (over [0, L] in arc length) changed by the closure
  * correction psi' of coefficients c into *out (the caller frees it), as
  * km__closure_add changes a signature's. KM_ENOMEM. */

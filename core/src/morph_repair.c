@@ -933,17 +933,13 @@ km_status km__add_kappa(const km_signature *sig, const km_pp *dk,
   km_pp k0, kt;
   km__pp_init(&k0);
   km__pp_init(&kt);
-  km_fn kf;
-  km_fn_init(&kf);
   double L = sig->length;
   km_status st = km__pp_from_fn(&k0, &sig->kappa);
   if (!st) st = km__pp_blend(&kt, &k0, 1.0, dk, 1.0 / L, 0.0, L);
-  if (!st) st = km__pp_to_fn(&kf, &kt);
-  if (st) st = km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
-  if (!st)
-    st = km_signature_create(out, L, sig->start, sig->angle, &kf, sig->corners,
-                             sig->ncorners, sig->closed, err);
-  km_fn_free(&kf);
+  if (st)
+    st = km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
+  else
+    st = km__signature_with_kappa(sig, &kt, out, err);
   km__pp_free(&k0);
   km__pp_free(&kt);
   return st;
