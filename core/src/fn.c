@@ -214,20 +214,24 @@ double km_fn_abs_bound(const km_fn *f, double x0, double x1) {
   return m;
 }
 
-/* max |p| over [0,1] by subdivision: the coefficient hull bounds from
- * above, end values from below. */
-static double bern_max_abs(const double *c, int d, double lower, int depth) {
+/* max |p| over [0,1] by subdivision, to rel relative: the coefficient
+ * hull bounds from above, end values from below. */
+static double bern_max_abs_within(const double *c, int d, double lower,
+                                  double rel, int depth) {
   double ends = fmax(fabs(c[0]), fabs(c[d]));
   if (ends > lower) lower = ends;
   double upper = km__bern_abs_bound(c, d);
-  if (upper <= lower * (1.0 + 1e-13) || depth > 60) return fmax(lower, ends);
+  if (upper <= lower * (1.0 + rel) || depth > 60) return fmax(lower, ends);
   double L[FN_MAX_DEGREE + 2], R[FN_MAX_DEGREE + 2];
-  km__bern_restrict(c, d, 0.0, 0.5, L);
-  km__bern_restrict(c, d, 0.5, 1.0, R);
-  double ml = bern_max_abs(L, d, lower, depth + 1);
+  km__bern_halves(c, d, L, R);
+  double ml = bern_max_abs_within(L, d, lower, rel, depth + 1);
   if (ml > lower) lower = ml;
-  double mr = bern_max_abs(R, d, lower, depth + 1);
+  double mr = bern_max_abs_within(R, d, lower, rel, depth + 1);
   return fmax(lower, mr);
+}
+
+static double bern_max_abs(const double *c, int d, double lower, int depth) {
+  return bern_max_abs_within(c, d, lower, 1e-13, depth);
 }
 
 double km__pp_max_abs(const km_pp *p) {
@@ -235,6 +239,33 @@ double km__pp_max_abs(const km_pp *p) {
   int d = p->degree;
   for (size_t i = 0; i < p->m; i++)
     m = fmax(m, bern_max_abs(p->c + i * (size_t)(d + 1), d, m, 0));
+  return m;
+}
+
+double km__pp_max_abs_within(const km_pp *p, double rel) {
+  double m = 0.0;
+  int d = p->degree;
+  /* every piece's end values first: a lower bound that spares refining
+   * pieces whose own maximum is not the largest (a curvature that is
+   * nearly constant on a stretch has many, each refined in turn when
+   * compared with the running maximum only) */
+  for (size_t i = 0; i < p->m; i++) {
+    const double *c = p->c + i * (size_t)(d + 1);
+    m = fmax(m, fmax(fabs(c[0]), fabs(c[d])));
+  }
+  for (size_t i = 0; i < p->m; i++) {
+    const double *c = p->c + i * (size_t)(d + 1);
+    /* a piece monotone by its coefficients (their differences of one
+     * sign) has its largest |value| at an end, taken above: most pieces
+     * of a curvature, whose subdivision towards an end maximum only
+     * halves the gap a level */
+    bool up = true, down = true;
+    for (int j = 0; j < d; j++) {
+      up = up && c[j + 1] >= c[j];
+      down = down && c[j + 1] <= c[j];
+    }
+    if (!up && !down) m = fmax(m, bern_max_abs_within(c, d, m, rel, 0));
+  }
   return m;
 }
 

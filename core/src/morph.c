@@ -608,6 +608,12 @@ static km_status placed_signature(const km_signature *sig, double rot,
                              sig->closed, err);
 }
 
+/* How closely a planned frame's max |kappa| is found: far below the
+ * tolerance the frame itself is within. square_to_circle's frames have
+ * eight equal maxima, each refined by halving until the hull meets it:
+ * to 1e-13 that was a third of a frame with metrics. */
+#define MAX_KAPPA_REL 1e-9
+
 /* The planned frame with the metrics of the signature it is built from:
  * the blend closed by the frame's own closure correction (the basis and
  * metric of the general path's lsq closure, its coefficients those the
@@ -645,7 +651,7 @@ static km_status planned_frame_with_metrics(const km_morph *m, double t,
     if (!st) {
       const km_pp *k = psi ? &kt : &kb;
       metrics->length = Lt;
-      metrics->max_abs_kappa = km__pp_max_abs(k);
+      metrics->max_abs_kappa = km__pp_max_abs_within(k, MAX_KAPPA_REL);
       metrics->bending_energy = km__pp_integral_sq(k);
       st = curve_metrics(m, &f, lsq ? cl.gap0 : 0.0, poll, metrics, err);
     }

@@ -110,6 +110,10 @@ static void bern_split(const double *c, int d, double u, double *L, double *R) {
   }
 }
 
+void km__bern_halves(const double *c, int d, double *L, double *R) {
+  bern_split(c, d, 0.5, L, R);
+}
+
 void km__bern_restrict(const double *c, int d, double u0, double u1,
                        double *out) {
   double tmp[KM_MAX_FN_DEGREE + 2];

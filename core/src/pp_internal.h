@@ -49,6 +49,9 @@ void km__bern_restrict(const double *c, int d, double u0, double u1,
                        double *out);
 /* Degree elevation from d to e >= d. */
 void km__bern_elevate(const double *c, int d, int e, double *out);
+/* Both halves of c (degree d) at once: what km__bern_restrict gives for
+ * [0, 1/2] into L and for [1/2, 1] into R, by one de Casteljau pass. */
+void km__bern_halves(const double *c, int d, double *L, double *R);
 /* Derivative with respect to the piece variable scaled by 1/h (degree d-1
  * coefficients). */
 void km__bern_derivative(const double *c, int d, double h, double *out);
@@ -58,6 +61,10 @@ double km__bern_abs_bound(const double *c, int d);
 size_t km__pp_find(const km_pp *p, double x);
 double km__pp_eval(const km_pp *p, double x);
 double km__pp_max_abs(const km_pp *p);
+/* The same to rel relative (the value returned is attained, at most rel
+ * below the largest): a frame's metric needs no 1e-13, whose subdivision
+ * costs most where the curvature is nearly constant. */
+double km__pp_max_abs_within(const km_pp *p, double rel);
 double km__pp_integral_sq(const km_pp *p);
 /* out(u0 + r (u1-u0)) = wa a(r over a's domain) + wb b(r over b's), exact. */
 km_status km__pp_blend(km_pp *out, const km_pp *a, double wa, const km_pp *b,
