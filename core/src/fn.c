@@ -290,9 +290,12 @@ static double binom(int n, int k) {
  * 2d is sum over a of C(d,a) C(d,k-a) / C(2d,k) f_a g_(k-a); the integral
  * over a piece of width h is h times their mean. These are the weights. */
 static void sq_weights(int d, double w[FN_MAX_DEGREE + 2][FN_MAX_DEGREE + 2]) {
+  /* the binomials once each (exact integers, as binom gives them) */
+  double bd[FN_MAX_DEGREE + 2], b2d[2 * FN_MAX_DEGREE + 3];
+  for (int a = 0; a <= d; a++) bd[a] = binom(d, a);
+  for (int k = 0; k <= 2 * d; k++) b2d[k] = binom(2 * d, k);
   for (int a = 0; a <= d; a++)
-    for (int b = 0; b <= d; b++)
-      w[a][b] = binom(d, a) * binom(d, b) / binom(2 * d, a + b);
+    for (int b = 0; b <= d; b++) w[a][b] = bd[a] * bd[b] / b2d[a + b];
 }
 
 static double piece_sq(double w[FN_MAX_DEGREE + 2][FN_MAX_DEGREE + 2],
