@@ -573,12 +573,13 @@ static const double BERN3_AT_NINTHS[10][4] = {
 /* The parameters u[k - a] of M's points nearest the junctions of pieces
  * a .. b - 1 (u[0] = 0, u[b - a] = 1) and M's speed there over the
  * pieces' (slope[k - a], du / ds in the knot parameter s), from a first
- * guess in proportion to arc length; false if they do not increase.
- * *est receives the largest distance from a junction to M. */
+ * guess in proportion to arc length; false if they do not increase, or
+ * if a junction is past budget from M (slack added, as merges does:
+ * merge_distance's bound is at least that). */
 static bool match_junctions(const double *bz, const double *X, size_t a,
-                            size_t b, const cubic *q, double *u, double *slope,
-                            double *est) {
-  double H = X[b] - X[a], sp2, d2, worst = 0.0;
+                            size_t b, const cubic *q, double budget,
+                            double slack, double *u, double *slope) {
+  double H = X[b] - X[a], sp2, d2, worst = 0.0, lim = budget - slack;
   u[0] = 0.0;
   u[b - a] = 1.0;
   for (size_t k = a + 1; k < b; k++) {
@@ -587,6 +588,9 @@ static bool match_junctions(const double *bz, const double *X, size_t a,
     /* the pieces' speed at a junction is 1 in s (legs a third of the
      * span): du / ds = 1 / |M'(u)| */
     slope[k - a] = 1.0 / sqrt(sp2);
+    /* past the budget already (d2 > lim^2 only saves the root): the
+     * largest distance can only grow */
+    if (d2 > lim * lim && sqrt(d2) + slack > budget) return false;
     worst = max_nan(worst, d2);
   }
   if (!(u[b - a] > u[b - a - 1])) return false;
@@ -596,8 +600,7 @@ static bool match_junctions(const double *bz, const double *X, size_t a,
     if (!(sp > 0)) return false;
     slope[i] = 1.0 / sp;
   }
-  *est = sqrt(worst);
-  return true;
+  return !(sqrt(worst) + slack > budget);
 }
 
 /* A bound on the distance between cubic M (power form q) and pieces a ..
@@ -684,13 +687,12 @@ static bool turns_not(const double *bz, size_t k) {
  * (merge_distance). u and slope are scratch (b - a + 1 each). */
 static bool merges(const double *bz, const double *X, size_t a, size_t b,
                    double budget, double slack, double *u, double *slope) {
-  double M[8], v[2], est;
+  double M[8], v[2];
   cubic q;
   if (!run_speeds(bz, X, a, b, v)) return false;
   merged_cubic(bz, X, a, b, v, M);
   cubic_of(M, &q);
-  if (!match_junctions(bz, X, a, b, &q, u, slope, &est) || est + slack > budget)
-    return false;
+  if (!match_junctions(bz, X, a, b, &q, budget, slack, u, slope)) return false;
   return merge_distance(bz, X, a, b, &q, u, slope, budget) + slack <= budget;
 }
 
