@@ -18,7 +18,7 @@
  * a corner the frame turns at. So a frame is within the pieces' share
  * plus the merge's of its exact curve, as point sets, and carries 1.0-2.6x
  * fewer control points than its pieces (the circle's arcs four to a
- * cubic). The bound costs some 1,800 instructions an evaluation, two
+ * cubic). The bound costs some 1,200 instructions an evaluation, two
  * evaluations a run: more than printing the points it saves through the
  * CLI (bench/RESULTS.md).
  */
@@ -518,9 +518,10 @@ static double project(const cubic *q, const double x[2], double u,
  * place of pieces a .. b - 1 by the arc formula: legs 2 c^2 / (3 (c +
  * T.d)) for chord d, |d| = c, end tangent T (a circular arc's best); 1
  * (the pieces' own, Hermite in arc length) for a single piece. False
- * where an end turns too far from the chord. */
-static bool run_speeds(const double *bz, const double *X, size_t a, size_t b,
-                       double v[2]) {
+ * where an end turns too far from the chord. Inline, as merged_cubic:
+ * the calls were some 5% of a bound. */
+static inline bool run_speeds(const double *bz, const double *X, size_t a,
+                              size_t b, double v[2]) {
   v[0] = v[1] = 1.0;
   if (b == a + 1) return true;
   const double *A = bz + 8 * a, *B = bz + 8 * (b - 1);
@@ -542,8 +543,8 @@ static bool run_speeds(const double *bz, const double *X, size_t a, size_t b,
 /* The cubic M (8 values, as bz) in place of pieces a .. b - 1: their end
  * points and end tangents, legs v[0] H / 3 and v[1] H / 3 over its knot
  * span H (speeds v in the arc-length knots). */
-static void merged_cubic(const double *bz, const double *X, size_t a, size_t b,
-                         const double v[2], double M[8]) {
+static inline void merged_cubic(const double *bz, const double *X, size_t a,
+                                size_t b, const double v[2], double M[8]) {
   const double *A = bz + 8 * a, *B = bz + 8 * (b - 1);
   double H = X[b] - X[a], fa = v[0] * H / (X[a + 1] - X[a]),
          fb = v[1] * H / (X[b] - X[b - 1]);
@@ -712,10 +713,14 @@ static size_t merge_runs(const km__frame_plan *p, const double *bz,
   double slack = 1e-11 * X[np];
   /* runs of a frame are of similar lengths: each starts from the last
    * one's and grows or shrinks by the bound */
-  size_t guess = 2;
+  size_t guess = 2, stop = 0;
   while (a < np) {
-    size_t stop = a + 1;
-    while (stop < np && (!p->corner[stop] || turns_not(bz, stop))) stop++;
+    /* the first corner past a the frame turns at: the same for every run
+     * before it */
+    if (stop <= a) {
+      stop = a + 1;
+      while (stop < np && (!p->corner[stop] || turns_not(bz, stop))) stop++;
+    }
     size_t b = a + guess < stop ? a + guess : stop;
     while (b > a + 1 && !merges(bz, X, a, b, budget, slack, u, slope)) b--;
     if (b == a + guess)
