@@ -18,7 +18,7 @@
  * a corner the frame turns at. So a frame is within the pieces' share
  * plus the merge's of its exact curve, as point sets, and carries 1.0-2.6x
  * fewer control points than its pieces (the circle's arcs four to a
- * cubic). The bound costs some 1,800 instructions an evaluation, two
+ * cubic). The bound costs some 1,200 instructions an evaluation, two
  * evaluations a run: more than printing the points it saves through the
  * CLI (bench/RESULTS.md).
  */
@@ -448,25 +448,44 @@ static inline double max_nan(double w, double e) {
   return (isnan(w) || e <= w) ? w : e;
 }
 
-/* A cubic in power form about u = 0: c[d][k] the coefficient of u^k of
- * coordinate d. */
+/* A point or vector of the plane, x and y side by side in one SSE2
+ * register (a GCC and Clang extension; gcc -O3 would not pair them by
+ * itself here). Each lane rounds as the scalar expression would, in the
+ * same order: the bounds are those of the coordinates taken apart, to the
+ * bit. */
+typedef double vec2 __attribute__((vector_size(16)));
+
+static inline vec2 vec2_at(const double *p) {
+  return (vec2){p[0], p[1]};
+}
+
+/* x^2 + y^2 */
+static inline double norm2(vec2 v) {
+  vec2 s = v * v;
+  return s[0] + s[1];
+}
+
+/* A cubic in power form about u = 0: c[k] the coefficient of u^k. */
 typedef struct cubic {
-  double c[2][4];
+  vec2 c[4];
 } cubic;
 
 static void cubic_of(const double *M, cubic *q) {
-  for (int d = 0; d < 2; d++) {
-    double m0 = M[d], m1 = M[2 + d], m2 = M[4 + d], m3 = M[6 + d];
-    q->c[d][0] = m0;
-    q->c[d][1] = 3 * (m1 - m0);
-    q->c[d][2] = 3 * (m2 - 2 * m1 + m0);
-    q->c[d][3] = m3 - 3 * m2 + 3 * m1 - m0;
-  }
+  vec2 m0 = vec2_at(M), m1 = vec2_at(M + 2), m2 = vec2_at(M + 4),
+       m3 = vec2_at(M + 6);
+  q->c[0] = m0;
+  q->c[1] = 3.0 * (m1 - m0);
+  q->c[2] = 3.0 * (m2 - 2.0 * m1 + m0);
+  q->c[3] = m3 - 3.0 * m2 + 3.0 * m1 - m0;
 }
 
-static inline void cubic_at(const cubic *q, double u, double out[2]) {
-  for (int d = 0; d < 2; d++)
-    out[d] = q->c[d][0] + u * (q->c[d][1] + u * (q->c[d][2] + u * q->c[d][3]));
+static inline vec2 cubic_at(const cubic *q, double u) {
+  return q->c[0] + u * (q->c[1] + u * (q->c[2] + u * q->c[3]));
+}
+
+/* q' at u */
+static inline vec2 cubic_d1(const cubic *q, double u) {
+  return q->c[1] + u * (2.0 * q->c[2] + u * 3.0 * q->c[3]);
 }
 
 /* The parameter of the point of cubic q nearest point x, by Newton from u
@@ -474,31 +493,24 @@ static inline void cubic_at(const cubic *q, double u, double out[2]) {
  * distance. */
 static double project(const cubic *q, const double x[2], double u,
                       double *speed2, double *dist2) {
-  double p[2], p1[2];
+  vec2 c0 = q->c[0] - vec2_at(x), p, p1;
   /* any increasing match keeps merge_distance a bound: two steps from a
    * guess near the point make it close enough to be tight */
   for (int it = 0; it < 2; it++) {
-    double f = 0.0, fp = 0.0;
-    for (int d = 0; d < 2; d++) {
-      const double *c = q->c[d];
-      p[d] = c[0] - x[d] + u * (c[1] + u * (c[2] + u * c[3]));
-      p1[d] = c[1] + u * (2 * c[2] + u * 3 * c[3]);
-      double p2 = 2 * c[2] + 6 * u * c[3];
-      f += p[d] * p1[d];
-      fp += p1[d] * p1[d] + p[d] * p2;
-    }
+    p = c0 + u * (q->c[1] + u * (q->c[2] + u * q->c[3]));
+    p1 = cubic_d1(q, u);
+    vec2 p2 = 2.0 * q->c[2] + 6.0 * u * q->c[3], pp = p * p1,
+         dd = p1 * p1 + p * p2;
+    /* summed from 0.0 as the coordinates were: the sign of a zero */
+    double f = 0.0 + pp[0] + pp[1], fp = 0.0 + dd[0] + dd[1];
     if (!(fp > 0)) break;
     double du = f / fp;
     u -= du;
     u = u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
   }
-  for (int d = 0; d < 2; d++) {
-    const double *c = q->c[d];
-    p[d] = c[0] - x[d] + u * (c[1] + u * (c[2] + u * c[3]));
-    p1[d] = c[1] + u * (2 * c[2] + u * 3 * c[3]);
-  }
-  *speed2 = p1[0] * p1[0] + p1[1] * p1[1];
-  *dist2 = p[0] * p[0] + p[1] * p[1];
+  p = c0 + u * (q->c[1] + u * (q->c[2] + u * q->c[3]));
+  *speed2 = norm2(cubic_d1(q, u));
+  *dist2 = norm2(p);
   return u;
 }
 
@@ -506,9 +518,10 @@ static double project(const cubic *q, const double x[2], double u,
  * place of pieces a .. b - 1 by the arc formula: legs 2 c^2 / (3 (c +
  * T.d)) for chord d, |d| = c, end tangent T (a circular arc's best); 1
  * (the pieces' own, Hermite in arc length) for a single piece. False
- * where an end turns too far from the chord. */
-static bool run_speeds(const double *bz, const double *X, size_t a, size_t b,
-                       double v[2]) {
+ * where an end turns too far from the chord. Inline, as merged_cubic:
+ * the calls were some 5% of a bound. */
+static inline bool run_speeds(const double *bz, const double *X, size_t a,
+                              size_t b, double v[2]) {
   v[0] = v[1] = 1.0;
   if (b == a + 1) return true;
   const double *A = bz + 8 * a, *B = bz + 8 * (b - 1);
@@ -530,8 +543,8 @@ static bool run_speeds(const double *bz, const double *X, size_t a, size_t b,
 /* The cubic M (8 values, as bz) in place of pieces a .. b - 1: their end
  * points and end tangents, legs v[0] H / 3 and v[1] H / 3 over its knot
  * span H (speeds v in the arc-length knots). */
-static void merged_cubic(const double *bz, const double *X, size_t a, size_t b,
-                         const double v[2], double M[8]) {
+static inline void merged_cubic(const double *bz, const double *X, size_t a,
+                                size_t b, const double v[2], double M[8]) {
   const double *A = bz + 8 * a, *B = bz + 8 * (b - 1);
   double H = X[b] - X[a], fa = v[0] * H / (X[a + 1] - X[a]),
          fb = v[1] * H / (X[b] - X[b - 1]);
@@ -561,12 +574,13 @@ static const double BERN3_AT_NINTHS[10][4] = {
 /* The parameters u[k - a] of M's points nearest the junctions of pieces
  * a .. b - 1 (u[0] = 0, u[b - a] = 1) and M's speed there over the
  * pieces' (slope[k - a], du / ds in the knot parameter s), from a first
- * guess in proportion to arc length; false if they do not increase.
- * *est receives the largest distance from a junction to M. */
+ * guess in proportion to arc length; false if they do not increase, or
+ * if a junction is past budget from M (slack added, as merges does:
+ * merge_distance's bound is at least that). */
 static bool match_junctions(const double *bz, const double *X, size_t a,
-                            size_t b, const cubic *q, double *u, double *slope,
-                            double *est) {
-  double H = X[b] - X[a], sp2, d2, worst = 0.0;
+                            size_t b, const cubic *q, double budget,
+                            double slack, double *u, double *slope) {
+  double H = X[b] - X[a], sp2, d2, worst = 0.0, lim = budget - slack;
   u[0] = 0.0;
   u[b - a] = 1.0;
   for (size_t k = a + 1; k < b; k++) {
@@ -575,20 +589,19 @@ static bool match_junctions(const double *bz, const double *X, size_t a,
     /* the pieces' speed at a junction is 1 in s (legs a third of the
      * span): du / ds = 1 / |M'(u)| */
     slope[k - a] = 1.0 / sqrt(sp2);
+    /* past the budget already (d2 > lim^2 only saves the root): the
+     * largest distance can only grow */
+    if (d2 > lim * lim && sqrt(d2) + slack > budget) return false;
     worst = max_nan(worst, d2);
   }
   if (!(u[b - a] > u[b - a - 1])) return false;
   for (size_t e = 0; e < 2; e++) {
     size_t i = e ? b - a : 0;
-    double uu = u[i],
-           p1x = q->c[0][1] + uu * (2 * q->c[0][2] + uu * 3 * q->c[0][3]),
-           p1y = q->c[1][1] + uu * (2 * q->c[1][2] + uu * 3 * q->c[1][3]);
-    double sp = sqrt(p1x * p1x + p1y * p1y);
+    double sp = sqrt(norm2(cubic_d1(q, u[i])));
     if (!(sp > 0)) return false;
     slope[i] = 1.0 / sp;
   }
-  *est = sqrt(worst);
-  return true;
+  return !(sqrt(worst) + slack > budget);
 }
 
 /* A bound on the distance between cubic M (power form q) and pieces a ..
@@ -598,48 +611,66 @@ static bool match_junctions(const double *bz, const double *X, size_t a,
  * Bernstein coefficients are), the difference P_k(s) - M(g(s)) is a
  * polynomial of degree 9, and its largest Bernstein coefficient bounds it
  * (a quadratic g left a tangential mismatch of some 3x the normal
- * distance). Stops (returning more) once past budget. */
+ * distance). Stops (returning more) once past budget.
+ *   A piece's value at 0 is the last one's at 1 (the same point, the same
+ * u), and at 0 and 1 the weights (1, 0, 0, 0) leave g and the piece at
+ * their ends: each piece works out nine values and one cubic at the
+ * ends, to the bit what all ten would give. */
 static double merge_distance(const double *bz, const double *X, size_t a,
                              size_t b, const cubic *q, const double *u,
                              const double *slope, double budget) {
   double worst = 0.0, b2 = budget * budget;
+  vec2 D[10];
+  D[9] = vec2_at(bz + 8 * a) - cubic_at(q, u[0]);
+  worst = max_nan(worst, norm2(D[9]));
   for (size_t k = a; k < b && worst <= b2; k++) {
     const double *Pk = bz + 8 * k;
     double h = X[k + 1] - X[k], u0 = u[k - a], u1 = u[k - a + 1];
     double gb[4] = {u0, u0 + slope[k - a] * h / 3,
                     u1 - slope[k - a + 1] * h / 3, u1};
     if (!(gb[0] <= gb[1] && gb[1] <= gb[2] && gb[2] <= gb[3])) return INFINITY;
-    double D[10][2];
-    for (int i = 0; i <= 9; i++) {
-      const double *w = BERN3_AT_NINTHS[i];
-      double g = w[0] * gb[0] + w[1] * gb[1] + w[2] * gb[2] + w[3] * gb[3],
-             m[2];
-      cubic_at(q, g, m);
-      D[i][0] =
-          w[0] * Pk[0] + w[1] * Pk[2] + w[2] * Pk[4] + w[3] * Pk[6] - m[0];
-      D[i][1] =
-          w[0] * Pk[1] + w[1] * Pk[3] + w[2] * Pk[5] + w[3] * Pk[7] - m[1];
+    vec2 P[4] = {vec2_at(Pk), vec2_at(Pk + 2), vec2_at(Pk + 4),
+                 vec2_at(Pk + 6)};
+    D[0] = D[9];
+    /* values i and 9 - i, whose weights are each other's reversed: g at
+     * both side by side */
+    for (int i = 1; i < 5; i++) {
+      const double *w = BERN3_AT_NINTHS[i], *v = BERN3_AT_NINTHS[9 - i];
+      vec2 g = (vec2){w[0], v[0]} * gb[0] + (vec2){w[1], v[1]} * gb[1] +
+               (vec2){w[2], v[2]} * gb[2] + (vec2){w[3], v[3]} * gb[3];
+      D[i] = w[0] * P[0] + w[1] * P[1] + w[2] * P[2] + w[3] * P[3] -
+             cubic_at(q, g[0]);
+      D[9 - i] = v[0] * P[0] + v[1] * P[1] + v[2] * P[2] + v[3] * P[3] -
+                 cubic_at(q, g[1]);
     }
-    double S[5][2], T[5][2];
-    for (int i = 0; i < 5; i++)
-      for (int d = 0; d < 2; d++) {
-        S[i][d] = D[i][d] + D[9 - i][d];
-        T[i][d] = D[i][d] - D[9 - i][d];
-      }
-    worst = max_nan(worst, D[0][0] * D[0][0] + D[0][1] * D[0][1]);
-    worst = max_nan(worst, D[9][0] * D[9][0] + D[9][1] * D[9][1]);
+    D[9] = P[3] - cubic_at(q, u1);
+    vec2 S[5], T[5];
+    for (int i = 0; i < 5; i++) {
+      S[i] = D[i] + D[9 - i];
+      T[i] = D[i] - D[9 - i];
+    }
+    /* coefficients j and 9 - j, their squared norms side by side in V[j];
+     * their largest, and their sum to catch a NaN (which the largest
+     * drops) */
+    vec2 V[4], all = {0.0, 0.0};
     for (int j = 0; j < 4; j++) {
-      double e[2] = {0.0, 0.0}, o[2] = {0.0, 0.0};
-      for (int i = 0; i < 5; i++)
-        for (int d = 0; d < 2; d++) {
-          e[d] += BERN9_EVEN[j][i] * S[i][d];
-          o[d] += BERN9_ODD[j][i] * T[i][d];
-        }
-      double lx = e[0] + o[0], ly = e[1] + o[1], rx = e[0] - o[0],
-             ry = e[1] - o[1];
-      worst = max_nan(worst, lx * lx + ly * ly);
-      worst = max_nan(worst, rx * rx + ry * ry);
+      vec2 e = {0.0, 0.0}, o = {0.0, 0.0};
+      for (int i = 0; i < 5; i++) {
+        e += BERN9_EVEN[j][i] * S[i];
+        o += BERN9_ODD[j][i] * T[i];
+      }
+      vec2 l = e + o, r = e - o;
+      l *= l;
+      r *= r;
+      V[j] = (vec2){l[0], r[0]} + (vec2){l[1], r[1]};
+      all += V[j];
     }
+    if (isnan(all[0] + all[1])) return NAN;
+    double top = V[0][0];
+    for (int j = 0; j < 4; j++)
+      for (int s = 0; s < 2; s++) top = V[j][s] > top ? V[j][s] : top;
+    worst = max_nan(worst, top);
+    worst = max_nan(worst, norm2(D[9]));
   }
   return sqrt(worst);
 }
@@ -657,13 +688,12 @@ static bool turns_not(const double *bz, size_t k) {
  * (merge_distance). u and slope are scratch (b - a + 1 each). */
 static bool merges(const double *bz, const double *X, size_t a, size_t b,
                    double budget, double slack, double *u, double *slope) {
-  double M[8], v[2], est;
+  double M[8], v[2];
   cubic q;
   if (!run_speeds(bz, X, a, b, v)) return false;
   merged_cubic(bz, X, a, b, v, M);
   cubic_of(M, &q);
-  if (!match_junctions(bz, X, a, b, &q, u, slope, &est) || est + slack > budget)
-    return false;
+  if (!match_junctions(bz, X, a, b, &q, budget, slack, u, slope)) return false;
   return merge_distance(bz, X, a, b, &q, u, slope, budget) + slack <= budget;
 }
 
@@ -683,10 +713,14 @@ static size_t merge_runs(const km__frame_plan *p, const double *bz,
   double slack = 1e-11 * X[np];
   /* runs of a frame are of similar lengths: each starts from the last
    * one's and grows or shrinks by the bound */
-  size_t guess = 2;
+  size_t guess = 2, stop = 0;
   while (a < np) {
-    size_t stop = a + 1;
-    while (stop < np && (!p->corner[stop] || turns_not(bz, stop))) stop++;
+    /* the first corner past a the frame turns at: the same for every run
+     * before it */
+    if (stop <= a) {
+      stop = a + 1;
+      while (stop < np && (!p->corner[stop] || turns_not(bz, stop))) stop++;
+    }
     size_t b = a + guess < stop ? a + guess : stop;
     while (b > a + 1 && !merges(bz, X, a, b, budget, slack, u, slope)) b--;
     if (b == a + guess)
