@@ -380,7 +380,9 @@ km_status km__closure_kappa(const km_pp *kappa, double L, const double *c,
     double f[3];
     for (int k = 0; k < 3; k++) {
       double u = iv + 0.5 * k, v = 0.0;
-      for (int i = 0; i < NF; i++) v += c[i] * km__bspline3_d(u - i);
+      /* only B(u - i) with 0 < u - i < 4 is not zero: four of them */
+      int lo = iv - 4 > 0 ? iv - 4 : 0, hi = iv + 1 < NF ? iv + 1 : NF - 1;
+      for (int i = lo; i <= hi; i++) v += c[i] * km__bspline3_d(u - i);
       f[k] = v / h;
     }
     double *bc = dpsi.c + (size_t)iv * 3;
