@@ -167,6 +167,11 @@ static int usable_cpus(void) {
   return 1;
 }
 
+/* Answers up to this size are printed frame by frame on the rendering
+ * threads (api_morph_print_while_rendering): the printed frames and the
+ * answer are then both held for a moment. */
+#define PRINT_WHILE_RENDERING_BYTES ((size_t)32 << 20)
+
 /* Frames handed out one at a time to the rendering threads. */
 typedef struct frame_queue {
   api_morph_plan *plan;
@@ -198,6 +203,9 @@ static void handle_morph(const api_config *cfg, const api_request *req,
     return;
   frame_queue q = {plan, api_morph_frame_count(plan), 0, false};
   if (threads > 1 && q.count > 1) {
+    /* frames printed on the threads too, where the answer is small
+     * enough to be held twice */
+    api_morph_print_while_rendering(plan, PRINT_WHILE_RENDERING_BYTES);
     size_t extra = (size_t)threads - 1;
     if (extra > q.count - 1) extra = q.count - 1;
     pthread_t *tid = calloc(extra, sizeof *tid);

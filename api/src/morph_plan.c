@@ -24,6 +24,7 @@ void api_morph_plan_free(api_morph_plan *plan) {
     km_curve_free(&plan->frames[i].curve);
     km_signature_free(&plan->frames[i].sig);
     km_shape_frame_free(&plan->frames[i].shape);
+    api__svg_buf_free(&plan->frames[i].text);
   }
   km__free(plan->frames);
   km__free(plan->matches);
@@ -161,6 +162,28 @@ size_t api_morph_predicted_bytes(const api_morph_plan *plan) {
 
 /* ------------------------------------------------------ rendering frames */
 
+bool api_morph_print_while_rendering(api_morph_plan *plan, size_t limit) {
+  if (plan == NULL || plan->svg || plan->inc.animate_d ||
+      plan->predicted > limit)
+    return false;
+  plan->print_early = true;
+  return true;
+}
+
+/* Frame f's object of the answer into its slot, when the plan prints
+ * frames as they are rendered; left empty when it cannot be written (the
+ * answer then writes it and reports why). */
+static void print_early(api_morph_plan *plan, api_frame_slot *f) {
+  if (!plan->print_early) return;
+  api_ctx ctx;
+  api__ctx_init(&ctx, &plan->cfg);
+  api_grid grid = api__plan_grid(plan);
+  /* room for the frame's share of the predicted answer at once */
+  api__svg_buf_room(&f->text, plan->predicted / (plan->nframes + 1));
+  if (!api__frame_write(&ctx, &f->text, plan, f, &grid) || f->text.failed)
+    api__svg_buf_free(&f->text);
+}
+
 api_status api_morph_render_frame(api_morph_plan *plan, size_t i) {
   return api_morph_render_frame_until(plan, i, NULL, NULL);
 }
@@ -172,9 +195,13 @@ api_status api_morph_render_frame_until(api_morph_plan *plan, size_t i,
   if (plan == NULL || i >= plan->nframes) return 404;
   f = &plan->frames[i];
   if (f->state == API_FRAME_DONE) return API_STEP_DONE;
+  api__svg_buf_free(&f->text);
   if (plan->shapes) {
     api__shape_render(plan, f, stop != NULL ? &ks : NULL);
-    if (f->state == API_FRAME_DONE) return API_STEP_DONE;
+    if (f->state == API_FRAME_DONE) {
+      print_early(plan, f);
+      return API_STEP_DONE;
+    }
     return f->st == KM_ENOMEM || f->st == KM_ECANCELLED ? 503 : 422;
   }
   km_curve_free(&f->curve);
@@ -203,5 +230,6 @@ api_status api_morph_render_frame_until(api_morph_plan *plan, size_t i,
     }
   }
   f->state = API_FRAME_DONE;
+  print_early(plan, f);
   return API_STEP_DONE;
 }

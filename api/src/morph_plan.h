@@ -18,6 +18,7 @@
 #include <stddef.h>
 
 #include "internal.h"
+#include "json_write.h"
 #include "svg.h"
 
 /* Bytes of a colour option, its NUL included, at most. */
@@ -43,6 +44,10 @@ typedef struct api_frame_slot {
    * measured) and its crossings for "intersections" (-1: not counted) */
   double length;
   long crossings;
+  /* the frame's object of the JSON answer, printed on the thread that
+   * rendered it (api_morph_print_while_rendering); empty: printed with
+   * the answer */
+  api_svg_buf text;
 } api_frame_slot;
 
 struct api_morph_plan {
@@ -65,6 +70,7 @@ struct api_morph_plan {
   char stroke[API_COLOUR_MAX], from_color[API_COLOUR_MAX],
       to_color[API_COLOUR_MAX];
   size_t predicted; /* upper bound on the result's bytes */
+  bool print_early; /* frames print themselves when rendered */
   /* A compound morph (either input a shape): the shapes, their morph,
    * and the request's contour pairing (NULL: automatic). */
   bool shapes;
@@ -103,6 +109,13 @@ cJSON *api__intersections_json(api_ctx *ctx, const api_morph_plan *pl);
 /* The tolerance a frame's crossings are counted at for "intersections":
  * the request's, else the core's default (1e-5 of the longer input). */
 double api__crossing_tolerance(const api_morph_plan *pl);
+/* Frame f's object of the JSON answer (its t, curve or contours, metrics)
+ * into b, its control points on grid; false when it cannot be written
+ * (recorded in ctx). */
+bool api__frame_write(api_ctx *ctx, api_svg_buf *b, const api_morph_plan *pl,
+                      const api_frame_slot *f, const api_grid *grid);
+/* The grid a plan's control points are printed on (off when exact). */
+api_grid api__plan_grid(const api_morph_plan *pl);
 /* Cubic pieces of a path "M x y C ..." as api_svg_path_d writes it. */
 size_t api__count_pieces(const char *d);
 

@@ -74,9 +74,16 @@ static bool animate_write(api_ctx *ctx, api_svg_buf *b,
   return true;
 }
 
+api_grid api__plan_grid(const api_morph_plan *pl) {
+  api_grid grid = {false, 0};
+  if (pl->precision == API_PRECISION_TOLERANCE)
+    grid = api__tolerance_grid(pl->tol);
+  return grid;
+}
+
 /* One frame's object: its t, its curve, its metrics when asked for. */
-static bool frame_write(api_ctx *ctx, api_svg_buf *b, const api_morph_plan *pl,
-                        const api_frame_slot *f, const api_grid *grid) {
+bool api__frame_write(api_ctx *ctx, api_svg_buf *b, const api_morph_plan *pl,
+                      const api_frame_slot *f, const api_grid *grid) {
   if (pl->shapes) return api__shape_frame_write(ctx, b, pl, f);
   API_JSON_LIT(b, "{\"t\":");
   if (!api__json_num(ctx, b, f->t, "t")) return false;
@@ -112,16 +119,21 @@ static bool matches_used_write(api_ctx *ctx, api_svg_buf *b,
 static api_status result_json(api_ctx *ctx, api_morph_plan *pl,
                               api_response *out) {
   api_svg_buf b;
-  api_grid grid = {false, 0};
-  if (pl->precision == API_PRECISION_TOLERANCE)
-    grid = api__tolerance_grid(pl->tol);
+  api_grid grid = api__plan_grid(pl);
   api__svg_buf_init(&b);
   API_JSON_LIT(&b, "{\"method\":");
   api__json_string(&b, api__morph_method_names[pl->opt.method]);
   API_JSON_LIT(&b, ",\"frames\":[");
   for (size_t i = 0; i < pl->nframes; i++) {
+    api_frame_slot *f = &pl->frames[i];
     if (i > 0) API_JSON_LIT(&b, ",");
-    if (!frame_write(ctx, &b, pl, &pl->frames[i], &grid)) goto fail;
+    if (f->text.s != NULL) {
+      /* printed when rendered: copied, and its memory given back at once */
+      api__json_raw(&b, f->text.s, f->text.len);
+      api__svg_buf_free(&f->text);
+    } else if (!api__frame_write(ctx, &b, pl, f, &grid)) {
+      goto fail;
+    }
   }
   if (pl->shapes) {
     API_JSON_LIT(&b, "],\"contour_matches_used\":");

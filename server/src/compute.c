@@ -231,6 +231,10 @@ static void create_job(srv_req *r, api_request *req) {
 
 /* ------------------------------------------------ synchronous answers */
 
+/* Synchronous answers up to this size are printed frame by frame by the
+ * workers that render them (api_morph_print_while_rendering). */
+#define SYNC_PRINT_WHILE_RENDERING ((size_t)16 << 20)
+
 /* POST /v1/morph on a worker, frame by frame the way api_handle does it,
  * so that the work stops when the client leaves or the compute time limit
  * passes - between frames, and inside preparing and each frame through
@@ -257,6 +261,10 @@ static void morph_sync(srv_req *r, api_request *req) {
   /* Idle workers render frames beside this one (frame_share.h). A frame
    * that fails for its own reason leaves its problem in the plan for
    * api_morph_result; one that was stopped ends the work. */
+  /* with other workers to help, frames print themselves where they are
+   * rendered, for answers small enough to be held twice a moment */
+  if (n > 1 && srv_pool_workers(s->pool) > 1)
+    api_morph_print_while_rendering(plan, SYNC_PRINT_WHILE_RENDERING);
   srv_shared_frames sf;
   srv_frame_share_open(&s->shares, &sf, plan, n, r->deadline,
                        &s->abort_compute);

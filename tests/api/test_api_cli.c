@@ -164,6 +164,20 @@ static void cli_morph_threads_give_the_same_answer(void **state) {
   cJSON_Delete(j);
   free(one);
   free(many);
+  /* frames printed on the threads: on the tolerance grid, with svg_d */
+  at_buf g = {0};
+  at_printf(&g, "{\"from\":");
+  at_circle_json(&g, 0, 0, 2, 1);
+  at_printf(&g, ",\"to\":{\"type\":\"svg\",\"d\":\"M-2 -2 L2 -2 L2 2 L-2 "
+                "2 Z\"},\"frames\":17,\"precision\":\"tolerance\","
+                "\"include\":[\"svg_d\"]}");
+  assert_int_equal(run(env, "morph --threads 1", g.s, &one), 0);
+  assert_int_equal(run(env, "morph --threads 3", g.s, &many), 0);
+  assert_string_equal(one, many);
+  assert_non_null(strstr(many, "\"svg_d\":\"M"));
+  free(one);
+  free(many);
+  free(g.s);
   assert_int_equal(run(env, "morph --threads 0", b.s, &one), 2);
   free(one);
   assert_int_equal(run(env, "morph --threads", b.s, &one), 2);

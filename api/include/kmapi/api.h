@@ -150,6 +150,15 @@ api_status api_morph_render_frame(api_morph_plan *plan, size_t i);
  * unless it is rendered again first. */
 api_status api_morph_render_frame_until(api_morph_plan *plan, size_t i,
                                         api_stop_fn stop, void *ctx);
+/* Have each frame print its part of a JSON answer on the thread that
+ * renders it (call before rendering), so that frames rendered on several
+ * threads are printed on them too and api_morph_result only copies: the
+ * same bytes. The printed frames hold up to the answer's size again until
+ * the answer is assembled, so this is taken only when the predicted
+ * answer is at most limit bytes, and not for SVG or "animate_d" answers,
+ * which are written from every frame at once. Returns whether it was
+ * taken; false for a NULL plan. */
+bool api_morph_print_while_rendering(api_morph_plan *plan, size_t limit);
 /* Upper bound on the bytes of the result (JSON or SVG, as requested), as
  * checked against max_output_bytes by api_morph_prepare: for reserving
  * result memory before the frames are rendered. 0 for a NULL plan. */
