@@ -635,7 +635,9 @@ static km_status planned_frame_with_metrics(const km_morph *m, double t,
   km_status st = KM_OK;
   bool lsq = m->closed && how == KM_CLOSURE_LSQ;
   if (lsq || !m->closed) {
+    /* zero: a frame that failed before its closure leaves it so */
     km__plan_closure cl;
+    memset(&cl, 0, sizeof cl);
     st = planned_frame(m, t, how, poll, &f, lsq ? &cl : NULL, err);
     /* the curvature the frame is built from, without the signature's
      * tables: a piecewise polynomial is all its metrics need */
