@@ -39,6 +39,7 @@
 
 static void usage(FILE *to) {
   fputs("usage: kmorph signature|reconstruct|morph [--pretty] [--svg] "
+        "[--threads N] "
         "< request.json\n"
         "\n"
         "Reads one request body (JSON, as for POST /v1/<command>) from\n"
