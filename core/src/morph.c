@@ -25,6 +25,7 @@
 #include "morph_closure.h"
 #include "pp_internal.h"
 #include "morph_internal.h"
+#include "morph_kappa.h"
 #include "morph_linear.h"
 #include "morph_match.h"
 #include "morph_place.h"
@@ -51,6 +52,7 @@ void km_morph_free(km_morph *m) {
   km__free(m->ra);
   km__free(m->rb);
   km__frame_plan_free(m->plan);
+  km__kappa_table_free(m->frame_kappa);
   km__free(m->place_ab);
   km__repair_free(m->repair);
   km__free(m);
@@ -118,6 +120,10 @@ static km_status plan_frames(km_morph *m, km_error *err) {
                     m->opt.max_points);
   if (!st) m->close_by_corners = lsq && km__frame_plan_by_corners(m->plan);
   if (!st) st = km__place_plan_targets(m, err);
+  km__kappa_table_free(m->frame_kappa);
+  m->frame_kappa = NULL;
+  if (!st && km__kappa_table_build(&a->kappa, &b->kappa, &m->frame_kappa))
+    st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
   return st;
 }
 
@@ -610,8 +616,9 @@ static km_status placed_signature(const km_signature *sig, double rot,
 
 /* How closely a planned frame's max |kappa| is found: far below the
  * tolerance the frame itself is within. square_to_circle's frames have
- * eight equal maxima, each refined by halving until the hull meets it:
- * to 1e-13 that was a third of a frame with metrics. */
+ * eight equal maxima: refined by halving until the hull met them, to
+ * 1e-13 that was a third of a frame with metrics (where |kappa| is
+ * concave a Newton step now ends the search to rounding). */
 #define MAX_KAPPA_REL 1e-9
 
 /* The planned frame with the metrics of the signature it is built from:
@@ -620,10 +627,10 @@ static km_status placed_signature(const km_signature *sig, double rot,
  * planned frame found) gives length, curvature, energy and gap exactly,
  * and the crossings are counted on the returned curve, which is within
  * the tolerance of it. Neither the exact frame's reconstruction nor a
- * second closure solve is needed: a frame with metrics costs the blended
- * curvature (a piecewise polynomial, no signature), one pass for the gap
- * and the crossing count beyond the planned frame, and has the same curve
- * as without. A frame closed by turning its corners, and an open one,
+ * second closure solve is needed: a frame with metrics costs a weighted
+ * sum over the curvature tabled once per morph (morph_kappa.c: no blend
+ * of pieces, no signature), one pass for the gap and the crossing count
+ * beyond the planned frame, and has the same curve as without. A frame closed by turning its corners, and an open one,
  * have the blend's smooth curvature and length. */
 static km_status planned_frame_with_metrics(const km_morph *m, double t,
                                             km_closure how, km__poll *poll,
@@ -639,26 +646,18 @@ static km_status planned_frame_with_metrics(const km_morph *m, double t,
     km__plan_closure cl;
     memset(&cl, 0, sizeof cl);
     st = planned_frame(m, t, how, poll, &f, lsq ? &cl : NULL, err);
-    /* the curvature the frame is built from, without the signature's
-     * tables: a piecewise polynomial is all its metrics need */
-    double Lt = (1 - t) * m->in[0].sig.length + t * m->in[1].sig.length;
-    km_pp kb, kt;
-    km__pp_init(&kb);
-    km__pp_init(&kt);
-    if (!st) st = km__blend_kappa(m, t, &kb, err);
-    /* turning the corners leaves the blend's smooth curvature */
+    /* the curvature the frame is built from, tabled once per morph;
+     * turning the corners leaves the blend's smooth curvature */
+    double La = m->in[0].sig.length, Lb = m->in[1].sig.length;
     bool psi = lsq && !cl.by_corners;
-    if (!st && psi && km__closure_kappa(&kb, Lt, cl.c, &kt))
+    if (!st && km__kappa_table_metrics(
+                   m->frame_kappa, t, La, Lb, psi ? cl.c : NULL, MAX_KAPPA_REL,
+                   &metrics->max_abs_kappa, &metrics->bending_energy))
       st = km__fail(err, KM_ENOMEM, KM_FIELD_NONE, -1, NAN, NULL);
     if (!st) {
-      const km_pp *k = psi ? &kt : &kb;
-      metrics->length = Lt;
-      metrics->max_abs_kappa = km__pp_max_abs_within(k, MAX_KAPPA_REL);
-      metrics->bending_energy = km__pp_integral_sq(k);
+      metrics->length = (1 - t) * La + t * Lb;
       st = curve_metrics(m, &f, lsq ? cl.gap0 : 0.0, poll, metrics, err);
     }
-    km__pp_free(&kb);
-    km__pp_free(&kt);
   } else {
     /* the other closures: the general path's signature and gap */
     km_signature sig;

@@ -584,15 +584,6 @@ static km_status blend_parts(const km_morph *m, double t, km_pp *whole,
   return st;
 }
 
-km_status km__blend_kappa(const km_morph *m, double t, km_pp *out,
-                          km_error *err) {
-  corner_list cl = {NULL, 0, 0};
-  km_status st = blend_parts(m, t, out, &cl);
-  km__free(cl.c);
-  if (st == KM_ENOMEM) km__fail(err, st, KM_FIELD_NONE, -1, NAN, NULL);
-  return st;
-}
-
 km_status km__blend_signature(const km_morph *m, double t, km_signature *out,
                               km_error *err) {
   const km__input *a = &m->in[0], *b = &m->in[1];

@@ -14,13 +14,6 @@
  * km_signature_create. */
 km_status km__blend_signature(const km_morph *m, double t, km_signature *out,
                               km_error *err);
-/* The smooth part of the blended curvature of frame t alone (as
- * km__blend_signature's, over [0, L_t] in arc length) into *out (the
- * caller frees it): what a frame's metrics need of the blend, without
- * its corners and the signature's tables. Statuses as
- * km__blend_signature. */
-km_status km__blend_kappa(const km_morph *m, double t, km_pp *out,
-                          km_error *err);
 /* Frame arc length s of frame t -> the normalised arc lengths *ra, *rb on
  * the inputs that correspond to it (piecewise-linear correspondence). */
 void km__corresponding(const km_morph *m, double t, double s, double *ra,

@@ -20,6 +20,7 @@
 #include "km/morph.h"
 #include "km/signature.h"
 #include "km/status.h"
+#include "morph_kappa.h"
 #include "morph_plan.h"
 #include "morph_repair.h"
 
@@ -48,11 +49,12 @@ struct km_morph {
   km__input in[2];
   double *ra, *rb; /* correspondence knots, nm+2 of them incl. 0 and 1 */
   size_t nk;
-  size_t nuser;          /* match pairs reported */
-  km_curve lin[2];       /* compatible curves (linear method) */
-  km__frame_plan *plan;  /* frames planned once (morph_plan.c), or NULL */
-  bool close_by_corners; /* lsq closure by the frames' corners */
-  double kmax;           /* the inputs' largest |kappa|: the frames' bound */
+  size_t nuser;         /* match pairs reported */
+  km_curve lin[2];      /* compatible curves (linear method) */
+  km__frame_plan *plan; /* frames planned once (morph_plan.c), or NULL */
+  km__kappa_table *frame_kappa; /* planned frames' curvature (morph_kappa.c) */
+  bool close_by_corners;        /* lsq closure by the frames' corners */
+  double kmax; /* the inputs' largest |kappa|: the frames' bound */
   /* placement targets of planned frames: the inputs' points at the plan's
    * breaks (x, y of a, then of b) and the break's trapezoid weight; the
    * weights' sum and the weighted means */

@@ -66,6 +66,14 @@ double km__pp_max_abs(const km_pp *p);
  * costs most where the curvature is nearly constant. */
 double km__pp_max_abs_within(const km_pp *p, double rel);
 double km__pp_integral_sq(const km_pp *p);
+/* Integral over [0, 1] of the product of two Bernstein polynomials of
+ * degree d. */
+double km__bern_inner(const double *f, const double *g, int d);
+/* p's pieces over the intervals [r[i], r[i + 1]] of its normalised domain
+ * (r increasing in [0, 1], m intervals), each elevated to degree e >= p's:
+ * m * (e + 1) Bernstein coefficients into out, exact. */
+void km__pp_on_breaks(const km_pp *p, const double *r, size_t m, int e,
+                      double *out);
 /* out(u0 + r (u1-u0)) = wa a(r over a's domain) + wb b(r over b's), exact. */
 km_status km__pp_blend(km_pp *out, const km_pp *a, double wa, const km_pp *b,
                        double wb, double u0, double u1);

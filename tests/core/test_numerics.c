@@ -352,7 +352,40 @@ static void derivative_of_pieces_is_exact(void **state) {
   km__pp_free(&d);
 }
 
+/* q(x) = s (2 - 3 (x - x0)^2 + (x - x0)^4 / 2): |q| is concave on [0, 1]
+ * for x0 in [0, 1] (|q''| >= 3) with its largest value 2 at x0. Eight
+ * pieces with their maxima at different places and of equal height, as
+ * a nearly constant curvature has them: found to rounding (a Newton step
+ * on q'), not to the 1e-9 asked, and never above 2. */
+static void max_abs_of_concave_pieces_is_found_to_rounding(void **state) {
+  (void)state;
+  for (int sign = -1; sign <= 1; sign += 2) {
+    km_pp p;
+    km__pp_init(&p);
+    assert_int_equal(km__pp_alloc(&p, 4, 8), KM_OK);
+    for (size_t i = 0; i < 8; i++) {
+      double x0 = 0.1 + 0.1 * (double)i, a[5];
+      /* (x - x0)^2 = x^2 - 2 x0 x + x0^2, and its square */
+      double q2[3] = {x0 * x0, -2 * x0, 1.0};
+      double q4[5] = {q2[0] * q2[0], 2 * q2[0] * q2[1],
+                      q2[1] * q2[1] + 2 * q2[0] * q2[2], 2 * q2[1] * q2[2],
+                      q2[2] * q2[2]};
+      for (int j = 0; j <= 4; j++)
+        a[j] = sign *
+               ((j == 0 ? 2.0 : 0.0) - 3 * (j < 3 ? q2[j] : 0.0) + 0.5 * q4[j]);
+      power_to_bernstein(a, 4, p.c + 5 * i);
+      p.x[i] = (double)i;
+    }
+    p.x[8] = 8.0;
+    double m9 = km__pp_max_abs_within(&p, 1e-9), m13 = km__pp_max_abs(&p);
+    assert_true(fabs(m9 - 2.0) <= 4e-16 * 2 && m9 <= 2.0 * (1 + 1e-15));
+    assert_true(fabs(m13 - 2.0) <= 4e-16 * 2);
+    km__pp_free(&p);
+  }
+}
+
 static const struct CMUnitTest tests[] = {
+    cmocka_unit_test(max_abs_of_concave_pieces_is_found_to_rounding),
     cmocka_unit_test(cheb_cumulative_integrates_monomials_exactly),
     cmocka_unit_test(cheb_cumulative_of_exp_is_spectrally_accurate),
     cmocka_unit_test(bern_eval_is_within_its_rounding_bound),
