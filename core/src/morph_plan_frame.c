@@ -341,7 +341,8 @@ static void warm_start(const km__frame_plan *p, double t, double *c) {
  * km__frame_plan_curve allocates it). */
 static km_status frame_closure(const km__frame_plan *p, double t, double theta0,
                                bool close_lsq, double *c, double *sum,
-                               double *dp, bool *corners, km__poll *poll) {
+                               double *dp, bool *corners, double *g0,
+                               km__poll *poll) {
   size_t np = p->np, nc = p->ncorners;
   double *e = sum + 2 * np;
   double *tau = sum + km__plan_frame_scratch(p), *delta = tau + nc,
@@ -351,6 +352,15 @@ static km_status frame_closure(const km__frame_plan *p, double t, double theta0,
   for (size_t k = 0; k < np; k++) dp[k] = 0.0;
   if (lsq && p->by_corners) {
     st = km__plan_close_frame(p, t, theta0, false, false, c, sum, e, poll);
+    /* that pass was theta_t's alone (c is zero): its gap, summed as the
+     * pass sums it */
+    if (!st && g0) {
+      g0[0] = g0[1] = 0.0;
+      for (size_t k = 0; k < np; k++) {
+        g0[0] += sum[2 * k];
+        g0[1] += sum[2 * k + 1];
+      }
+    }
     if (!st)
       st = km__plan_corner_closure(p, t, sum, tau, delta, S, dp, &by_corners);
   }
@@ -811,19 +821,24 @@ km_status km__frame_plan_curve(const km__frame_plan *p, double t, double theta0,
   km_curve f;
   km_curve_init(&f);
   km_status st = KM_OK;
+  /* the gap of theta_t alone, as the general path measures it: the first
+   * pass of a closure by the corners is that pass already */
+  double G[2] = {NAN, NAN};
+  bool gap_from_closure = close_lsq && p->closed && p->by_corners;
   if (closure) {
     memset(closure, 0, sizeof *closure);
-    if (p->closed) {
-      /* theta_t alone: its gap, as the general path measures it */
-      double zero[NF + 6] = {0}, G[2];
+    if (p->closed && !gap_from_closure) {
+      double zero[NF + 6] = {0};
       frame_pass(p, t, theta0, zero, NULL, false, sum, sum + 2 * np, G, NULL,
                  poll);
-      closure->gap0 = ((1 - t) * p->La + t * p->Lb) * hypot(G[0], G[1]);
     }
   }
   if (!(poll && poll->stopped))
     st = frame_closure(p, t, theta0, close_lsq, c, sum, dp,
-                       closure ? &closure->by_corners : NULL, poll);
+                       closure ? &closure->by_corners : NULL,
+                       closure && gap_from_closure ? G : NULL, poll);
+  if (closure && p->closed && !isnan(G[0]))
+    closure->gap0 = ((1 - t) * p->La + t * p->Lb) * hypot(G[0], G[1]);
   if (st == KM_ECANCELLED || (poll && poll->stopped)) {
     st = KM_ECANCELLED;
     goto done;
