@@ -345,9 +345,13 @@ static void sq_weights(int d, double w[FN_MAX_DEGREE + 2][FN_MAX_DEGREE + 2]) {
     for (int b = 0; b <= d; b++) w[a][b] = bd[a] * bd[b] / b2d[a + b];
 }
 
-double km__bern_inner(const double *f, const double *g, int d) {
-  double w[FN_MAX_DEGREE + 2][FN_MAX_DEGREE + 2], s = 0.0;
+void km__bern_product_weights(int d, km__bern_weights w) {
   sq_weights(d, w);
+}
+
+double km__bern_inner(km__bern_weights w, const double *f, const double *g,
+                      int d) {
+  double s = 0.0;
   for (int a = 0; a <= d; a++)
     for (int b = 0; b <= d; b++) s += w[a][b] * f[a] * g[b];
   return s / (2 * d + 1);

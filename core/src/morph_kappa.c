@@ -94,6 +94,8 @@ static km_status merged_breaks(const km_pp *ka, const km_pp *kb,
 static void gram(km__kappa_table *k) {
   int e = k->e;
   size_t s = (size_t)(e + 1);
+  km__bern_weights w;
+  km__bern_product_weights(e, w);
   memset(k->G, 0, sizeof k->G);
   for (size_t i = 0; i < k->m; i++) {
     const double *f[6];
@@ -111,7 +113,7 @@ static void gram(km__kappa_table *k) {
     double h = k->r[i + 1] - k->r[i];
     for (int p = 0; p < n; p++)
       for (int q = p; q < n; q++) {
-        double v = h * km__bern_inner(f[p], f[q], e);
+        double v = h * km__bern_inner(w, f[p], f[q], e);
         k->G[idx[p] * NV + idx[q]] += v;
         if (idx[p] != idx[q]) k->G[idx[q] * NV + idx[p]] += v;
       }

@@ -67,8 +67,11 @@ double km__pp_max_abs(const km_pp *p);
 double km__pp_max_abs_within(const km_pp *p, double rel);
 double km__pp_integral_sq(const km_pp *p);
 /* Integral over [0, 1] of the product of two Bernstein polynomials of
- * degree d. */
-double km__bern_inner(const double *f, const double *g, int d);
+ * degree d, with the weights km__bern_product_weights tables for d. */
+typedef double km__bern_weights[KM_MAX_FN_DEGREE + 2][KM_MAX_FN_DEGREE + 2];
+void km__bern_product_weights(int d, km__bern_weights w);
+double km__bern_inner(km__bern_weights w, const double *f, const double *g,
+                      int d);
 /* p's pieces over the intervals [r[i], r[i + 1]] of its normalised domain
  * (r increasing in [0, 1], m intervals), each elevated to degree e >= p's:
  * m * (e + 1) Bernstein coefficients into out, exact. */
