@@ -303,19 +303,30 @@ api_grid api__tolerance_grid(double tol) {
 
 #define KNOT_GRID_DECADES 6 /* tried past the first candidate */
 
+/* The reciprocals of de Boor's denominators on span j of degree p with
+ * knots u, level r (1..p) and local index i (r..p) at inv[r * (p + 1) +
+ * i]: shared by the span's Bezier points. */
+static void span_inverses(const double *u, int p, size_t j, double *inv) {
+  size_t base = j - (size_t)p;
+  for (int r = 1; r <= p; r++)
+    for (int i = r; i <= p; i++)
+      inv[r * (p + 1) + i] =
+          1.0 / (u[base + (size_t)(i + p + 1 - r)] - u[base + (size_t)i]);
+}
+
 /* The k-th Bezier point of span j of the non-rational B-spline of degree
  * p with knots u and control points cp, by de Boor's algorithm on the
- * blossom's arguments (k copies of u_(j+1), then u_j). */
+ * blossom's arguments (k copies of u_(j+1), then u_j); inv from
+ * span_inverses. */
 static void bezier_point(const double *u, const double *cp, int p, size_t j,
-                         int k, double out[2]) {
+                         int k, const double *inv, double out[2]) {
   double d[2 * (KM_MAX_DEGREE + 1)];
   size_t base = j - (size_t)p;
   memcpy(d, cp + 2 * base, 2 * (size_t)(p + 1) * sizeof *d);
   for (int r = 1; r <= p; r++) {
     double a = r <= k ? u[j + 1] : u[j];
     for (int i = p; i >= r; i--) {
-      double lo = u[base + (size_t)i], hi = u[base + (size_t)(i + p + 1 - r)];
-      double al = (a - lo) / (hi - lo);
+      double al = (a - u[base + (size_t)i]) * inv[r * (p + 1) + i];
       d[2 * i] = (1 - al) * d[2 * (i - 1)] + al * d[2 * i];
       d[2 * i + 1] = (1 - al) * d[2 * (i - 1) + 1] + al * d[2 * i + 1];
     }
@@ -330,19 +341,23 @@ static void bezier_point(const double *u, const double *cp, int p, size_t j,
 static double bezier_gap(const km_curve *c, const double *u2, const double *cp2,
                          double limit) {
   int p = c->degree;
-  double gap = 0.0;
+  double gap2 = 0.0, limit2 = limit * limit;
+  double ie[(KM_MAX_DEGREE + 1) * (KM_MAX_DEGREE + 1)];
+  double ir[(KM_MAX_DEGREE + 1) * (KM_MAX_DEGREE + 1)];
   for (size_t j = (size_t)p; j < c->n; j++) {
     if (!(c->knots[j] < c->knots[j + 1])) continue;
+    span_inverses(c->knots, p, j, ie);
+    span_inverses(u2, p, j, ir);
     for (int k = 0; k <= p; k++) {
       double e[2], r[2];
-      bezier_point(c->knots, c->cp, p, j, k, e);
-      bezier_point(u2, cp2, p, j, k, r);
-      double d = hypot(r[0] - e[0], r[1] - e[1]);
-      if (d > gap) gap = d;
+      bezier_point(c->knots, c->cp, p, j, k, ie, e);
+      bezier_point(u2, cp2, p, j, k, ir, r);
+      double dx = r[0] - e[0], dy = r[1] - e[1];
+      gap2 = fmax(gap2, dx * dx + dy * dy);
     }
-    if (gap > limit) break;
+    if (gap2 > limit2) break;
   }
-  return gap;
+  return sqrt(gap2);
 }
 
 /* The knots of c on the coarsest decimal grid (tried from an estimate,
@@ -472,9 +487,12 @@ bool api__json_curve(api_ctx *ctx, api_svg_buf *b, const km_curve *c,
       finite = finite && isfinite(c->cp[i]);
       rounded[i] = api__num_grid_value(c->cp[i], grid->decimals);
     }
-    for (size_t i = 0; i < c->n; i++)
-      largest = fmax(largest, hypot(rounded[2 * i] - c->cp[2 * i],
-                                    rounded[2 * i + 1] - c->cp[2 * i + 1]));
+    for (size_t i = 0; i < c->n; i++) {
+      double dx = rounded[2 * i] - c->cp[2 * i],
+             dy = rounded[2 * i + 1] - c->cp[2 * i + 1];
+      largest = fmax(largest, dx * dx + dy * dy);
+    }
+    largest = sqrt(largest);
     bool knots_finite = true;
     for (size_t i = 0; i < nk; i++)
       knots_finite = knots_finite && isfinite(c->knots[i]);
