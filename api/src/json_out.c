@@ -337,18 +337,23 @@ static void bezier_point(const double *u, const double *cp, int p, size_t j,
 
 /* The largest distance between the spans' Bezier points of c and of the
  * curve with knots u2 and control points cp2 (the same spans); stops once
- * past limit. */
+ * past limit. cp_moved: the largest distance between c's control points
+ * and cp2's, which is what a cubic span between knots of multiplicity two
+ * or more moves at its inner Bezier points (they are control points). */
 static double bezier_gap(const km_curve *c, const double *u2, const double *cp2,
-                         double limit) {
+                         double cp_moved, double limit) {
   int p = c->degree;
-  double gap2 = 0.0, limit2 = limit * limit;
+  const double *u = c->knots;
+  double gap2 = cp_moved * cp_moved, limit2 = limit * limit;
   double ie[(KM_MAX_DEGREE + 1) * (KM_MAX_DEGREE + 1)];
   double ir[(KM_MAX_DEGREE + 1) * (KM_MAX_DEGREE + 1)];
   for (size_t j = (size_t)p; j < c->n; j++) {
     if (!(c->knots[j] < c->knots[j + 1])) continue;
     span_inverses(c->knots, p, j, ie);
     span_inverses(u2, p, j, ir);
-    for (int k = 0; k <= p; k++) {
+    /* inner Bezier points of such a span: counted in cp_moved */
+    bool hermite = p == 3 && u[j - 1] == u[j] && u[j + 1] == u[j + 2];
+    for (int k = 0; k <= p; k += hermite ? p : 1) {
       double e[2], r[2];
       bezier_point(c->knots, c->cp, p, j, k, ie, e);
       bezier_point(u2, cp2, p, j, k, ir, r);
@@ -404,7 +409,7 @@ static bool knot_grid(const km_curve *c, const double *cp2, double cp_moved,
                u2[i] >= u2[i - 1];
     }
     if (!same) continue;
-    double g = bezier_gap(c, u2, cp2, share);
+    double g = bezier_gap(c, u2, cp2, cp_moved, share);
     if (g + slack <= share) {
       *decimals = d;
       *gap = g + slack;
