@@ -10,6 +10,7 @@
  * (0.1 + 0.2 comes out as 0.3). We print the shortest decimal that reads
  * back exactly (num_print.c) and hand cJSON the text as a raw item.
  */
+#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -282,8 +283,157 @@ bool api__parse_precision(api_ctx *ctx, const cJSON *root, api_precision *out) {
 }
 
 api_grid api__tolerance_grid(double tol) {
-  api_grid g = {true, api__grid_decimals(0.1 * tol)};
+  api_grid g = {true, api__grid_decimals(0.1 * tol), 0.1 * tol};
   return g;
+}
+
+/* ---- knots on a grid ---------------------------------------------------
+ *
+ * A curve printed with rounded knots u2 and rounded control points cp2 is
+ * compared span by span with the exact one: each span (u_j < u_(j+1)) of
+ * either is a Bezier curve of degree p over the same local parameter, its
+ * points the blossoms at p - k copies of u_j and k of u_(j+1). Bernstein
+ * weights are non-negative and sum to one, so no point of a span moves by
+ * more than the largest distance between corresponding Bezier points. For
+ * cubic frames (double knots at smooth joins) that is the implied joint's
+ * movement along b_left -> b_right with the control points' own rounding;
+ * triple and end knots count only through the ratios of their neighbours.
+ * Kept only while the knots keep their multiplicities (no span collapses,
+ * none appears) and the whole movement fits in the grid's share. */
+
+#define KNOT_GRID_DECADES 6 /* tried past the first candidate */
+
+/* The reciprocals of de Boor's denominators on span j of degree p with
+ * knots u, level r (1..p) and local index i (r..p) at inv[r * (p + 1) +
+ * i]: shared by the span's Bezier points. */
+static void span_inverses(const double *u, int p, size_t j, double *inv) {
+  size_t base = j - (size_t)p;
+  for (int r = 1; r <= p; r++)
+    for (int i = r; i <= p; i++)
+      inv[r * (p + 1) + i] =
+          1.0 / (u[base + (size_t)(i + p + 1 - r)] - u[base + (size_t)i]);
+}
+
+/* The k-th Bezier point of span j of the non-rational B-spline of degree
+ * p with knots u and control points cp, by de Boor's algorithm on the
+ * blossom's arguments (k copies of u_(j+1), then u_j); inv from
+ * span_inverses. */
+static void bezier_point(const double *u, const double *cp, int p, size_t j,
+                         int k, const double *inv, double out[2]) {
+  double d[2 * (KM_MAX_DEGREE + 1)];
+  size_t base = j - (size_t)p;
+  memcpy(d, cp + 2 * base, 2 * (size_t)(p + 1) * sizeof *d);
+  for (int r = 1; r <= p; r++) {
+    double a = r <= k ? u[j + 1] : u[j];
+    for (int i = p; i >= r; i--) {
+      double al = (a - u[base + (size_t)i]) * inv[r * (p + 1) + i];
+      d[2 * i] = (1 - al) * d[2 * (i - 1)] + al * d[2 * i];
+      d[2 * i + 1] = (1 - al) * d[2 * (i - 1) + 1] + al * d[2 * i + 1];
+    }
+  }
+  out[0] = d[2 * p];
+  out[1] = d[2 * p + 1];
+}
+
+/* The largest distance between the spans' Bezier points of c and of the
+ * curve with knots u2 and control points cp2 (the same spans); stops once
+ * past limit. cp_moved: the largest distance between c's control points
+ * and cp2's, which is what a cubic span between knots of multiplicity two
+ * or more moves at its inner Bezier points (they are control points). */
+static double bezier_gap(const km_curve *c, const double *u2, const double *cp2,
+                         double cp_moved, double limit) {
+  int p = c->degree;
+  const double *u = c->knots;
+  double gap2 = cp_moved * cp_moved, limit2 = limit * limit;
+  double ie[(KM_MAX_DEGREE + 1) * (KM_MAX_DEGREE + 1)];
+  double ir[(KM_MAX_DEGREE + 1) * (KM_MAX_DEGREE + 1)];
+  for (size_t j = (size_t)p; j < c->n; j++) {
+    if (!(c->knots[j] < c->knots[j + 1])) continue;
+    span_inverses(c->knots, p, j, ie);
+    span_inverses(u2, p, j, ir);
+    /* inner Bezier points of such a span: counted in cp_moved */
+    bool hermite = p == 3 && u[j - 1] == u[j] && u[j + 1] == u[j + 2];
+    for (int k = 0; k <= p; k += hermite ? p : 1) {
+      double e[2], r[2];
+      bezier_point(c->knots, c->cp, p, j, k, ie, e);
+      bezier_point(u2, cp2, p, j, k, ir, r);
+      double dx = r[0] - e[0], dy = r[1] - e[1];
+      gap2 = fmax(gap2, dx * dx + dy * dy);
+    }
+    if (gap2 > limit2) break;
+  }
+  return sqrt(gap2);
+}
+
+/* The knots of c on the coarsest decimal grid (tried from an estimate,
+ * one decade finer at a time) on which the curve with them and the
+ * rounded control points cp2 stays within share of c: u2 receives them,
+ * *decimals the grid, *gap the movement (rounding of the computation
+ * included). false (exact knots): rational curves, and no grid within
+ * KNOT_GRID_DECADES of the estimate. */
+static bool knot_grid(const km_curve *c, const double *cp2, double cp_moved,
+                      double share, double *u2, int *decimals, double *gap) {
+  int p = c->degree;
+  size_t nk = c->n + (size_t)p + 1;
+  double min_gap = INFINITY, speed = 0.0, scale = 0.0;
+  if (c->w != NULL || p < 1 || p > KM_MAX_DEGREE || c->n <= (size_t)p)
+    return false;
+  for (size_t i = 0; i + 1 < nk; i++) {
+    double h = c->knots[i + 1] - c->knots[i];
+    if (h > 0 && h < min_gap) min_gap = h;
+  }
+  for (size_t i = 0; i < c->n; i++) {
+    scale = fmax(scale, fmax(fabs(c->cp[2 * i]), fabs(c->cp[2 * i + 1])));
+    if (i + 1 == c->n) break;
+    double h = c->knots[i + (size_t)p + 1] - c->knots[i + 1];
+    double dx = c->cp[2 * i + 2] - c->cp[2 * i],
+           dy = c->cp[2 * i + 3] - c->cp[2 * i + 1];
+    if (h > 0) speed = fmax(speed, p * hypot(dx, dy) / h);
+  }
+  /* what computing the Bezier points may get wrong, both curves */
+  double slack = 64 * (p + 1) * DBL_EPSILON * scale;
+  double budget = share - cp_moved - slack;
+  if (!(budget > 0) || !isfinite(min_gap)) return false;
+  /* knots moved by half a step each move a double knot's ratio lambda by
+   * at most a step over the two spans, and its joint along b_left ->
+   * b_right, a third of the spans times the speed at most: a step of
+   * three budgets over the speed fits; one more budget tried as well */
+  double step = speed > 0 ? fmin(min_gap, 4 * budget / speed) : min_gap;
+  int d0 = api__grid_decimals(step);
+  for (int d = d0; d < d0 + KNOT_GRID_DECADES; d++) {
+    bool same = true;
+    for (size_t i = 0; i < nk && same; i++) {
+      u2[i] = api__num_grid_value(c->knots[i], d);
+      if (i > 0)
+        same = (u2[i] == u2[i - 1]) == (c->knots[i] == c->knots[i - 1]) &&
+               u2[i] >= u2[i - 1];
+    }
+    if (!same) continue;
+    double g = bezier_gap(c, u2, cp2, cp_moved, share);
+    if (g + slack <= share) {
+      *decimals = d;
+      *gap = g + slack;
+      return true;
+    }
+  }
+  return false;
+}
+
+/* n values on the grid 10^-decimals as [v,...]. */
+static void json_values_grid(api_svg_buf *b, const double *v, size_t n,
+                             int decimals) {
+  char *at = api__svg_buf_room(b, 2 + n * (API_NUM_PRINT_MAX + 1));
+  if (at == NULL) return;
+  char *p = at;
+  *p++ = '[';
+  for (size_t i = 0; i < n; i++) {
+    double got;
+    if (i > 0) *p++ = ',';
+    p += api__num_print_grid(p, v[i], decimals, &got);
+  }
+  *p++ = ']';
+  *p = '\0';
+  b->len += (size_t)(p - at);
 }
 
 /* n points on grid g as [[x,y],...]; rounded receives the points as they
@@ -324,25 +474,56 @@ double api__curve_length(const km_curve *c) {
 bool api__json_curve(api_ctx *ctx, api_svg_buf *b, const km_curve *c,
                      bool svg_d, double tol, const api_grid *grid,
                      double known_length, double *moved) {
-  double length, largest = 0.0;
+  double length, largest = 0.0, knot_gap = 0.0;
   km_curve printed = *c;
-  double *rounded = NULL;
-  bool ok = false;
-  API_JSON_LIT(b, "{\"degree\":");
-  if (!api__json_num(ctx, b, c->degree, "degree")) return false;
-  API_JSON_LIT(b, ",\"knots\":");
-  if (!api__json_nums(ctx, b, c->knots, c->n + (size_t)c->degree + 1, 1))
-    return false;
-  API_JSON_LIT(b, ",\"control_points\":");
+  double *rounded = NULL, *u2 = NULL;
+  size_t nk = c->n + (size_t)c->degree + 1;
+  int knot_decimals = 0;
+  bool ok = false, knots_on_grid = false;
   if (grid != NULL && grid->on) {
-    if ((rounded = km__malloc((c->n > 0 ? 2 * c->n : 1) * sizeof *rounded)) ==
-        NULL)
+    if ((rounded = km__malloc((c->n > 0 ? 2 * c->n : 1) * sizeof *rounded +
+                              nk * sizeof *u2)) == NULL)
       return api__oom(ctx);
+    u2 = rounded + (c->n > 0 ? 2 * c->n : 1);
+    /* the control points as they will read back, to choose the knots'
+     * grid with; printed (and rounded again, alike) below */
+    bool finite = true;
+    for (size_t i = 0; i < 2 * c->n; i++) {
+      finite = finite && isfinite(c->cp[i]);
+      rounded[i] = api__num_grid_value(c->cp[i], grid->decimals);
+    }
+    for (size_t i = 0; i < c->n; i++) {
+      double dx = rounded[2 * i] - c->cp[2 * i],
+             dy = rounded[2 * i + 1] - c->cp[2 * i + 1];
+      largest = fmax(largest, dx * dx + dy * dy);
+    }
+    largest = sqrt(largest);
+    bool knots_finite = true;
+    for (size_t i = 0; i < nk; i++)
+      knots_finite = knots_finite && isfinite(c->knots[i]);
+    if (finite && knots_finite)
+      knots_on_grid = knot_grid(c, rounded, largest, grid->share, u2,
+                                &knot_decimals, &knot_gap);
+    largest = 0.0;
+  }
+  API_JSON_LIT(b, "{\"degree\":");
+  if (!api__json_num(ctx, b, c->degree, "degree")) goto done;
+  API_JSON_LIT(b, ",\"knots\":");
+  if (knots_on_grid) {
+    json_values_grid(b, c->knots, nk, knot_decimals);
+    printed.knots = u2;
+  } else if (!api__json_nums(ctx, b, c->knots, nk, 1)) {
+    goto done;
+  }
+  API_JSON_LIT(b, ",\"control_points\":");
+  if (rounded != NULL) {
     if (!json_points_grid(ctx, b, c->cp, c->n, grid, rounded, &largest))
       goto done;
     printed.cp = rounded;
+    /* the whole movement, knots' included, when they are rounded */
+    if (knots_on_grid) largest = fmax(largest, knot_gap);
   } else if (!api__json_nums(ctx, b, c->cp, c->n, 2)) {
-    return false;
+    goto done;
   }
   if (c->w != NULL) {
     API_JSON_LIT(b, ",\"weights\":");
@@ -354,9 +535,10 @@ bool api__json_curve(api_ctx *ctx, api_svg_buf *b, const km_curve *c,
     API_JSON_LIT(b, ",\"closed\":false,\"length\":");
   /* the length of the curve as printed, which the contract promises:
    * the curve's own when printed exactly and already measured */
-  length = printed.cp == c->cp && !isnan(known_length)
-               ? known_length
-               : km_curve_length_within(&printed, LENGTH_REL_TOL);
+  length =
+      printed.cp == c->cp && printed.knots == c->knots && !isnan(known_length)
+          ? known_length
+          : km_curve_length_within(&printed, LENGTH_REL_TOL);
   if (!api__json_num(ctx, b, length, "length")) goto done;
   if (svg_d) {
     /* Default tolerance as everywhere: 1e-5 of the curve's length. */

@@ -32,23 +32,33 @@ bool api__json_nums(api_ctx *ctx, api_svg_buf *b, const double *v, size_t n,
 typedef struct api_grid {
   bool on;
   int decimals;
+  double share; /* of the tolerance the printed curve may move by */
 } api_grid;
 
 /* The grid of "precision": "tolerance" for a tolerance tol (> 0): the
- * coarsest 10^-d at most tol / 10. A point so rounded moves by at most
- * sqrt(2)/2 of it (both coordinates by half a step), 0.071 tol, and so
- * does the curve: a B-spline point is a convex combination of its control
- * points, with or without (positive, unrounded) weights. */
+ * coarsest 10^-d at most tol / 10, and the share tol / 10 the printed
+ * curve may move by. A point so rounded moves by at most sqrt(2)/2 of it
+ * (both coordinates by half a step), 0.071 tol, and so does the curve: a
+ * B-spline point is a convex combination of its control points, with or
+ * without (positive, unrounded) weights. The knots of a polynomial curve
+ * go on a grid of their own, the coarsest found on which the whole
+ * movement (api__json_curve) stays within the share. */
 api_grid api__tolerance_grid(double tol);
 
 /* A curve as the contract's Curve (output) object (degree, knots,
  * control_points, weights when rational, closed, length, svg_d when
  * asked), its control points on grid (NULL: exact) with the length of
  * the curve so printed (known_length, api__curve_length's, when printed
- * exactly and already measured; else NAN). *moved (may be NULL) receives the largest distance a
- * control point moved by printing (0 when exact). Knots, weights and
- * length are always exact: rounding a knot or a weight moves the curve
- * by more than its share. */
+ * exactly and already measured; else NAN). On a grid, a polynomial
+ * curve's knots go on the coarsest decimal grid (from an estimate, a
+ * decade finer at a time, a few at most) that keeps every multiplicity
+ * and on which the printed curve stays within grid->share of c: span by
+ * span, the largest distance between the Bezier points of c and of the
+ * printed curve (rounded knots and control points), which bounds every
+ * point of the span at the same local parameter; else exact. *moved (may
+ * be NULL) receives a bound on how far printing moved the curve (0 when
+ * exact). Weights (and a rational curve's knots), length and svg_d's
+ * source stay exact. */
 bool api__json_curve(api_ctx *ctx, api_svg_buf *b, const km_curve *c,
                      bool svg_d, double tol, const api_grid *grid,
                      double known_length, double *moved);

@@ -148,9 +148,11 @@ bool api__shape_check_size(api_ctx *ctx, api_morph_plan *pl,
 
 /* The JSON answer's frame of a compound morph, written into b as
  * json_write.h writes: t, contours (null for an absent one), svg_d when
- * asked, metrics when asked. False with the error in ctx. */
+ * asked, metrics when asked; contours on grid as single frames' curves
+ * (NULL: exact). False with the error in ctx. */
 bool api__shape_frame_write(api_ctx *ctx, api_svg_buf *b,
-                            const api_morph_plan *pl, const api_frame_slot *f);
+                            const api_morph_plan *pl, const api_frame_slot *f,
+                            const api_grid *grid);
 
 /* "contour_matches_used": the pairs of the morph, into b. */
 bool api__shape_pairs_write(api_ctx *ctx, api_svg_buf *b,

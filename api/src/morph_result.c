@@ -75,7 +75,7 @@ static bool animate_write(api_ctx *ctx, api_svg_buf *b,
 }
 
 api_grid api__plan_grid(const api_morph_plan *pl) {
-  api_grid grid = {false, 0};
+  api_grid grid = {false, 0, 0.0};
   if (pl->precision == API_PRECISION_TOLERANCE)
     grid = api__tolerance_grid(pl->tol);
   return grid;
@@ -84,7 +84,7 @@ api_grid api__plan_grid(const api_morph_plan *pl) {
 /* One frame's object: its t, its curve, its metrics when asked for. */
 bool api__frame_write(api_ctx *ctx, api_svg_buf *b, const api_morph_plan *pl,
                       const api_frame_slot *f, const api_grid *grid) {
-  if (pl->shapes) return api__shape_frame_write(ctx, b, pl, f);
+  if (pl->shapes) return api__shape_frame_write(ctx, b, pl, f, grid);
   API_JSON_LIT(b, "{\"t\":");
   if (!api__json_num(ctx, b, f->t, "t")) return false;
   API_JSON_LIT(b, ",\"curve\":");

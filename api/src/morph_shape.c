@@ -460,7 +460,8 @@ static bool shape_metrics_write(api_ctx *ctx, api_svg_buf *b,
 }
 
 bool api__shape_frame_write(api_ctx *ctx, api_svg_buf *b,
-                            const api_morph_plan *pl, const api_frame_slot *f) {
+                            const api_morph_plan *pl, const api_frame_slot *f,
+                            const api_grid *grid) {
   const km_shape_frame *sf = &f->shape;
   API_JSON_LIT(b, "{\"t\":");
   if (!api__json_num(ctx, b, f->t, "t")) return false;
@@ -469,7 +470,7 @@ bool api__shape_frame_write(api_ctx *ctx, api_svg_buf *b,
     if (k > 0) API_JSON_LIT(b, ",");
     if (!sf->present[k])
       API_JSON_LIT(b, "null");
-    else if (!api__json_curve(ctx, b, &sf->contours[k], false, pl->tol, NULL,
+    else if (!api__json_curve(ctx, b, &sf->contours[k], false, pl->tol, grid,
                               NAN, NULL))
       return false;
   }

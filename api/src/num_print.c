@@ -591,6 +591,16 @@ static const double exact_pow10[23] = {
     1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
     1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 
+double api__num_grid_value(double v, int decimals) {
+  if (decimals > 22 || decimals < -22) return v;
+  double scaled =
+      decimals >= 0 ? v * exact_pow10[decimals] : v / exact_pow10[-decimals];
+  if (!(fabs(scaled) < 0x1p53)) return v;
+  double n = nearbyint(scaled);
+  if (n == 0) return 0.0;
+  return decimals >= 0 ? n / exact_pow10[decimals] : n * exact_pow10[-decimals];
+}
+
 size_t api__num_print_grid(char *out, double v, int decimals, double *got) {
   if (decimals > 22 || decimals < -22) {
     *got = v;

@@ -65,6 +65,10 @@ size_t api__num_print_within(char *out, double x, double budget, double *got);
  * / 2 + 2^-52 |v|. v must be finite. Returns the length (at most 24). */
 size_t api__num_print_grid(char *out, double v, int decimals, double *got);
 
+/* The double api__num_print_grid(_, v, decimals, &got) leaves in got,
+ * without printing it (to try grids before printing on one). */
+double api__num_grid_value(double v, int decimals);
+
 /* The decimals of the coarsest grid 10^-decimals that is at most step
  * (> 0, finite): the grid "precision": "tolerance" prints on. */
 int api__grid_decimals(double step);

@@ -42,8 +42,8 @@ static bool reconstruct(api_ctx *ctx, const api_request *req, const options *o,
   km_stop stop_buf;
   size_t predicted;
   /* the answer's curve is held to the limit on curves, as inputs are */
-  /* on the tolerance's grid the printing may move the curve by 0.071 of
-   * the tolerance (json_write.h): the fit leaves it a tenth */
+  /* on the tolerance's grids the printing may move the curve by a tenth
+   * of the tolerance, knots included (json_write.h): the fit leaves it */
   double tol = o->tol > 0 ? o->tol : 1e-5 * sig->length;
   if (o->precision == API_PRECISION_TOLERANCE) tol *= 0.9;
   km_status st = km_reconstruct_until(
@@ -71,7 +71,7 @@ static bool reconstruct(api_ctx *ctx, const api_request *req, const options *o,
 static bool answer_write(api_ctx *ctx, api_svg_buf *b, const options *o,
                          double length, const km_curve *curve, double bound) {
   double tol = o->tol > 0 ? o->tol : 1e-5 * length, moved = 0.0;
-  api_grid grid = {false, 0};
+  api_grid grid = {false, 0, 0.0};
   if (o->precision == API_PRECISION_TOLERANCE) grid = api__tolerance_grid(tol);
   API_JSON_LIT(b, "{\"curve\":");
   if (!api__json_curve(ctx, b, curve, o->inc.svg_d, tol, &grid, NAN, &moved))

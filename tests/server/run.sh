@@ -41,7 +41,7 @@ fi
 # 3. The live-daemon tests.
 out=$(cd tests/server && timeout "${KM_TEST_TIMEOUT:-900}" "$PY" -m unittest -v \
         test_contract test_jobs test_load test_shutdown test_http_framing test_signals \
-        test_bounds test_shapes test_healthcheck test_conventions 2>&1)
+        test_bounds test_shapes test_healthcheck test_conventions test_precision 2>&1)
 rc=$?
 printf '%s\n' "$out" | grep -E ' \.\.\. |^(FAIL|ERROR):|^Ran |^OK|^FAILED|Error|assert' | head -n 400
 ran=$(printf '%s\n' "$out" | sed -n 's/^Ran \([0-9]*\) tests\{0,1\}.*/\1/p' | tail -n 1)
