@@ -349,11 +349,34 @@ static double bezier_gap(const km_curve *c, const double *u2, const double *cp2,
   double ir[(KM_MAX_DEGREE + 1) * (KM_MAX_DEGREE + 1)];
   for (size_t j = (size_t)p; j < c->n; j++) {
     if (!(c->knots[j] < c->knots[j + 1])) continue;
-    span_inverses(c->knots, p, j, ie);
-    span_inverses(u2, p, j, ir);
     /* inner Bezier points of such a span: counted in cp_moved */
     bool hermite = p == 3 && u[j - 1] == u[j] && u[j + 1] == u[j + 2];
-    for (int k = 0; k <= p; k += hermite ? p : 1) {
+    if (hermite) {
+      /* its ends by de Boor's algorithm worked out: with u_(j-1) = u_j the
+       * start is P_(j-3) + a (P_(j-2) - P_(j-3)), a = (u_j - u_(j-2)) /
+       * (u_(j+1) - u_(j-2)), and with u_(j+1) = u_(j+2) the end is
+       * P_(j-1) + b (P_j - P_(j-1)), b = (u_(j+1) - u_j) / (u_(j+3) -
+       * u_j): the joints' ratios (and the ends, where a = 0 or b = 1) */
+      const double *P = c->cp + 2 * (j - 3), *Q = cp2 + 2 * (j - 3);
+      double a = (u[j] - u[j - 2]) / (u[j + 1] - u[j - 2]),
+             a2 = (u2[j] - u2[j - 2]) / (u2[j + 1] - u2[j - 2]),
+             b = (u[j + 1] - u[j]) / (u[j + 3] - u[j]),
+             b2 = (u2[j + 1] - u2[j]) / (u2[j + 3] - u2[j]);
+      double d0[2], d3[2];
+      for (int x = 0; x < 2; x++) {
+        d0[x] =
+            (Q[x] + a2 * (Q[2 + x] - Q[x])) - (P[x] + a * (P[2 + x] - P[x]));
+        d3[x] = (Q[4 + x] + b2 * (Q[6 + x] - Q[4 + x])) -
+                (P[4 + x] + b * (P[6 + x] - P[4 + x]));
+      }
+      gap2 = fmax(gap2, fmax(d0[0] * d0[0] + d0[1] * d0[1],
+                             d3[0] * d3[0] + d3[1] * d3[1]));
+      if (gap2 > limit2) break;
+      continue;
+    }
+    span_inverses(c->knots, p, j, ie);
+    span_inverses(u2, p, j, ir);
+    for (int k = 0; k <= p; k++) {
       double e[2], r[2];
       bezier_point(c->knots, c->cp, p, j, k, ie, e);
       bezier_point(u2, cp2, p, j, k, ir, r);
