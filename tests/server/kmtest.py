@@ -170,5 +170,18 @@ class ContractCase(unittest.TestCase):
         return doc
 
 
+class DaemonCase(ContractCase):
+    """A contract case with one kmorphd (two compute threads) shared by
+    the class's tests, as d."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.d = Daemon("--threads", "2")
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.d.stop()
+
+
 def close_to(a, b, rel):
     return math.isclose(a, b, rel_tol=rel, abs_tol=rel)

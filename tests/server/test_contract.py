@@ -10,10 +10,10 @@ import unittest
 
 import yaml
 
-from kmtest import (DAEMON, ROOT, SPEC, ContractCase, Daemon, circle_svg,
-                    close_to, heavy_morph_body, metric, morph_body, open_arc,
-                    raw_exchange, raw_status, schema_errors, component,
-                    ring_morph_body, run_job, wait_for)
+from kmtest import (DAEMON, ROOT, SPEC, ContractCase, Daemon, DaemonCase,
+                    circle_svg, close_to, component, heavy_morph_body, metric,
+                    morph_body, open_arc, raw_exchange, raw_status,
+                    ring_morph_body, run_job, schema_errors, wait_for)
 
 TWO_PI = 2 * math.pi
 
@@ -311,17 +311,9 @@ class CommandLine(unittest.TestCase):
             d.stop()
 
 
-class GeometryEndpoints(ContractCase):
+class GeometryEndpoints(DaemonCase):
     """Real computations through HTTP; the expected numbers are those of
     circles (length 2 pi r, curvature 1/r, turning 2 pi)."""
-
-    @classmethod
-    def setUpClass(cls):
-        cls.d = Daemon("--threads", "2")
-
-    @classmethod
-    def tearDownClass(cls):
-        cls.d.stop()
 
     def test_signature_of_a_circle_has_length_2_pi_r_and_turning_2_pi(self):
         r = self.d.request("POST", "/v1/signature",

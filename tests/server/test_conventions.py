@@ -12,7 +12,8 @@ import subprocess
 import time
 import unittest
 
-from kmtest import (DAEMON, HOST, ROOT, SPEC, ContractCase, Daemon, deref,
+from kmtest import (DAEMON, HOST, ROOT, SPEC, ContractCase, Daemon,
+                    DaemonCase, deref,
                     component,
                     metric, morph_body, raw_exchange, ring_morph_body,
                     run_job, schema_errors, wait_for)
@@ -530,18 +531,10 @@ def media_types():
                 yield "%s %s %s" % (method, path, status), mt, obj
 
 
-class Examples(ContractCase):
+class Examples(DaemonCase):
     """Every request and response of the contract has examples; request
     examples are the files of docs/examples, answered by the live daemon
     with a documented status and schema."""
-
-    @classmethod
-    def setUpClass(cls):
-        cls.d = Daemon("--threads", "2")
-
-    @classmethod
-    def tearDownClass(cls):
-        cls.d.stop()
 
     def test_every_request_body_has_examples_from_docs_examples(self):
         seen = 0

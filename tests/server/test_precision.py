@@ -15,7 +15,7 @@ import os
 import sys
 import unittest
 
-from kmtest import ROOT, Daemon
+from kmtest import ROOT, DaemonCase
 
 sys.path.insert(0, os.path.join(ROOT, "bench", "e2e"))
 from pairs import load_pairs  # noqa: E402
@@ -56,15 +56,7 @@ def curves(frame):
     return frame["contours"] if "contours" in frame else [frame["curve"]]
 
 
-class ToleranceGrids(unittest.TestCase):
-    @classmethod
-    def setUpClass(cls):
-        cls.d = Daemon("--threads", "2")
-
-    @classmethod
-    def tearDownClass(cls):
-        cls.d.stop()
-
+class ToleranceGrids(DaemonCase):
     def answer(self, a, b, precision):
         body = {"from": {"type": "svg", "d": a}, "to": {"type": "svg", "d": b},
                 "frames": FRAMES, "metrics": False, "tolerance": TOL,

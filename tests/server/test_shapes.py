@@ -8,7 +8,7 @@ import os
 import unittest
 import xml.etree.ElementTree as ET
 
-from kmtest import ROOT, ContractCase, Daemon, circle_svg, run_job
+from kmtest import ROOT, ContractCase, Daemon, DaemonCase, circle_svg, run_job
 
 FIXTURES = os.path.join(ROOT, "tests", "fixtures", "compound")
 
@@ -35,15 +35,7 @@ def ring(r_out, r_in):
             circle_svg(r_in)["d"]}
 
 
-class CompoundMorphs(ContractCase):
-    @classmethod
-    def setUpClass(cls):
-        cls.d = Daemon("--threads", "2")
-
-    @classmethod
-    def tearDownClass(cls):
-        cls.d.stop()
-
+class CompoundMorphs(DaemonCase):
     def body(self, frames=5):
         return {"from": glyph(PAIR["from"]), "to": glyph(PAIR["to"]),
                 "frames": frames, "include": ["svg_d"]}
