@@ -266,7 +266,7 @@ static double bern_max_abs_within(const double *c, int d, double lower,
   if (ends > lower) lower = ends;
   double upper = km__bern_abs_bound(c, d);
   if (upper <= lower * (1.0 + rel) || depth > 60) return fmax(lower, ends);
-  double at, top = concave_max_abs(c, d, &at);
+  double at = 0.0, top = concave_max_abs(c, d, &at);
   if (at > lower && top < INFINITY) lower = at;
   if (top <= lower * (1.0 + rel)) return lower;
   double L[FN_MAX_DEGREE + 2], R[FN_MAX_DEGREE + 2];
